@@ -1,0 +1,166 @@
+# Ajar — build, test, bench, demo, install.
+# `make help` lists the targets. Quiet unless V=1. Objects per mode in build/<mode>.
+
+PREFIX ?= /usr/local
+MODE ?= release
+BUILD := build/$(MODE)
+V ?= 0
+Q := $(if $(filter 1,$(V)),,@)
+
+CC ?= cc
+CXX ?= c++
+PKGS := OpenEXR OpenCL tinygltf stb
+PKG_CFLAGS = $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
+PKG_LIBS = $(shell pkg-config --libs OpenEXR OpenCL tinygltf 2>/dev/null)
+WARN := -Wall -Wextra -Werror -Wno-unused-parameter
+MODE_FLAGS_release := -O2 -g
+MODE_FLAGS_debug := -O0 -g
+MODE_FLAGS_asan := -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
+MFLAGS := $(MODE_FLAGS_$(MODE))
+CPPFLAGS += -Iinclude -Isrc -MMD -MP
+CFLAGS += -std=c11 -D_GNU_SOURCE $(WARN) $(MFLAGS) -fPIC
+CXXFLAGS += -std=c++14 $(WARN) $(MFLAGS) -fPIC
+LDFLAGS += $(MFLAGS)
+LDLIBS = $(PKG_LIBS) -lz -lm -lpthread
+
+LIB_C := $(wildcard src/*.c)
+LIB_CXX := $(wildcard src/*.cpp)
+LIB_OBJS := $(LIB_C:src/%.c=$(BUILD)/src/%.o) $(LIB_CXX:src/%.cpp=$(BUILD)/src/%.o) $(BUILD)/kernel_source.o
+CLI_OBJS := $(patsubst src/cli/%.c,$(BUILD)/cli/%.o,$(wildcard src/cli/*.c))
+KERNELS := $(wildcard kernels/*.h kernels/*.cl)
+TESTS := $(patsubst tests/%.c,%,$(wildcard tests/test_*.c))
+
+# One test binary per module, linking only what it tests (plus error.o).
+obj = $(addprefix $(BUILD)/src/,$(addsuffix .o,$(1)))
+DEPS_test_bsdf := $(call obj,error)
+DEPS_test_sampling := $(call obj,error)
+DEPS_test_bvh := $(call obj,error scene bvh)
+DEPS_test_lights := $(call obj,error scene lights)
+DEPS_test_scene := $(call obj,error scene scene_api gltf exr)
+DEPS_test_exr := $(call obj,error exr png)
+# Tests that render need the whole library.
+DEPS_test_layout := $(BUILD)/libajar.a
+DEPS_test_render := $(BUILD)/libajar.a
+DEPS_test_api := $(BUILD)/libajar.a
+DEPS_test_cli := $(BUILD)/libajar.a
+
+.PHONY: all lib cli tests test test-unit asan demo bench install uninstall clean deps help
+all: lib cli
+
+help:
+	@echo "make demo       install missing packages, build, render scenes/cornell to out/demo.exr + .png"
+	@echo "make test       install missing packages, build and run every test (cmocka)"
+	@echo "make asan       host unit tests under AddressSanitizer + UBSan"
+	@echo "make bench      BVH, traversal, samples/s, start-up figures"
+	@echo "make install    PREFIX=$(PREFIX): ajar, libajar.{a,so}, ajar.h, ajar.pc"
+	@echo "make all        library and CLI (MODE=release|debug|asan, V=1 for commands)"
+
+deps:
+	$(Q)sh tests/deps.sh
+
+lib: $(BUILD)/libajar.a $(BUILD)/libajar.so
+cli: build/ajar
+
+build/ajar: $(BUILD)/ajar
+	$(Q)cp $< $@
+
+$(BUILD)/ajar: $(CLI_OBJS) $(BUILD)/libajar.a
+	@echo "  LD      $@"
+	$(Q)$(CXX) $(LDFLAGS) -o $@ $^ $(LDLIBS)
+
+$(BUILD)/libajar.a: $(LIB_OBJS)
+	@echo "  AR      $@"
+	$(Q)rm -f $@ && ar rcs $@ $^
+
+$(BUILD)/libajar.so: $(LIB_OBJS)
+	@echo "  LD      $@"
+	$(Q)$(CXX) -shared -Wl,-soname,libajar.so.0 $(LDFLAGS) -o $@ $^ $(LDLIBS)
+
+$(BUILD)/src/%.o: src/%.c
+	@mkdir -p $(@D)
+	@echo "  CC      $<"
+	$(Q)$(CC) $(CPPFLAGS) $(PKG_CFLAGS) $(CFLAGS) -c -o $@ $<
+
+$(BUILD)/src/%.o: src/%.cpp
+	@mkdir -p $(@D)
+	@echo "  CXX     $<"
+	$(Q)$(CXX) $(CPPFLAGS) $(PKG_CFLAGS) $(CXXFLAGS) -c -o $@ $<
+
+$(BUILD)/cli/%.o: src/cli/%.c
+	@mkdir -p $(@D)
+	@echo "  CC      $<"
+	$(Q)$(CC) $(CPPFLAGS) $(CFLAGS) -c -o $@ $<
+
+# Kernel sources are embedded in the library, flattened with #line markers
+# so device compiler errors still name kernels/<file>:<line>.
+$(BUILD)/embed_kernels: src/tools/embed_kernels.c
+	@mkdir -p $(@D)
+	$(Q)$(CC) -std=c11 $(WARN) -O1 -o $@ $<
+
+$(BUILD)/kernel_source.c: $(KERNELS) $(BUILD)/embed_kernels
+	@echo "  EMBED   kernels/ajar.cl"
+	$(Q)$(BUILD)/embed_kernels kernels/ajar.cl > $@
+
+$(BUILD)/kernel_source.o: $(BUILD)/kernel_source.c
+	$(Q)$(CC) -std=c11 $(WARN) -O0 -c -o $@ $<
+
+$(BUILD)/tests/%.o: tests/%.c
+	@mkdir -p $(@D)
+	@echo "  CC      $<"
+	$(Q)$(CC) $(CPPFLAGS) -Itests $(PKG_CFLAGS) $(CFLAGS) -c -o $@ $<
+
+# Test binaries link their module objects (secondary expansion of DEPS_*).
+.SECONDEXPANSION:
+$(BUILD)/tests/test_%: $(BUILD)/tests/test_%.o $(BUILD)/tests/testutil.o $$(DEPS_test_$$*)
+	@echo "  LD      $@"
+	$(Q)$(CXX) $(LDFLAGS) -o $@ $^ $(LDLIBS) -lcmocka
+
+.SECONDARY:
+
+$(BUILD)/tests/bench: $(BUILD)/tests/bench.o $(BUILD)/libajar.a
+	@echo "  LD      $@"
+	$(Q)$(CXX) $(LDFLAGS) -o $@ $^ $(LDLIBS)
+
+tests: $(TESTS:%=$(BUILD)/tests/%) build/ajar
+
+test:
+	$(Q)$(MAKE) --no-print-directory deps
+	$(Q)$(MAKE) --no-print-directory tests
+	$(Q)sh tests/run.sh $(BUILD) $(TESTS)
+
+# Host tests that need no OpenCL device, under ASan + UBSan.
+ASAN_TESTS := test_bsdf test_sampling test_bvh test_lights test_scene test_exr
+asan:
+	$(Q)$(MAKE) --no-print-directory deps
+	$(Q)$(MAKE) --no-print-directory MODE=asan $(ASAN_TESTS:%=build/asan/tests/%)
+	$(Q)ASAN_OPTIONS=detect_leaks=1 sh tests/run.sh build/asan $(ASAN_TESTS)
+
+demo:
+	$(Q)$(MAKE) --no-print-directory deps
+	$(Q)$(MAKE) --no-print-directory all
+	@mkdir -p out
+	build/ajar render scenes/cornell/cornell.gltf -o out/demo.exr --png out/demo.png --spp 64
+
+bench:
+	$(Q)$(MAKE) --no-print-directory deps
+	$(Q)$(MAKE) --no-print-directory all $(BUILD)/tests/bench
+	$(BUILD)/tests/bench
+
+install: all
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/lib/pkgconfig
+	install -m 755 build/ajar $(DESTDIR)$(PREFIX)/bin/ajar
+	install -m 644 $(BUILD)/libajar.a $(DESTDIR)$(PREFIX)/lib/libajar.a
+	install -m 755 $(BUILD)/libajar.so $(DESTDIR)$(PREFIX)/lib/libajar.so.0
+	ln -sf libajar.so.0 $(DESTDIR)$(PREFIX)/lib/libajar.so
+	install -m 644 include/ajar.h $(DESTDIR)$(PREFIX)/include/ajar.h
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(shell sed -n 's/.*AJAR_VERSION_STRING "\(.*\)"/\1/p' include/ajar.h)|' \
+		src/ajar.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/ajar.pc
+
+uninstall:
+	rm -f $(DESTDIR)$(PREFIX)/bin/ajar $(DESTDIR)$(PREFIX)/lib/libajar.* $(DESTDIR)$(PREFIX)/include/ajar.h \
+		$(DESTDIR)$(PREFIX)/lib/pkgconfig/ajar.pc
+
+clean:
+	rm -rf build out
+
+-include $(shell find build -name '*.d' 2>/dev/null)

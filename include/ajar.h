@@ -1,0 +1,183 @@
+/* ajar.h — the public C API of Ajar, an unbiased OpenCL renderer for glTF
+ * scenes lit through openings (portal-based bidirectional path tracing).
+ *
+ * Conventions: every fallible call returns an ajar_status; on failure the
+ * message (naming the file and the place in it where there is one) is kept
+ * per thread and returned by ajar_last_error(), and sent to the log callback
+ * if one is set. The library never exits or aborts. Handles are opaque;
+ * destroy functions take the handle's address and clear it. */
+#ifndef AJAR_H
+#define AJAR_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define AJAR_VERSION_MAJOR 0
+#define AJAR_VERSION_MINOR 1
+#define AJAR_VERSION_PATCH 0
+#define AJAR_VERSION_STRING "0.1.0"
+
+typedef enum {
+	AJAR_OK = 0,
+	AJAR_ERROR_INVALID_ARGUMENT = 1, /* a caller's mistake */
+	AJAR_ERROR_BAD_INPUT = 2,        /* a scene or image file is malformed */
+	AJAR_ERROR_IO = 3,               /* cannot read or write a file */
+	AJAR_ERROR_DEVICE = 4,           /* OpenCL: no device, build or run failure */
+	AJAR_ERROR_OUT_OF_MEMORY = 5,
+	AJAR_ERROR_CANCELLED = 6         /* stopped by the caller; the image is valid */
+} ajar_status;
+
+/* Message of the last failure on this thread ("" if none). */
+const char *ajar_last_error(void);
+const char *ajar_status_name(ajar_status status);
+const char *ajar_version(void);
+
+typedef enum { AJAR_LOG_ERROR, AJAR_LOG_WARNING, AJAR_LOG_INFO } ajar_log_level;
+typedef void (*ajar_log_fn)(ajar_log_level level, const char *message, void *user);
+/* Process-wide; NULL restores the default (silence). */
+void ajar_set_log_callback(ajar_log_fn fn, void *user);
+
+/* ---- Devices ----------------------------------------------------------- */
+
+typedef struct {
+	char selector[32];  /* what --device / ajar_options.device accepts, e.g. "0:1" */
+	char platform[128];
+	char name[128];
+	char type[16];      /* "cpu", "gpu", "accelerator", "other" */
+	uint32_t compute_units;
+	uint64_t global_memory; /* bytes */
+} ajar_device_info;
+
+/* Lists every OpenCL device of every platform. *count may be 0. */
+ajar_status ajar_devices(ajar_device_info *out, uint32_t capacity, uint32_t *count);
+
+/* ---- Scenes ------------------------------------------------------------ */
+
+typedef struct ajar_scene ajar_scene;
+
+/* Loads .gltf (with .bin, images) or .glb. Portals are mesh nodes with
+ * extras {"portal": true}; the environment comes from scene extras. */
+ajar_status ajar_scene_load(const char *path, ajar_scene **out);
+/* An empty scene to be filled in code. */
+ajar_status ajar_scene_create(ajar_scene **out);
+void ajar_scene_destroy(ajar_scene **scene);
+
+typedef struct {
+	float base_color[3];     /* linear RGB */
+	float metallic;          /* 0..1 */
+	float roughness;         /* 0..1, perceptual (GGX alpha = roughness^2) */
+	float specular;          /* KHR_materials_specular factor: 0 = pure Lambertian */
+	float transmission;      /* 0..1, KHR_materials_transmission */
+	float ior;               /* KHR_materials_ior */
+	float emission[3];       /* emitted radiance, W sr^-1 m^-2 */
+	int double_sided;
+} ajar_material;
+void ajar_material_default(ajar_material *m); /* white Lambertian */
+ajar_status ajar_scene_add_material(ajar_scene *s, const ajar_material *m, uint32_t *id);
+
+typedef struct {
+	const float *positions;  /* 3 per vertex */
+	const float *normals;    /* 3 per vertex, or NULL */
+	const float *uvs;        /* 2 per vertex, or NULL */
+	uint32_t vertex_count;
+	const uint32_t *indices; /* 3 per triangle, or NULL: vertices taken in threes */
+	uint32_t triangle_count;
+	uint32_t material;       /* from ajar_scene_add_material */
+	const float *transform;  /* column-major 4x4 (as glTF), or NULL for identity */
+} ajar_mesh;
+ajar_status ajar_scene_add_mesh(ajar_scene *s, const ajar_mesh *mesh);
+/* A portal: triangles invisible to every ray, marking an opening. */
+ajar_status ajar_scene_add_portal(ajar_scene *s, const ajar_mesh *mesh);
+
+typedef struct {
+	float position[3];
+	float target[3];
+	float up[3];
+	float yfov;   /* vertical field of view, radians */
+	float aspect; /* width / height; 0 = take it from the image size */
+} ajar_camera;
+ajar_status ajar_scene_set_camera(ajar_scene *s, const ajar_camera *c);
+ajar_status ajar_scene_set_environment_color(ajar_scene *s, const float rgb[3]);
+/* Equirectangular OpenEXR, +Y up, importance-sampled. */
+ajar_status ajar_scene_set_environment_image(ajar_scene *s, const char *exr_path, float strength);
+
+typedef struct {
+	uint64_t triangles;
+	uint32_t materials;
+	uint32_t emissive_triangles;
+	uint32_t portal_triangles;
+	uint32_t portals;
+	uint32_t textures;
+	int environment;         /* 0 none, 1 colour, 2 image */
+	float bounds_min[3], bounds_max[3];
+	ajar_camera camera;
+	int has_camera;          /* 0: a default view framing the bounds is used */
+	uint32_t width, height;  /* suggested resolution (glTF extras), or 0 */
+} ajar_scene_info;
+ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info);
+
+/* ---- Rendering --------------------------------------------------------- */
+
+typedef enum { AJAR_INTEGRATOR_PT = 0, AJAR_INTEGRATOR_BDPT = 1, AJAR_INTEGRATOR_PORTAL = 2 } ajar_integrator;
+
+typedef struct {
+	uint32_t width, height;  /* 0: scene's suggestion, else 512 x 512/aspect */
+	uint32_t spp;            /* samples per pixel; 0 = until time_limit */
+	double time_limit;       /* seconds; 0 = none */
+	ajar_integrator integrator;
+	uint32_t max_depth;      /* maximum path segments */
+	uint32_t seed;
+	const char *device;      /* selector ("0:0", "cpu", "gpu", name substring) or NULL */
+} ajar_options;
+void ajar_options_default(ajar_options *o);
+
+typedef struct {
+	uint64_t samples_done;   /* samples per pixel done, summed over all pixels / pixels */
+	uint32_t spp_done;
+	uint32_t spp_target;     /* 0 if time-limited */
+	double elapsed;          /* seconds */
+	double samples_per_second; /* pixel samples per second */
+	double eta;              /* seconds, < 0 if unknown */
+	double fraction;         /* 0..1 */
+} ajar_progress;
+/* Called after each pass; return non-zero to stop after that pass. */
+typedef int (*ajar_progress_fn)(const ajar_progress *p, void *user);
+
+typedef struct ajar_renderer ajar_renderer;
+
+/* Builds the BVH and tables, compiles (or loads cached) kernels, uploads. */
+ajar_status ajar_renderer_create(const ajar_scene *scene, const ajar_options *o, ajar_renderer **out);
+void ajar_renderer_destroy(ajar_renderer **r);
+/* Renders until spp or time_limit, or until cancelled (AJAR_ERROR_CANCELLED,
+ * with a valid image of the samples done). */
+ajar_status ajar_renderer_render(ajar_renderer *r, ajar_progress_fn fn, void *user);
+/* Safe from a signal handler or another thread. */
+void ajar_renderer_cancel(ajar_renderer *r);
+uint32_t ajar_renderer_spp(const ajar_renderer *r);
+/* The current estimate: width * height RGBA floats, row-major, top row first. */
+ajar_status ajar_renderer_image(ajar_renderer *r, float *rgba, uint32_t *width, uint32_t *height);
+ajar_status ajar_renderer_write_exr(ajar_renderer *r, const char *path);
+ajar_status ajar_renderer_write_png(ajar_renderer *r, const char *path);
+/* The device(s) used, for reports. */
+const char *ajar_renderer_device_name(const ajar_renderer *r);
+
+/* ---- Images ------------------------------------------------------------ */
+
+/* Writes float RGBA (width * height * 4, top row first) as an OpenEXR file;
+ * `attrs` are extra string header attributes as name/value pairs. */
+ajar_status ajar_write_exr(const char *path, const float *rgba, uint32_t width, uint32_t height,
+			   const char *const *attrs, uint32_t nattrs);
+/* Reads an OpenEXR's R, G, B (and A if present, else 1) into a new array
+ * that the caller frees with free(). */
+ajar_status ajar_read_exr(const char *path, float **rgba, uint32_t *width, uint32_t *height);
+/* Tone-mapped (exposure, sRGB) 8-bit PNG of float RGBA. */
+ajar_status ajar_write_png(const char *path, const float *rgba, uint32_t width, uint32_t height);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

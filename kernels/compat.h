@@ -1,0 +1,35 @@
+/* compat.h — lets the kernel headers compile both as OpenCL C and as host C11.
+ *
+ * Everything under kernels/ except ajar.cl includes only this file for
+ * portability. The host compiles the same math for unit tests and
+ * sanitizers (as Cycles does with its kernel), so only the address-space
+ * qualifiers and a few builtins differ between the two worlds. */
+#ifndef AJAR_COMPAT_H
+#define AJAR_COMPAT_H
+
+#ifdef __OPENCL_C_VERSION__
+#define AJAR_DEVICE 1
+#define GLOBAL __global
+#define INLINE inline
+#define STATIC_INLINE static inline
+#define u2f(u) as_float(u)
+#define f2u(f) as_uint(f)
+#else
+#include <stdint.h>
+#include <string.h>
+#include <tgmath.h> /* sqrt(float) must stay float, as in OpenCL */
+typedef unsigned int uint;
+typedef unsigned long ulong;
+#define GLOBAL
+#define INLINE static inline
+#define STATIC_INLINE static inline
+static inline float u2f(uint u) { float f; memcpy(&f, &u, 4); return f; }
+static inline uint f2u(float f) { uint u; memcpy(&u, &f, 4); return u; }
+#endif
+
+#define AJAR_PI 3.14159265358979323846f
+#define AJAR_INV_PI 0.31830988618379067154f
+#define AJAR_INV_2PI 0.15915494309189533577f
+#define AJAR_INF 3.402823466e+38f
+
+#endif

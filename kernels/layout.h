@@ -1,0 +1,33 @@
+/* layout.h — the shared structs' sizes and field offsets, listed once. The
+ * host checks them with static asserts (src/layout.c) and a probe kernel
+ * reports the device compiler's view (tests/test_layout.c). */
+#ifndef AJAR_LAYOUT_H
+#define AJAR_LAYOUT_H
+#include "types.h"
+
+#define AJAR_LAYOUT_TYPES(X) \
+	X(BvhNode, 32) X(Tri, 48) X(TriShade, 64) X(Material, 64) X(Texture, 16) \
+	X(Emitter, 16) X(PortalTri, 48) X(Camera, 64) X(Params, 160)
+
+#define AJAR_LAYOUT_FIELDS(X)                                                          \
+	X(BvhNode, bmin) X(BvhNode, index) X(BvhNode, bmax) X(BvhNode, count)          \
+	X(Tri, p0) X(Tri, p1) X(Tri, p2) X(Tri, material) X(Tri, emitter)              \
+	X(TriShade, n0) X(TriShade, n2) X(TriShade, u0) X(TriShade, v2)                \
+	X(TriShade, has_normals)                                                        \
+	X(Material, base_color) X(Material, base_tex) X(Material, emission)            \
+	X(Material, metallic) X(Material, roughness) X(Material, transmission)         \
+	X(Material, ior) X(Material, specular) X(Material, flags)                      \
+	X(Material, alpha_cutoff)                                                       \
+	X(Texture, offset) X(Texture, width) X(Texture, height)                        \
+	X(Emitter, tri) X(Emitter, area) X(Emitter, pdf_select)                        \
+	X(PortalTri, p0) X(PortalTri, p2) X(PortalTri, area) X(PortalTri, pdf_select)  \
+	X(Camera, pos) X(Camera, tan_half_fov_y) X(Camera, right) X(Camera, aspect)    \
+	X(Camera, up) X(Camera, width) X(Camera, forward) X(Camera, height)            \
+	X(Params, camera) X(Params, num_tris) X(Params, num_emitters)                  \
+	X(Params, num_portals) X(Params, num_textures) X(Params, env_type)             \
+	X(Params, env_width) X(Params, env_height) X(Params, env_strength)             \
+	X(Params, env_color) X(Params, env_pdf_select) X(Params, scene_center)         \
+	X(Params, scene_radius) X(Params, max_depth) X(Params, rr_depth)               \
+	X(Params, integrator) X(Params, seed) X(Params, emitter_power)                 \
+	X(Params, env_power)
+#endif

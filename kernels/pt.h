@@ -1,0 +1,94 @@
+/* pt.h — the unidirectional path tracer, the reference every other
+ * integrator is checked against.
+ *
+ * Next-event estimation to emitters and the environment, combined with BSDF
+ * sampling by the power heuristic; Russian roulette after rr_depth segments
+ * scales only the throughput, so it enters neither strategy's density and
+ * the MIS weights stay consistent (design.md, Pitfalls). max_depth counts
+ * path segments, camera segment included (Mitsuba's max_depth). */
+#ifndef AJAR_PT_H
+#define AJAR_PT_H
+#include "bsdf.h"
+#include "bvh.h"
+#include "camera.h"
+#include "lights.h"
+#include "mis.h"
+#include "rng.h"
+#include "surface.h"
+
+INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
+{
+	GLOBAL const Params *prm = sc->params;
+	V3 L = v3(0.0f, 0.0f, 0.0f), beta = v3(1.0f, 1.0f, 1.0f);
+	float prev_pdf_w = 0.0f;
+	int prev_delta = 1; /* the camera ray counts emission in full */
+	V3 prev_p = o;
+	for (int depth = 0;; depth++) {
+		Hit h;
+		if (!bvh_intersect(sc, o, d, AJAR_INF, &h)) {
+			V3 Le = env_radiance(sc, d);
+			if (!v3_is_zero(Le)) {
+				float w = prev_delta ? 1.0f
+						     : mis_power(prev_pdf_w, light_pdf_w(sc, prev_p, d, -1, AJAR_INF, 1.0f));
+				L = v3_add(L, v3_scale(v3_mul(beta, Le), w));
+			}
+			break;
+		}
+		Surface s;
+		surface_from_hit(sc, &h, &s);
+		V3 wo = v3_neg(d);
+		if (sc->tris[s.tri].emitter >= 0) {
+			V3 Le = emitter_radiance(sc, s.tri, wo);
+			if (!v3_is_zero(Le)) {
+				float w = 1.0f;
+				if (!prev_delta) {
+					float cos_l = fabs(v3_dot(s.ng, wo));
+					w = mis_power(prev_pdf_w, light_pdf_w(sc, prev_p, d, s.tri, h.t, cos_l));
+				}
+				L = v3_add(L, v3_scale(v3_mul(beta, Le), w));
+			}
+		}
+		/* The next vertex would make depth + 2 segments. */
+		if (depth + 2 > prm->max_depth)
+			break;
+		Bsdf bs;
+		bsdf_setup(&bs, &sc->materials[s.material], surface_base_color(sc, &s), s.ns, s.ng);
+		if (!bsdf_is_delta(&bs)) {
+			LightSample ls;
+			float u0 = rng_f(rng), u1 = rng_f(rng), u2 = rng_f(rng);
+			if (light_sample(sc, s.p, u0, u1, u2, &ls) && ls.pdf_w > 0.0f && !v3_is_zero(ls.Le)) {
+				float pdf_bsdf_w, pdf_rev_w;
+				V3 f = bsdf_eval(&bs, wo, ls.wi, BSDF_RADIANCE, &pdf_bsdf_w, &pdf_rev_w);
+				if (!v3_is_zero(f)) {
+					V3 org = ray_offset(s.p, s.ng, ls.wi);
+					float dist = ls.is_env ? AJAR_INF : ls.dist * (1.0f - 1e-4f);
+					if (!bvh_occluded(sc, org, ls.wi, dist)) {
+						float w = mis_power(ls.pdf_w, pdf_bsdf_w);
+						float k = fabs(v3_dot(s.ns, ls.wi)) * w / ls.pdf_w;
+						L = v3_add(L, v3_scale(v3_mul(v3_mul(beta, f), ls.Le), k));
+					}
+				}
+			}
+		}
+		BsdfSample bsm;
+		float u0 = rng_f(rng), u1 = rng_f(rng), u2 = rng_f(rng);
+		if (!bsdf_sample(&bs, wo, u0, u1, u2, BSDF_RADIANCE, &bsm) || !(bsm.pdf_w > 0.0f))
+			break;
+		beta = v3_mul(beta, v3_scale(bsm.f, fabs(v3_dot(s.ns, bsm.wi)) / bsm.pdf_w));
+		prev_pdf_w = bsm.pdf_w;
+		prev_delta = bsm.delta;
+		prev_p = s.p;
+		o = ray_offset(s.p, s.ng, bsm.wi);
+		d = bsm.wi;
+		if (depth + 1 >= prm->rr_depth) {
+			float q = fmin(v3_maxc(beta), 0.95f);
+			if (rng_f(rng) >= q)
+				break;
+			beta = v3_scale(beta, 1.0f / q);
+		}
+		if (v3_is_zero(beta))
+			break;
+	}
+	return L;
+}
+#endif

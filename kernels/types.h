@@ -1,0 +1,155 @@
+/* types.h — every struct the host uploads and the kernels read.
+ *
+ * Compiled as OpenCL C and as C11. Only int, uint, float and V3 fields; sizes
+ * are multiples of 16 with named padding. src/layout.c checks sizes and
+ * offsets with static asserts on the host, and tests/test_layout.c compares
+ * them with what a probe kernel reports on the device. */
+#ifndef AJAR_TYPES_H
+#define AJAR_TYPES_H
+#include "vec.h"
+
+/* Flattened BVH node, depth-first order. Interior (count == 0): the left
+ * child is the next node, the right child is node `index`. Leaf (count > 0):
+ * triangles [index, index + count) of the reordered triangle array. */
+typedef struct {
+	V3 bmin;
+	int index;
+	V3 bmax;
+	int count;
+} BvhNode; /* 32 */
+
+/* Triangle as traversal sees it. `emitter` indexes Emitter (or -1). */
+typedef struct {
+	V3 p0, p1, p2;
+	int material;
+	int emitter;
+	int pad0;
+} Tri; /* 48 */
+
+/* Shading attributes of the triangle with the same index. */
+typedef struct {
+	V3 n0, n1, n2;   /* vertex normals, world space, unit */
+	float u0, v0, u1, v1, u2, v2;
+	int has_normals; /* 0: use the geometric normal */
+} TriShade; /* 64 */
+
+#define MATERIAL_DOUBLE_SIDED 1
+#define MATERIAL_ALPHA_MASK 2   /* alpha below alpha_cutoff is a hole (future) */
+
+/* glTF metallic-roughness, with KHR_materials_specular/transmission/ior. */
+typedef struct {
+	V3 base_color;      /* linear RGB factor */
+	int base_tex;       /* Texture index or -1; multiplies base_color */
+	V3 emission;        /* radiance, W sr^-1 m^-2 (factor x strength) */
+	float metallic;
+	float roughness;    /* perceptual; GGX alpha = roughness^2 */
+	float transmission;
+	float ior;
+	float specular;     /* KHR_materials_specular factor; 0 = pure diffuse */
+	int flags;          /* MATERIAL_* */
+	float alpha_cutoff;
+	float pad0, pad1;
+} Material; /* 64 */
+
+/* RGBA8 texture (sRGB colour, linear alpha) in the shared texel array. */
+typedef struct {
+	int offset; /* first texel in `texels` */
+	int width;
+	int height;
+	int pad0;
+} Texture; /* 16 */
+
+/* Emissive triangle; chosen with probability proportional to its power. */
+typedef struct {
+	int tri;
+	float area;
+	float pdf_select; /* probability of choosing this emitter */
+	int pad0;
+} Emitter; /* 16 */
+
+/* Portal triangle: invisible to every ray, sampled by area (issue 4). */
+typedef struct {
+	V3 p0, p1, p2;
+	float area;
+	float pdf_select;
+	int pad0;
+} PortalTri; /* 48 */
+
+#define ENV_NONE 0
+#define ENV_COLOR 1
+#define ENV_IMAGE 2
+
+/* Pinhole camera. Raster (px, py) in [0,W)x[0,H), y down. */
+typedef struct {
+	V3 pos;
+	float tan_half_fov_y; /* tan(yfov / 2) */
+	V3 right;             /* unit */
+	float aspect;         /* width / height of the image plane */
+	V3 up;                /* unit */
+	int width;
+	V3 forward;           /* unit, view direction */
+	int height;
+} Camera; /* 64 */
+
+#define INTEGRATOR_PT 0
+#define INTEGRATOR_BDPT 1
+#define INTEGRATOR_PORTAL 2
+
+/* Everything about a render that is not an array. One per upload. */
+typedef struct {
+	Camera camera;          /* 0 */
+	int num_tris;           /* 64 */
+	int num_emitters;
+	int num_portals;
+	int num_textures;
+	int env_type;           /* 80, ENV_* */
+	int env_width;          /* equirectangular, +Y up */
+	int env_height;
+	float env_strength;
+	V3 env_color;           /* 96, ENV_COLOR radiance */
+	float env_pdf_select;   /* probability NEE picks the environment */
+	V3 scene_center;        /* 112, bounding sphere, for light subpaths */
+	float scene_radius;
+	int max_depth;          /* 128, maximum number of path segments */
+	int rr_depth;           /* Russian roulette starts after this many */
+	int integrator;         /* INTEGRATOR_* */
+	uint seed;
+	float emitter_power;    /* 144, total power of emissive triangles */
+	float env_power;        /* power estimate of the environment */
+	int pad0, pad1;
+} Params; /* 160 */
+
+/* Layout of the float array `env`: for an ENV_IMAGE of W x H,
+ *   [0, 3WH)                    linear RGB radiance, row-major, row 0 = top
+ *   [3WH, 3WH + H + 1)          marginal CDF over rows
+ *   [3WH + H + 1, .. + H(W+1))  conditional CDF of each row
+ * The CDFs are of luminance x sin(theta), so sampling is in solid angle. */
+#define ENV_PIXELS(w, h) 0
+#define ENV_MARGINAL(w, h) (3 * (w) * (h))
+#define ENV_CONDITIONAL(w, h) (3 * (w) * (h) + (h) + 1)
+#define ENV_FLOATS(w, h) (3 * (w) * (h) + (h) + 1 + (h) * ((w) + 1))
+
+/* The device arrays, listed once: kernel arguments, the SceneView below and
+ * the host upload are all generated from this list so they cannot drift. */
+#define AJAR_SCENE_BUFFERS(X) \
+	X(BvhNode, nodes)         \
+	X(Tri, tris)              \
+	X(TriShade, shade)        \
+	X(Material, materials)    \
+	X(Texture, textures)      \
+	X(uint, texels)           \
+	X(Emitter, emitters)      \
+	X(float, emitter_cdf)     \
+	X(float, env)             \
+	X(PortalTri, portals)     \
+	X(float, portal_cdf)      \
+	X(Params, params)
+
+/* What device code sees of the scene: one pointer per array. */
+typedef struct {
+#define AJAR_VIEW_FIELD(type, name) GLOBAL const type *name;
+	AJAR_SCENE_BUFFERS(AJAR_VIEW_FIELD)
+#undef AJAR_VIEW_FIELD
+} SceneView;
+
+#endif

@@ -1,0 +1,392 @@
+/* device.c — OpenCL discovery, selection, program build and binary cache.
+ *
+ * Program binaries are cached per device and per hash of (source, options,
+ * device name, driver and platform version), so the second run of the same
+ * build skips the OpenCL C front end. Cache files are written to a temporary
+ * name and renamed, so concurrent renders never read a half-written binary. */
+#include "device.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "error.h"
+
+#define MAX_PLATFORMS 16
+#define MAX_DEVICES 64
+
+const char *cl_error_name(cl_int err)
+{
+	switch (err) {
+#define E(x) case x: return #x;
+	E(CL_DEVICE_NOT_FOUND) E(CL_DEVICE_NOT_AVAILABLE) E(CL_COMPILER_NOT_AVAILABLE)
+	E(CL_MEM_OBJECT_ALLOCATION_FAILURE) E(CL_OUT_OF_RESOURCES) E(CL_OUT_OF_HOST_MEMORY)
+	E(CL_BUILD_PROGRAM_FAILURE) E(CL_INVALID_VALUE) E(CL_INVALID_DEVICE) E(CL_INVALID_BINARY)
+	E(CL_INVALID_BUILD_OPTIONS) E(CL_INVALID_PROGRAM) E(CL_INVALID_PROGRAM_EXECUTABLE)
+	E(CL_INVALID_KERNEL_NAME) E(CL_INVALID_KERNEL_ARGS) E(CL_INVALID_ARG_INDEX)
+	E(CL_INVALID_ARG_VALUE) E(CL_INVALID_ARG_SIZE) E(CL_INVALID_WORK_GROUP_SIZE)
+	E(CL_INVALID_WORK_ITEM_SIZE) E(CL_INVALID_GLOBAL_WORK_SIZE) E(CL_INVALID_BUFFER_SIZE)
+	E(CL_INVALID_MEM_OBJECT) E(CL_INVALID_COMMAND_QUEUE) E(CL_INVALID_CONTEXT)
+	E(CL_INVALID_PLATFORM) E(CL_EXEC_STATUS_ERROR_FOR_EVENTS_IN_WAIT_LIST)
+	E(CL_INVALID_KERNEL) E(CL_INVALID_OPERATION)
+#undef E
+	}
+	return "unknown OpenCL error";
+}
+
+ajar_status cl_fail(const Device *d, const char *what, cl_int err)
+{
+	ajar_status st = (err == CL_OUT_OF_HOST_MEMORY || err == CL_MEM_OBJECT_ALLOCATION_FAILURE)
+				 ? AJAR_ERROR_OUT_OF_MEMORY
+				 : AJAR_ERROR_DEVICE;
+	return err_set(st, "OpenCL device %s: %s failed: %s (%d)", d && d->name[0] ? d->name : "?", what,
+		       cl_error_name(err), (int)err);
+}
+
+/* All devices of all platforms; platforms without devices are skipped. */
+static int enumerate(cl_platform_id *plat_of, cl_device_id *ids, int *pidx, int *didx, int cap)
+{
+	cl_platform_id plats[MAX_PLATFORMS];
+	cl_uint nplat = 0;
+	int n = 0;
+	if (clGetPlatformIDs(MAX_PLATFORMS, plats, &nplat) != CL_SUCCESS)
+		return 0;
+	for (cl_uint p = 0; p < nplat && p < MAX_PLATFORMS; p++) {
+		cl_device_id devs[MAX_DEVICES];
+		cl_uint ndev = 0;
+		if (clGetDeviceIDs(plats[p], CL_DEVICE_TYPE_ALL, MAX_DEVICES, devs, &ndev) != CL_SUCCESS)
+			continue;
+		for (cl_uint i = 0; i < ndev && i < MAX_DEVICES && n < cap; i++, n++) {
+			plat_of[n] = plats[p];
+			ids[n] = devs[i];
+			pidx[n] = (int)p;
+			didx[n] = (int)i;
+		}
+	}
+	return n;
+}
+
+static const char *type_name(cl_device_type t)
+{
+	if (t & CL_DEVICE_TYPE_GPU)
+		return "gpu";
+	if (t & CL_DEVICE_TYPE_CPU)
+		return "cpu";
+	if (t & CL_DEVICE_TYPE_ACCELERATOR)
+		return "accelerator";
+	return "other";
+}
+
+ajar_status device_list(ajar_device_info *out, uint32_t capacity, uint32_t *count)
+{
+	cl_platform_id plats[MAX_DEVICES];
+	cl_device_id ids[MAX_DEVICES];
+	int pidx[MAX_DEVICES], didx[MAX_DEVICES];
+	int n = enumerate(plats, ids, pidx, didx, MAX_DEVICES);
+	if (!count)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_devices: count is NULL");
+	*count = (uint32_t)n;
+	for (int i = 0; i < n && (uint32_t)i < capacity && out; i++) {
+		ajar_device_info *o = &out[i];
+		cl_device_type t = 0;
+		cl_uint cu = 0;
+		cl_ulong mem = 0;
+		memset(o, 0, sizeof *o);
+		snprintf(o->selector, sizeof o->selector, "%d:%d", pidx[i], didx[i]);
+		clGetPlatformInfo(plats[i], CL_PLATFORM_NAME, sizeof o->platform - 1, o->platform, NULL);
+		clGetDeviceInfo(ids[i], CL_DEVICE_NAME, sizeof o->name - 1, o->name, NULL);
+		clGetDeviceInfo(ids[i], CL_DEVICE_TYPE, sizeof t, &t, NULL);
+		clGetDeviceInfo(ids[i], CL_DEVICE_MAX_COMPUTE_UNITS, sizeof cu, &cu, NULL);
+		clGetDeviceInfo(ids[i], CL_DEVICE_GLOBAL_MEM_SIZE, sizeof mem, &mem, NULL);
+		snprintf(o->type, sizeof o->type, "%s", type_name(t));
+		o->compute_units = cu;
+		o->global_memory = mem;
+	}
+	return AJAR_OK;
+}
+
+static int contains_ci(const char *hay, const char *needle)
+{
+	size_t n = strlen(needle);
+	for (; *hay; hay++) {
+		size_t i = 0;
+		while (i < n && hay[i] && (hay[i] | 32) == (needle[i] | 32))
+			i++;
+		if (i == n)
+			return 1;
+	}
+	return 0;
+}
+
+ajar_status device_select(const char *sel, cl_platform_id *platforms, cl_device_id *out, uint32_t cap,
+			  uint32_t *count)
+{
+	cl_platform_id plats[MAX_DEVICES];
+	cl_device_id ids[MAX_DEVICES];
+	int pidx[MAX_DEVICES], didx[MAX_DEVICES];
+	int n = enumerate(plats, ids, pidx, didx, MAX_DEVICES);
+	uint32_t k = 0;
+	*count = 0;
+	if (n == 0)
+		return err_set(AJAR_ERROR_DEVICE,
+			       "no OpenCL device found: is an ICD installed (e.g. pocl-opencl-icd) and "
+			       "/etc/OpenCL/vendors readable?");
+	int want_default = !sel || !sel[0];
+	int p, d;
+	char end;
+	for (int i = 0; i < n && k < cap; i++) {
+		cl_device_type t = 0;
+		char name[256] = "";
+		int match;
+		clGetDeviceInfo(ids[i], CL_DEVICE_TYPE, sizeof t, &t, NULL);
+		clGetDeviceInfo(ids[i], CL_DEVICE_NAME, sizeof name - 1, name, NULL);
+		if (want_default)
+			match = (t & CL_DEVICE_TYPE_CPU) != 0;
+		else if (sscanf(sel, "%d:%d%c", &p, &d, &end) == 2)
+			match = p == pidx[i] && d == didx[i];
+		else if (sscanf(sel, "%d%c", &p, &end) == 1)
+			match = p == i;
+		else if (!strcmp(sel, "all"))
+			match = 1;
+		else if (!strcmp(sel, "cpu"))
+			match = (t & CL_DEVICE_TYPE_CPU) != 0;
+		else if (!strcmp(sel, "gpu"))
+			match = (t & CL_DEVICE_TYPE_GPU) != 0;
+		else
+			match = contains_ci(name, sel);
+		if (match) {
+			platforms[k] = plats[i];
+			out[k++] = ids[i];
+		}
+	}
+	if (k == 0 && want_default) { /* no CPU device: take the first of any kind */
+		platforms[0] = plats[0];
+		out[0] = ids[0];
+		k = 1;
+	}
+	if (k == 0)
+		return err_set(AJAR_ERROR_DEVICE, "no OpenCL device matches '%s' (see `ajar devices`)", sel);
+	*count = k;
+	return AJAR_OK;
+}
+
+ajar_status device_open(Device *d, cl_platform_id platform, cl_device_id id)
+{
+	cl_int err;
+	cl_device_type t = 0;
+	memset(d, 0, sizeof *d);
+	d->platform = platform;
+	d->id = id;
+	clGetDeviceInfo(id, CL_DEVICE_NAME, sizeof d->name - 1, d->name, NULL);
+	clGetDeviceInfo(id, CL_DEVICE_TYPE, sizeof t, &t, NULL);
+	d->is_cpu = (t & CL_DEVICE_TYPE_CPU) != 0;
+	cl_context_properties props[] = {CL_CONTEXT_PLATFORM, (cl_context_properties)platform, 0};
+	d->ctx = clCreateContext(props, 1, &id, NULL, NULL, &err);
+	if (!d->ctx)
+		return cl_fail(d, "clCreateContext", err);
+	d->queue = clCreateCommandQueue(d->ctx, id, 0, &err);
+	if (!d->queue)
+		return cl_fail(d, "clCreateCommandQueue", err);
+	return AJAR_OK;
+}
+
+void device_close(Device *d)
+{
+	if (d->program)
+		clReleaseProgram(d->program);
+	if (d->queue)
+		clReleaseCommandQueue(d->queue);
+	if (d->ctx)
+		clReleaseContext(d->ctx);
+	memset(d, 0, sizeof *d);
+}
+
+const char *device_cache_dir(char *buf, size_t cap)
+{
+	const char *env = getenv("AJAR_CACHE_DIR");
+	const char *xdg = getenv("XDG_CACHE_HOME");
+	const char *home = getenv("HOME");
+	if (env && !strcmp(env, "off"))
+		return NULL;
+	if (env && env[0])
+		snprintf(buf, cap, "%s", env);
+	else if (xdg && xdg[0])
+		snprintf(buf, cap, "%s/ajar", xdg);
+	else if (home && home[0])
+		snprintf(buf, cap, "%s/.cache/ajar", home);
+	else
+		return NULL;
+	return buf;
+}
+
+static uint64_t fnv1a(uint64_t h, const char *s)
+{
+	for (; *s; s++)
+		h = (h ^ (unsigned char)*s) * 1099511628211ull;
+	return (h ^ 0xff) * 1099511628211ull; /* separator: "ab"+"c" != "a"+"bc" */
+}
+
+static void cache_path(const Device *d, const char *source, const char *options, char *path, size_t cap)
+{
+	char dir[1024], drv[256] = "", pver[256] = "";
+	clGetDeviceInfo(d->id, CL_DRIVER_VERSION, sizeof drv - 1, drv, NULL);
+	clGetPlatformInfo(d->platform, CL_PLATFORM_VERSION, sizeof pver - 1, pver, NULL);
+	uint64_t h = 14695981039346656037ull;
+	h = fnv1a(h, source);
+	h = fnv1a(h, options);
+	h = fnv1a(h, d->name);
+	h = fnv1a(h, drv);
+	h = fnv1a(h, pver);
+	if (!device_cache_dir(dir, sizeof dir)) {
+		path[0] = '\0';
+		return;
+	}
+	snprintf(path, cap, "%s/kernel-%016llx.bin", dir, (unsigned long long)h);
+}
+
+static unsigned char *read_file(const char *path, size_t *n)
+{
+	FILE *f = fopen(path, "rb");
+	unsigned char *buf = NULL;
+	long len;
+	if (!f)
+		return NULL;
+	if (fseek(f, 0, SEEK_END) == 0 && (len = ftell(f)) > 0 && fseek(f, 0, SEEK_SET) == 0) {
+		buf = malloc((size_t)len);
+		if (buf && fread(buf, 1, (size_t)len, f) != (size_t)len) {
+			free(buf);
+			buf = NULL;
+		}
+		*n = (size_t)len;
+	}
+	fclose(f);
+	return buf;
+}
+
+static void mkdirs(const char *path)
+{
+	char tmp[1024];
+	snprintf(tmp, sizeof tmp, "%s", path);
+	for (char *p = tmp + 1; *p; p++) {
+		if (*p == '/') {
+			*p = '\0';
+			mkdir(tmp, 0755);
+			*p = '/';
+		}
+	}
+	mkdir(tmp, 0755);
+}
+
+/* Saving is best effort: a failure costs only the next start-up time. */
+static void cache_store(const Device *d, const char *path)
+{
+	size_t size = 0;
+	unsigned char *bin;
+	char dir[1024], tmp[1100];
+	if (clGetProgramInfo(d->program, CL_PROGRAM_BINARY_SIZES, sizeof size, &size, NULL) != CL_SUCCESS ||
+	    size == 0 || !(bin = malloc(size)))
+		return;
+	if (clGetProgramInfo(d->program, CL_PROGRAM_BINARIES, sizeof bin, &bin, NULL) == CL_SUCCESS) {
+		snprintf(dir, sizeof dir, "%s", path);
+		*strrchr(dir, '/') = '\0';
+		mkdirs(dir);
+		snprintf(tmp, sizeof tmp, "%s.%ld.tmp", path, (long)getpid());
+		FILE *f = fopen(tmp, "wb");
+		if (f) {
+			int ok = fwrite(bin, 1, size, f) == size;
+			ok &= fclose(f) == 0;
+			if (!ok || rename(tmp, path) != 0)
+				remove(tmp);
+		}
+	}
+	free(bin);
+}
+
+static double now_seconds(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static ajar_status build_failed(Device *d, cl_int err)
+{
+	size_t n = 0;
+	char *log;
+	clGetProgramBuildInfo(d->program, d->id, CL_PROGRAM_BUILD_LOG, 0, NULL, &n);
+	log = malloc(n + 1);
+	if (log && clGetProgramBuildInfo(d->program, d->id, CL_PROGRAM_BUILD_LOG, n, log, NULL) == CL_SUCCESS) {
+		log[n] = '\0';
+		err_set(AJAR_ERROR_DEVICE, "OpenCL device %s: kernel build failed (%s):\n%s", d->name,
+			cl_error_name(err), log);
+	} else {
+		err_set(AJAR_ERROR_DEVICE, "OpenCL device %s: kernel build failed (%s)", d->name,
+			cl_error_name(err));
+	}
+	free(log);
+	return AJAR_ERROR_DEVICE;
+}
+
+ajar_status device_build(Device *d, const char *source, const char *options)
+{
+	char path[1200];
+	size_t nbin = 0;
+	unsigned char *bin;
+	cl_int err, st;
+	double t0 = now_seconds();
+	cache_path(d, source, options, path, sizeof path);
+	bin = path[0] ? read_file(path, &nbin) : NULL;
+	if (bin) {
+		const unsigned char *b = bin;
+		d->program = clCreateProgramWithBinary(d->ctx, 1, &d->id, &nbin, &b, &st, &err);
+		free(bin);
+		if (d->program && err == CL_SUCCESS && st == CL_SUCCESS &&
+		    clBuildProgram(d->program, 1, &d->id, options, NULL, NULL) == CL_SUCCESS) {
+			d->from_cache = 1;
+			d->build_seconds = now_seconds() - t0;
+			return AJAR_OK;
+		}
+		/* A stale or foreign binary: rebuild from source and overwrite it. */
+		if (d->program)
+			clReleaseProgram(d->program);
+		d->program = NULL;
+	}
+	d->program = clCreateProgramWithSource(d->ctx, 1, &source, NULL, &err);
+	if (!d->program)
+		return cl_fail(d, "clCreateProgramWithSource", err);
+	err = clBuildProgram(d->program, 1, &d->id, options, NULL, NULL);
+	if (err != CL_SUCCESS)
+		return build_failed(d, err);
+	d->build_seconds = now_seconds() - t0;
+	if (path[0])
+		cache_store(d, path);
+	return AJAR_OK;
+}
+
+ajar_status device_kernel(Device *d, const char *name, cl_kernel *out)
+{
+	cl_int err;
+	*out = clCreateKernel(d->program, name, &err);
+	if (!*out)
+		return cl_fail(d, name, err);
+	return AJAR_OK;
+}
+
+ajar_status device_buffer(Device *d, cl_mem_flags flags, size_t bytes, const void *host, cl_mem *out)
+{
+	cl_int err;
+	if (bytes == 0) {
+		bytes = 16; /* OpenCL forbids empty buffers; kernels never read it */
+		host = NULL;
+	}
+	if (host)
+		flags |= CL_MEM_COPY_HOST_PTR;
+	*out = clCreateBuffer(d->ctx, flags, bytes, (void *)host, &err);
+	if (!*out)
+		return cl_fail(d, "clCreateBuffer", err);
+	return AJAR_OK;
+}

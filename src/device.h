@@ -1,0 +1,57 @@
+/* device.h — one OpenCL device: discovery and selection, context and queue,
+ * program build with a binary cache, buffers. The only module that includes
+ * CL/cl.h (with render.c, which drives kernels through it). */
+#ifndef AJAR_DEVICE_H
+#define AJAR_DEVICE_H
+#ifndef CL_TARGET_OPENCL_VERSION
+#define CL_TARGET_OPENCL_VERSION 120
+#endif
+#include <CL/cl.h>
+#include <stddef.h>
+
+#include "ajar.h"
+
+typedef struct Device {
+	cl_platform_id platform;
+	cl_device_id id;
+	char name[256];
+	char selector[32];
+	int is_cpu;
+	cl_context ctx;
+	cl_command_queue queue;
+	cl_program program;
+	double build_seconds; /* source or cached binary to a built program */
+	int from_cache;       /* 1 if the program came from Ajar's binary cache */
+} Device;
+
+/* Every device of every platform, in selector order ("P:D"). */
+ajar_status device_list(ajar_device_info *out, uint32_t capacity, uint32_t *count);
+/* Resolves a selector: NULL/"" (first CPU device, else first device),
+ * "P:D", "N" (flat index), "cpu", "gpu", "all" or a name substring. Up to
+ * `cap` matches go to platforms/ids; "all" and "cpu"/"gpu" may give several
+ * but callers that want one take the first. */
+ajar_status device_select(const char *selector, cl_platform_id *platforms, cl_device_id *ids,
+			  uint32_t cap, uint32_t *count);
+
+ajar_status device_open(Device *d, cl_platform_id platform, cl_device_id id);
+void device_close(Device *d);
+/* Builds `source` with `options`, reusing a cached binary for this device,
+ * driver, source and options when one exists. Build logs go into the error. */
+ajar_status device_build(Device *d, const char *source, const char *options);
+ajar_status device_kernel(Device *d, const char *name, cl_kernel *out);
+ajar_status device_buffer(Device *d, cl_mem_flags flags, size_t bytes, const void *host, cl_mem *out);
+
+/* Names the failing call and the OpenCL error on the device. */
+ajar_status cl_fail(const Device *d, const char *what, cl_int err);
+const char *cl_error_name(cl_int err);
+#define CL_TRY(d, call)                                              \
+	do {                                                         \
+		cl_int cl_try_err_ = (call);                         \
+		if (cl_try_err_ != CL_SUCCESS)                       \
+			return cl_fail((d), #call, cl_try_err_);     \
+	} while (0)
+
+/* Where compiled kernels are cached: $AJAR_CACHE_DIR, else
+ * $XDG_CACHE_HOME/ajar, else ~/.cache/ajar; NULL disables the cache. */
+const char *device_cache_dir(char *buf, size_t cap);
+#endif

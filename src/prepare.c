@@ -1,0 +1,139 @@
+/* prepare.c — from Scene to device arrays. Triangles and their shading data
+ * are reordered to the BVH's leaf order so a leaf's triangles are
+ * contiguous; the light tables are built on the reordered triangles so
+ * emitter indices and Tri.emitter agree. */
+#include "prepare.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "error.h"
+
+static double seconds(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static ajar_status setup_camera(const Scene *s, const PrepareOptions *o, Camera *c)
+{
+	V3 pos, fwd, up;
+	float yfov;
+	scene_camera(s, &pos, &fwd, &up, &yfov);
+	V3 right = v3_cross(fwd, up);
+	if (!(v3_len2(right) > 1e-20f) || !(yfov > 0.0f && yfov < 3.1f))
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: camera: degenerate orientation or field of view",
+			       s->source);
+	memset(c, 0, sizeof *c);
+	c->pos = pos;
+	c->forward = v3_norm(fwd);
+	c->right = v3_norm(right);
+	c->up = v3_cross(c->right, c->forward);
+	c->tan_half_fov_y = tanf(0.5f * yfov);
+	c->aspect = (float)o->width / (float)o->height;
+	c->width = (int)o->width;
+	c->height = (int)o->height;
+	return AJAR_OK;
+}
+
+ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
+{
+	ajar_status st;
+	uint32_t n = s->ntris;
+	memset(d, 0, sizeof *d);
+	if (n == 0)
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: the scene has no triangles", s->source);
+	if (s->nmaterials == 0)
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: the scene has no materials", s->source);
+
+	double t0 = seconds();
+	if ((st = bvh_build(s->tris, n, &d->bvh)) != AJAR_OK)
+		return st;
+	d->bvh_seconds = seconds() - t0;
+	d->nodes = d->bvh.nodes;
+	d->n_nodes = d->bvh.nnodes;
+
+	d->tris = malloc(sizeof *d->tris * n);
+	d->shade = malloc(sizeof *d->shade * n);
+	d->params = calloc(1, sizeof *d->params);
+	d->portals = malloc(sizeof *d->portals * (s->nportal_tris ? s->nportal_tris : 1));
+	if (!d->tris || !d->shade || !d->params || !d->portals) {
+		prepare_free(d);
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory preparing %u triangles", s->source, n);
+	}
+	for (uint32_t i = 0; i < n; i++) {
+		d->tris[i] = s->tris[d->bvh.order[i]];
+		d->shade[i] = s->shade[d->bvh.order[i]];
+	}
+	d->n_tris = d->n_shade = n;
+	if (s->nportal_tris)
+		memcpy(d->portals, s->portals, sizeof *d->portals * s->nportal_tris);
+	d->n_portals = s->nportal_tris;
+	d->materials = s->materials;
+	d->n_materials = s->nmaterials;
+	d->textures = s->textures;
+	d->n_textures = s->ntextures;
+	d->texels = s->texels;
+	d->n_texels = s->ntexels;
+
+	scene_bounds(s, &d->bmin, &d->bmax);
+	V3 center = v3_scale(v3_add(d->bmin, d->bmax), 0.5f);
+	float radius = 0.5f * v3_len(v3_sub(d->bmax, d->bmin)) * 1.001f + 1e-4f;
+	if ((st = lights_build(s, d->tris, n, s->materials, d->portals, s->nportal_tris, center, radius,
+			       &d->lights)) != AJAR_OK) {
+		prepare_free(d);
+		return st;
+	}
+	d->emitters = d->lights.emitters;
+	d->n_emitters = d->lights.nemitters;
+	d->emitter_cdf = d->lights.emitter_cdf;
+	d->n_emitter_cdf = d->lights.nemitters ? d->lights.nemitters + 1 : 0;
+	d->env = d->lights.env;
+	d->n_env = d->lights.nenv;
+	d->portal_cdf = d->lights.portal_cdf;
+	d->n_portal_cdf = d->lights.nportals ? d->lights.nportals + 1 : 0;
+
+	Params *p = d->params;
+	d->n_params = 1;
+	if ((st = setup_camera(s, o, &p->camera)) != AJAR_OK) {
+		prepare_free(d);
+		return st;
+	}
+	p->num_tris = (int)n;
+	p->num_emitters = (int)d->lights.nemitters;
+	p->num_portals = (int)s->nportal_tris;
+	p->num_textures = (int)s->ntextures;
+	p->env_type = s->env_type;
+	p->env_width = (int)s->env_width;
+	p->env_height = (int)s->env_height;
+	p->env_strength = s->env_strength;
+	p->env_color = s->env_color;
+	p->env_pdf_select = d->lights.env_pdf_select;
+	p->scene_center = center;
+	p->scene_radius = radius;
+	p->max_depth = (int)o->max_depth;
+	p->rr_depth = 3;
+	p->integrator = o->integrator;
+	p->seed = o->seed;
+	p->emitter_power = d->lights.emitter_power;
+	p->env_power = d->lights.env_power;
+	if (p->num_emitters == 0 && p->env_type == ENV_NONE)
+		log_msg(AJAR_LOG_WARNING, "%s: no emissive triangles and no environment: the image is black",
+			s->source);
+	return AJAR_OK;
+}
+
+void prepare_free(SceneData *d)
+{
+	/* materials, textures and texels are borrowed from the Scene. */
+	free(d->tris);
+	free(d->shade);
+	free(d->params);
+	free(d->portals);
+	bvh_free(&d->bvh);
+	lights_free(&d->lights);
+	memset(d, 0, sizeof *d);
+}

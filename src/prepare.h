@@ -1,0 +1,28 @@
+/* prepare.h — turns a Scene into the flat arrays the kernels read: the BVH,
+ * triangles in BVH order, light and portal tables, and Params. */
+#ifndef AJAR_PREPARE_H
+#define AJAR_PREPARE_H
+#include "bvh.h"
+#include "lights.h"
+#include "scene.h"
+
+typedef struct {
+#define AJAR_DATA_FIELD(type, name) type *name; size_t n_##name;
+	AJAR_SCENE_BUFFERS(AJAR_DATA_FIELD)
+#undef AJAR_DATA_FIELD
+	Bvh bvh;
+	LightTables lights;
+	double bvh_seconds;
+	V3 bmin, bmax;
+} SceneData;
+
+typedef struct {
+	uint32_t width, height;
+	int integrator;
+	uint32_t max_depth;
+	uint32_t seed;
+} PrepareOptions;
+
+ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *out);
+void prepare_free(SceneData *d);
+#endif

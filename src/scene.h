@@ -1,0 +1,82 @@
+/* scene.h — the host's scene as loaded or built in code, before any
+ * acceleration structure: growable arrays of the shared device types.
+ *
+ * The glTF loader and the public builder API both fill a Scene through the
+ * functions below, which validate what they receive (finite positions,
+ * indices in range, materials that exist) so nothing later has to. */
+#ifndef AJAR_SCENE_H
+#define AJAR_SCENE_H
+#include <stddef.h>
+#include <stdint.h>
+
+#include "ajar.h"
+#include "../kernels/types.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The public ajar_scene handle is this struct. */
+typedef struct ajar_scene {
+	char *source;            /* file name for messages, or "<api>" */
+
+	Tri *tris;               /* world space, insertion order */
+	TriShade *shade;
+	uint32_t ntris, cap_tris;
+
+	Material *materials;
+	uint32_t nmaterials, cap_materials;
+
+	Texture *textures;
+	uint32_t ntextures, cap_textures;
+	uint32_t *texels;        /* RGBA8, R in the low byte */
+	size_t ntexels, cap_texels;
+
+	PortalTri *portals;      /* pdf_select is filled by the portal table */
+	uint32_t nportal_tris, cap_portals;
+	uint32_t nportals;       /* portal objects (nodes / API calls) */
+
+	int has_camera;
+	V3 cam_pos, cam_forward, cam_up;
+	float cam_yfov, cam_aspect; /* aspect 0: from the image */
+
+	uint32_t width, height;  /* suggested by the file, or 0 */
+
+	int env_type;            /* ENV_* */
+	V3 env_color;
+	float env_strength;
+	uint32_t env_width, env_height;
+	float *env_rgb;          /* env_width * env_height * 3, row 0 = top (+Y) */
+} Scene;
+
+ajar_status scene_new(const char *source, Scene **out);
+void scene_free(Scene *s);
+
+/* Returns the new material's index in *id. */
+ajar_status scene_add_material(Scene *s, const Material *m, uint32_t *id);
+/* RGBA8 texels, row 0 first as stored in the image file. */
+ajar_status scene_add_texture(Scene *s, uint32_t width, uint32_t height, const uint8_t *rgba,
+			      uint32_t *id);
+/* Adds triangles already in world space. `normals` and `uvs` may be NULL.
+ * `what` names the origin for messages (e.g. "meshes[2].primitives[0]"). */
+ajar_status scene_add_triangles(Scene *s, const char *what, const float *pos, const float *normals,
+				const float *uvs, uint32_t nverts, const uint32_t *idx, uint32_t ntris,
+				uint32_t material);
+ajar_status scene_add_portal(Scene *s, const char *what, const float *pos, uint32_t nverts,
+			     const uint32_t *idx, uint32_t ntris);
+ajar_status scene_set_camera(Scene *s, V3 pos, V3 forward, V3 up, float yfov, float aspect);
+void scene_set_env_color(Scene *s, V3 rgb);
+/* Takes ownership of rgb (malloc'ed, w * h * 3 floats). */
+ajar_status scene_set_env_image(Scene *s, uint32_t w, uint32_t h, float *rgb, float strength);
+
+/* Bounds of all renderable triangles (portals included). */
+void scene_bounds(const Scene *s, V3 *bmin, V3 *bmax);
+uint32_t scene_count_emissive(const Scene *s);
+/* The camera to render with: the scene's, or, if it has none, a view along
+ * -Z framing the bounding sphere (yfov 45 degrees). */
+void scene_camera(const Scene *s, V3 *pos, V3 *forward, V3 *up, float *yfov);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,278 @@
+/* test_render.c — whole renders through the public API, checked against
+ * answers known independently of Ajar:
+ *   - furnaces with analytic radiance (a convex Lambertian box under a
+ *     constant sky; a closed emissive Lambertian box with a depth limit);
+ *   - the Cornell box against Mitsuba 3's converged 8192-spp reference;
+ *   - determinism (same seed, same bits) and cancellation.
+ *
+ * Tolerances come from the renders' own noise: an independent second
+ * render estimates each pixel's variance, so a threshold in units of the
+ * predicted standard error stays meaningful whatever the sample count. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "ajar.h"
+#include "testutil.h"
+
+static float *render(ajar_scene *s, uint32_t w, uint32_t h, uint32_t spp, uint32_t seed, uint32_t depth)
+{
+	ajar_options o;
+	ajar_renderer *r = NULL;
+	ajar_options_default(&o);
+	o.width = w;
+	o.height = h;
+	o.spp = spp;
+	o.seed = seed;
+	o.max_depth = depth;
+	ajar_status st = ajar_renderer_create(s, &o, &r);
+	if (st != AJAR_OK)
+		fail_msg("renderer: %s", ajar_last_error());
+	st = ajar_renderer_render(r, NULL, NULL);
+	if (st != AJAR_OK)
+		fail_msg("render: %s", ajar_last_error());
+	assert_int_equal(ajar_renderer_spp(r), spp);
+	float *img = malloc(sizeof(float) * 4 * w * h);
+	assert_non_null(img);
+	assert_int_equal(ajar_renderer_image(r, img, NULL, NULL), AJAR_OK);
+	ajar_renderer_destroy(&r);
+	assert_null(r);
+	return img;
+}
+
+/* A unit cube [c-h, c+h]^3; `inward` winds the faces so their front (CCW)
+ * faces the inside. */
+static void add_cube(ajar_scene *s, uint32_t mat, float c, float hs, int inward)
+{
+	float p[8 * 3];
+	for (int i = 0; i < 8; i++) {
+		p[3 * i + 0] = c + ((i & 1) ? hs : -hs);
+		p[3 * i + 1] = c + ((i & 2) ? hs : -hs);
+		p[3 * i + 2] = c + ((i & 4) ? hs : -hs);
+	}
+	/* Outward-facing CCW quads. */
+	static const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+					     {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+	uint32_t idx[36];
+	for (int f = 0; f < 6; f++) {
+		const uint32_t *q = quads[f];
+		uint32_t t[6] = {q[0], q[1], q[2], q[0], q[2], q[3]};
+		for (int k = 0; k < 6; k++)
+			idx[6 * f + k] = inward ? t[(k / 3) * 3 + 2 - k % 3] : t[k];
+	}
+	ajar_mesh m = {p, NULL, NULL, 8, idx, 12, mat, NULL};
+	assert_int_equal(ajar_scene_add_mesh(s, &m), AJAR_OK);
+}
+
+static void set_camera(ajar_scene *s, float px, float py, float pz, float yfov)
+{
+	ajar_camera cam = {{px, py, pz}, {0, 0, 0}, {0, 1, 0}, yfov, 0};
+	assert_int_equal(ajar_scene_set_camera(s, &cam), AJAR_OK);
+}
+
+/* Mean and standard error of the mean over a block of pixels (channel c). */
+static void block_stats(const float *img, uint32_t w, uint32_t x0, uint32_t y0, uint32_t n, int c, double *mean,
+			double *sem)
+{
+	double s = 0, s2 = 0;
+	for (uint32_t y = y0; y < y0 + n; y++)
+		for (uint32_t x = x0; x < x0 + n; x++) {
+			double v = img[4 * (y * w + x) + c];
+			s += v;
+			s2 += v * v;
+		}
+	double m = (double)n * n;
+	*mean = s / m;
+	*sem = sqrt(fmax(s2 / m - *mean * *mean, 0) / (m - 1));
+}
+
+/* Under a constant sky E, every point of a convex Lambertian object with
+ * albedo rho has radiance rho * E (it sees only sky). Exercises env NEE,
+ * BSDF sampling of the sky and their MIS. */
+static void test_furnace_convex(void **state)
+{
+	ajar_scene *s;
+	ajar_material m;
+	uint32_t mat;
+	const float sky[3] = {1.0f, 0.5f, 0.25f};
+	assert_int_equal(ajar_scene_create(&s), AJAR_OK);
+	ajar_material_default(&m);
+	m.base_color[0] = m.base_color[1] = m.base_color[2] = 0.6f;
+	assert_int_equal(ajar_scene_add_material(s, &m, &mat), AJAR_OK);
+	add_cube(s, mat, 0.0f, 1.0f, 0);
+	assert_int_equal(ajar_scene_set_environment_color(s, sky), AJAR_OK);
+	set_camera(s, 0.3f, 0.4f, 5.0f, 0.9f);
+	float *img = render(s, 48, 48, 64, 1, 64);
+	for (int c = 0; c < 3; c++) {
+		double mean, sem;
+		block_stats(img, 48, 16, 16, 16, c, &mean, &sem);
+		double want = 0.6 * sky[c];
+		if (fabs(mean - want) > 5 * sem + 1e-5)
+			fail_msg("channel %d: cube radiance %.5f +- %.5f, want %.5f", c, mean, sem, want);
+		/* The corner sees the sky directly: exact. */
+		assert_float_equal(img[c], sky[c], 1e-5);
+	}
+	free(img);
+	ajar_scene_destroy(&s);
+	assert_null(s);
+}
+
+/* Inside a closed box whose walls emit Le and reflect with albedo rho, a
+ * path of at most D segments gathers Le * (1 + rho + ... + rho^(D-1)). */
+static void test_furnace_closed(void **state)
+{
+	ajar_scene *s;
+	ajar_material m;
+	uint32_t mat;
+	const double rho = 0.5, Le = 0.8;
+	const int depth = 5;
+	assert_int_equal(ajar_scene_create(&s), AJAR_OK);
+	ajar_material_default(&m);
+	m.base_color[0] = m.base_color[1] = m.base_color[2] = (float)rho;
+	m.emission[0] = m.emission[1] = m.emission[2] = (float)Le;
+	assert_int_equal(ajar_scene_add_material(s, &m, &mat), AJAR_OK);
+	add_cube(s, mat, 0.0f, 1.0f, 1);
+	set_camera(s, 0.2f, -0.1f, 0.5f, 1.2f);
+	float *img = render(s, 32, 32, 64, 3, depth);
+	double want = Le * (1 - pow(rho, depth)) / (1 - rho);
+	for (int c = 0; c < 3; c++) {
+		double mean, sem;
+		block_stats(img, 32, 0, 0, 32, c, &mean, &sem);
+		if (fabs(mean - want) > 5 * sem + 1e-5)
+			fail_msg("channel %d: furnace %.5f +- %.5f, want %.5f", c, mean, sem, want);
+	}
+	free(img);
+	ajar_scene_destroy(&s);
+}
+
+/* relMSE of a against b, normalised by the reference r: mean (a-b)^2/(r^2+eps). */
+static double rel_mse(const float *a, const float *b, const float *r, size_t npix)
+{
+	double sum = 0;
+	for (size_t i = 0; i < npix; i++)
+		for (int c = 0; c < 3; c++) {
+			double d = a[4 * i + c] - b[4 * i + c], ref = r[4 * i + c];
+			sum += d * d / (ref * ref + 1e-2);
+		}
+	return sum / (3.0 * npix);
+}
+
+static double image_mean(const float *img, size_t npix)
+{
+	double s = 0;
+	for (size_t i = 0; i < npix; i++)
+		s += img[4 * i] + img[4 * i + 1] + img[4 * i + 2];
+	return s / (3.0 * npix);
+}
+
+/* The Cornell box against Mitsuba 3 at 8192 spp (tests/refs/README.md).
+ * Two renders A and B with different seeds give the noise: E|A-B|^2 is
+ * twice the per-pixel variance, so an unbiased A has
+ *   E relMSE(A, ref) = relMSE(A, B) / 2 * (1 + n / 8192)
+ * (the reference's own noise at 8192 spp adds the last term). A bias adds
+ * its square on top; the test allows 15% over the prediction, far less
+ * than a wrong BSDF, emitter or MIS weight adds at this sample count. The
+ * image means must also agree within 4 standard errors plus 0.3%, the
+ * spread among independent renderers on this scene (shared/peers.md). */
+static void test_cornell_reference(void **state)
+{
+	ajar_scene *s;
+	float *ref;
+	uint32_t rw, rh;
+	const uint32_t n = 32;
+	assert_int_equal(ajar_read_exr("tests/refs/cornell-mitsuba-8192.exr", &ref, &rw, &rh), AJAR_OK);
+	assert_int_equal(ajar_scene_load(SCENE("cornell/cornell.gltf"), &s), AJAR_OK);
+	float *a = render(s, rw, rh, n, 11, 64);
+	float *b = render(s, rw, rh, n, 12, 64);
+	size_t npix = (size_t)rw * rh;
+	double noise = rel_mse(a, b, ref, npix) / 2;
+	double predicted = noise * (1.0 + n / 8192.0);
+	double err = rel_mse(a, ref, ref, npix);
+	double ma = image_mean(a, npix), mb = image_mean(b, npix), mr = image_mean(ref, npix);
+	double sem = fabs(ma - mb) / sqrt(2.0) + 1e-9; /* one-sample estimate of the mean's error */
+	print_message("cornell %u spp: relMSE vs ref %.5f, predicted by noise %.5f (ratio %.3f); "
+		      "mean %.5f / %.5f vs ref %.5f (%+.3f%%)\n",
+		      n, err, predicted, err / predicted, ma, mb, mr, 100 * ((ma + mb) / 2 / mr - 1));
+	assert_true(err < 1.15 * predicted);
+	assert_true(fabs((ma + mb) / 2 - mr) < 4 * sem + 0.003 * mr);
+	free(a);
+	free(b);
+	free(ref);
+	ajar_scene_destroy(&s);
+}
+
+static void test_same_seed_same_bits(void **state)
+{
+	ajar_scene *s;
+	assert_int_equal(ajar_scene_load(SCENE("cornell/cornell.gltf"), &s), AJAR_OK);
+	float *a = render(s, 40, 30, 6, 5, 16);
+	float *b = render(s, 40, 30, 6, 5, 16);
+	float *c = render(s, 40, 30, 6, 6, 16);
+	assert_memory_equal(a, b, sizeof(float) * 4 * 40 * 30);
+	assert_memory_not_equal(a, c, sizeof(float) * 4 * 40 * 30);
+	free(a);
+	free(b);
+	free(c);
+	ajar_scene_destroy(&s);
+}
+
+static int stop_after_first(const ajar_progress *p, void *user)
+{
+	int *calls = user;
+	(*calls)++;
+	return 1;
+}
+
+static void test_cancel_keeps_image(void **state)
+{
+	ajar_scene *s;
+	ajar_renderer *r;
+	ajar_options o;
+	int calls = 0;
+	assert_int_equal(ajar_scene_load(SCENE("cornell/cornell.gltf"), &s), AJAR_OK);
+	ajar_options_default(&o);
+	o.width = o.height = 32;
+	o.spp = 100000;
+	assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_OK);
+	assert_int_equal(ajar_renderer_render(r, stop_after_first, &calls), AJAR_ERROR_CANCELLED);
+	assert_int_equal(calls, 1);
+	uint32_t spp = ajar_renderer_spp(r);
+	assert_true(spp >= 1 && spp < 100000);
+	float img[32 * 32 * 4];
+	assert_int_equal(ajar_renderer_image(r, img, NULL, NULL), AJAR_OK);
+	assert_true(image_mean(img, 32 * 32) > 0.01);
+	ajar_renderer_destroy(&r);
+	ajar_scene_destroy(&s);
+}
+
+static void test_bad_options(void **state)
+{
+	ajar_scene *s;
+	ajar_renderer *r = (ajar_renderer *)1;
+	ajar_options o;
+	assert_int_equal(ajar_scene_load(SCENE("cornell/cornell.gltf"), &s), AJAR_OK);
+	ajar_options_default(&o);
+	o.max_depth = 0;
+	assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_ERROR_INVALID_ARGUMENT);
+	assert_null(r);
+	assert_non_null(strstr(ajar_last_error(), "depth"));
+	ajar_options_default(&o);
+	o.device = "no-such-device-anywhere";
+	assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_ERROR_DEVICE);
+	assert_non_null(strstr(ajar_last_error(), "no-such-device-anywhere"));
+	ajar_scene_destroy(&s);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_furnace_convex),
+		cmocka_unit_test(test_furnace_closed),
+		cmocka_unit_test(test_cornell_reference),
+		cmocka_unit_test(test_same_seed_same_bits),
+		cmocka_unit_test(test_cancel_keeps_image),
+		cmocka_unit_test(test_bad_options),
+	};
+	return cmocka_run_group_tests_name("render", tests, NULL, NULL);
+}

@@ -1,0 +1,78 @@
+/* testutil.c — chi-square statistics and temp dirs for the tests. */
+#include "testutil.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Regularized upper incomplete gamma Q(a, x), by series or continued
+ * fraction (Numerical Recipes' split at x = a + 1). */
+static double gamma_q(double a, double x)
+{
+	if (x <= 0)
+		return 1.0;
+	double gln = lgamma(a);
+	if (x < a + 1) {
+		double sum = 1.0 / a, del = sum, ap = a;
+		for (int n = 0; n < 1000; n++) {
+			ap += 1;
+			del *= x / ap;
+			sum += del;
+			if (fabs(del) < fabs(sum) * 1e-15)
+				break;
+		}
+		return 1.0 - sum * exp(-x + a * log(x) - gln);
+	}
+	double b = x + 1 - a, c = 1e300, d = 1 / b, h = d;
+	for (int i = 1; i < 1000; i++) {
+		double an = -i * (i - a);
+		b += 2;
+		d = an * d + b;
+		if (fabs(d) < 1e-300)
+			d = 1e-300;
+		c = b + an / c;
+		if (fabs(c) < 1e-300)
+			c = 1e-300;
+		d = 1 / d;
+		double del = d * c;
+		h *= del;
+		if (fabs(del - 1) < 1e-15)
+			break;
+	}
+	return exp(-x + a * log(x) - gln) * h;
+}
+
+double chi2_sf(double x, double dof) { return gamma_q(dof / 2, x / 2); }
+
+double chi2_test(const double *obs, const double *expct, int n, double min_expected)
+{
+	double chsq = 0, pool_obs = 0, pool_exp = 0;
+	int dof = 0;
+	for (int i = 0; i < n; i++) {
+		if (expct[i] < min_expected) {
+			pool_obs += obs[i];
+			pool_exp += expct[i];
+			continue;
+		}
+		double d = obs[i] - expct[i];
+		chsq += d * d / expct[i];
+		dof++;
+	}
+	if (pool_exp > 0) {
+		double d = pool_obs - pool_exp;
+		chsq += d * d / pool_exp;
+		dof++;
+	}
+	dof -= 1;
+	if (dof < 1)
+		return 1.0;
+	return chi2_sf(chsq, dof);
+}
+
+char *test_tmpdir(void)
+{
+	char tmpl[] = "/tmp/ajar-test-XXXXXX";
+	char *d = mkdtemp(tmpl);
+	return d ? strdup(d) : NULL;
+}

@@ -1,0 +1,24 @@
+/* testutil.h — what every cmocka test binary shares: includes, the scene
+ * directory, and small statistics (chi-square) used by sampling tests. */
+#ifndef AJAR_TESTUTIL_H
+#define AJAR_TESTUTIL_H
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+/* Path of a file in the source tree's scenes/ (tests run from the top). */
+#define SCENE(p) "scenes/" p
+
+/* Pearson chi-square test of observed counts against expected counts.
+ * Cells with expected < min_expected are pooled (as Mitsuba's test does).
+ * Returns the p-value; fails the caller's test if it is below `alpha`. */
+double chi2_test(const double *observed, const double *expected, int ncells, double min_expected);
+
+/* Upper tail of the chi-square distribution with `dof` degrees of freedom. */
+double chi2_sf(double x, double dof);
+
+/* A fresh temporary directory (removed by the caller) or NULL. */
+char *test_tmpdir(void);
+#endif
