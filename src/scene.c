@@ -1,0 +1,401 @@
+/* scene.c — the host scene: growable arrays of the shared device types,
+ * filled by the glTF loader and the public builder API.
+ *
+ * Everything that enters a Scene passes through the functions here, which
+ * check it once (finite numbers, indices in range, materials that exist) so
+ * that the BVH, the light tables and the kernels can trust the arrays.
+ * Messages name s->source (the file, or "<api>") and the caller's `what`. */
+#include "scene.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "error.h"
+
+/* Device code indexes with int, so no array may pass INT32_MAX entries. */
+#define SCENE_MAX_ITEMS ((size_t)INT32_MAX)
+
+/* Makes room for `need` items of `size` bytes in *arr (capacity *cap),
+ * doubling so that n appends cost O(n). */
+static ajar_status grow(void **arr, size_t *cap, size_t need, size_t size)
+{
+	if (need <= *cap)
+		return AJAR_OK;
+	size_t ncap = *cap ? *cap : 16;
+	while (ncap < need)
+		ncap *= 2;
+	if (ncap > SIZE_MAX / size)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "scene: array of %zu items is too large", need);
+	void *p = realloc(*arr, ncap * size);
+	if (!p)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "scene: out of memory for %zu items", need);
+	*arr = p;
+	*cap = ncap;
+	return AJAR_OK;
+}
+
+/* grow() for the uint32_t capacities of the Scene struct. */
+static ajar_status grow32(void **arr, uint32_t *cap, size_t need, size_t size)
+{
+	size_t c = *cap;
+	ajar_status st = grow(arr, &c, need, size);
+	*cap = c > UINT32_MAX ? UINT32_MAX : (uint32_t)c;
+	return st;
+}
+
+ajar_status scene_new(const char *source, Scene **out)
+{
+	*out = NULL;
+	Scene *s = calloc(1, sizeof *s);
+	if (!s)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "scene: out of memory");
+	s->source = strdup(source ? source : "<api>");
+	if (!s->source) {
+		free(s);
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "scene: out of memory");
+	}
+	s->env_type = ENV_NONE;
+	s->env_strength = 1.0f;
+	*out = s;
+	return AJAR_OK;
+}
+
+void scene_free(Scene *s)
+{
+	if (!s)
+		return;
+	free(s->source);
+	free(s->tris);
+	free(s->shade);
+	free(s->materials);
+	free(s->textures);
+	free(s->texels);
+	free(s->portals);
+	free(s->env_rgb);
+	free(s);
+}
+
+ajar_status scene_add_material(Scene *s, const Material *m, uint32_t *id)
+{
+	if (s->nmaterials >= SCENE_MAX_ITEMS)
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: too many materials", s->source);
+	if (m->base_tex >= (int)s->ntextures || m->base_tex < -1)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: material %u: texture %d does not exist (%u textures)",
+			       s->source, s->nmaterials, m->base_tex, s->ntextures);
+	ajar_status st = grow32((void **)&s->materials, &s->cap_materials, (size_t)s->nmaterials + 1,
+				sizeof *s->materials);
+	if (st)
+		return st;
+	s->materials[s->nmaterials] = *m;
+	if (id)
+		*id = s->nmaterials;
+	s->nmaterials++;
+	return AJAR_OK;
+}
+
+ajar_status scene_add_texture(Scene *s, uint32_t width, uint32_t height, const uint8_t *rgba, uint32_t *id)
+{
+	if (width == 0 || height == 0)
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: texture %u: empty image (%ux%u)", s->source,
+			       s->ntextures, width, height);
+	size_t n = (size_t)width * height;
+	if (n > SCENE_MAX_ITEMS - s->ntexels || s->ntextures >= SCENE_MAX_ITEMS)
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: texture %u: %ux%u texels exceed the texel budget",
+			       s->source, s->ntextures, width, height);
+	ajar_status st = grow32((void **)&s->textures, &s->cap_textures, (size_t)s->ntextures + 1,
+				sizeof *s->textures);
+	if (!st)
+		st = grow((void **)&s->texels, &s->cap_texels, s->ntexels + n, sizeof *s->texels);
+	if (st)
+		return st;
+	uint32_t *dst = s->texels + s->ntexels;
+	for (size_t i = 0; i < n; i++) {
+		const uint8_t *p = rgba + 4 * i;
+		dst[i] = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+	}
+	Texture *t = &s->textures[s->ntextures];
+	memset(t, 0, sizeof *t);
+	t->offset = (int)s->ntexels;
+	t->width = (int)width;
+	t->height = (int)height;
+	s->ntexels += n;
+	if (id)
+		*id = s->ntextures;
+	s->ntextures++;
+	return AJAR_OK;
+}
+
+static int all_finite(const float *v, size_t n)
+{
+	for (size_t i = 0; i < n; i++)
+		if (!isfinite(v[i]))
+			return 0;
+	return 1;
+}
+
+/* Checks what scene_add_triangles and scene_add_portal share: finite
+ * positions and indices in range. idx NULL means vertices taken in threes. */
+static ajar_status check_geometry(const Scene *s, const char *what, const float *pos, uint32_t nverts,
+				  const uint32_t *idx, uint32_t ntris, uint32_t have)
+{
+	if (!pos)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: %s: no positions", s->source, what);
+	if ((size_t)ntris > SCENE_MAX_ITEMS - have)
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: %u more triangles exceed the limit of %zu",
+			       s->source, what, ntris, SCENE_MAX_ITEMS);
+	for (uint32_t v = 0; v < nverts; v++)
+		if (!all_finite(pos + 3 * (size_t)v, 3))
+			return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: vertex %u: position (%g, %g, %g) is not finite",
+				       s->source, what, v, pos[3 * (size_t)v], pos[3 * (size_t)v + 1],
+				       pos[3 * (size_t)v + 2]);
+	if (!idx) {
+		if ((uint64_t)ntris * 3 > nverts)
+			return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: %u triangles need %llu vertices, have %u",
+				       s->source, what, ntris, (unsigned long long)ntris * 3, nverts);
+		return AJAR_OK;
+	}
+	for (size_t i = 0; i < (size_t)ntris * 3; i++)
+		if (idx[i] >= nverts)
+			return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: index %u (triangle %zu) out of range (%u vertices)",
+				       s->source, what, idx[i], i / 3, nverts);
+	return AJAR_OK;
+}
+
+static V3 load3(const float *a, uint32_t i) { return v3(a[3 * (size_t)i], a[3 * (size_t)i + 1], a[3 * (size_t)i + 2]); }
+
+ajar_status scene_add_triangles(Scene *s, const char *what, const float *pos, const float *normals,
+				const float *uvs, uint32_t nverts, const uint32_t *idx, uint32_t ntris,
+				uint32_t material)
+{
+	ajar_status st = check_geometry(s, what, pos, nverts, idx, ntris, s->ntris);
+	if (st)
+		return st;
+	if (material >= s->nmaterials)
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: material %u does not exist (%u materials)", s->source,
+			       what, material, s->nmaterials);
+	if (normals)
+		for (uint32_t v = 0; v < nverts; v++)
+			if (!all_finite(normals + 3 * (size_t)v, 3))
+				return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: vertex %u: normal is not finite",
+					       s->source, what, v);
+	if (uvs)
+		for (uint32_t v = 0; v < nverts; v++)
+			if (!all_finite(uvs + 2 * (size_t)v, 2))
+				return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: vertex %u: texture coordinate is not finite",
+					       s->source, what, v);
+
+	/* tris and shade share cap_tris, which only grows once both have. */
+	size_t need = (size_t)s->ntris + ntris;
+	if (need > s->cap_tris) {
+		size_t ncap = s->cap_tris ? s->cap_tris : 16;
+		while (ncap < need)
+			ncap *= 2;
+		Tri *t = realloc(s->tris, ncap * sizeof *t);
+		if (!t)
+			return err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: %s: out of memory", s->source, what);
+		s->tris = t;
+		TriShade *sh = realloc(s->shade, ncap * sizeof *sh);
+		if (!sh)
+			return err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: %s: out of memory", s->source, what);
+		s->shade = sh;
+		s->cap_tris = (uint32_t)ncap;
+	}
+
+	for (uint32_t t = 0; t < ntris; t++) {
+		uint32_t k[3];
+		for (int j = 0; j < 3; j++)
+			k[j] = idx ? idx[3 * (size_t)t + j] : 3 * t + (uint32_t)j;
+		Tri *tri = &s->tris[s->ntris + t];
+		TriShade *sh = &s->shade[s->ntris + t];
+		memset(tri, 0, sizeof *tri);
+		memset(sh, 0, sizeof *sh);
+		tri->p0 = load3(pos, k[0]);
+		tri->p1 = load3(pos, k[1]);
+		tri->p2 = load3(pos, k[2]);
+		tri->material = (int)material;
+		tri->emitter = -1;
+		if (normals) {
+			V3 n[3];
+			sh->has_normals = 1;
+			for (int j = 0; j < 3; j++) {
+				n[j] = load3(normals, k[j]);
+				float len = v3_len(n[j]);
+				/* A zero (or underflowing) normal has no direction: the
+				 * geometric normal is the honest fallback. */
+				if (!(len > 1e-20f) || !isfinite(1.0f / len))
+					sh->has_normals = 0;
+				else
+					n[j] = v3_scale(n[j], 1.0f / len);
+			}
+			if (sh->has_normals) {
+				sh->n0 = n[0];
+				sh->n1 = n[1];
+				sh->n2 = n[2];
+			}
+		}
+		if (uvs) {
+			sh->u0 = uvs[2 * (size_t)k[0]];
+			sh->v0 = uvs[2 * (size_t)k[0] + 1];
+			sh->u1 = uvs[2 * (size_t)k[1]];
+			sh->v1 = uvs[2 * (size_t)k[1] + 1];
+			sh->u2 = uvs[2 * (size_t)k[2]];
+			sh->v2 = uvs[2 * (size_t)k[2] + 1];
+		}
+	}
+	s->ntris += ntris;
+	return AJAR_OK;
+}
+
+ajar_status scene_add_portal(Scene *s, const char *what, const float *pos, uint32_t nverts, const uint32_t *idx,
+			     uint32_t ntris)
+{
+	ajar_status st = check_geometry(s, what, pos, nverts, idx, ntris, s->nportal_tris);
+	if (st)
+		return st;
+	if (ntris == 0)
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: portal has no triangles", s->source, what);
+	st = grow32((void **)&s->portals, &s->cap_portals, (size_t)s->nportal_tris + ntris, sizeof *s->portals);
+	if (st)
+		return st;
+	for (uint32_t t = 0; t < ntris; t++) {
+		uint32_t k[3];
+		for (int j = 0; j < 3; j++)
+			k[j] = idx ? idx[3 * (size_t)t + j] : 3 * t + (uint32_t)j;
+		PortalTri *p = &s->portals[s->nportal_tris + t];
+		memset(p, 0, sizeof *p);
+		p->p0 = load3(pos, k[0]);
+		p->p1 = load3(pos, k[1]);
+		p->p2 = load3(pos, k[2]);
+		p->area = 0.5f * v3_len(v3_cross(v3_sub(p->p1, p->p0), v3_sub(p->p2, p->p0)));
+		p->pdf_select = 0.0f;
+	}
+	s->nportal_tris += ntris;
+	s->nportals++;
+	return AJAR_OK;
+}
+
+static int v3_finite(V3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
+
+ajar_status scene_set_camera(Scene *s, V3 pos, V3 forward, V3 up, float yfov, float aspect)
+{
+	if (!v3_finite(pos) || !v3_finite(forward) || !v3_finite(up))
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: camera: position or orientation is not finite",
+			       s->source);
+	if (!(yfov > 0.0f && yfov < AJAR_PI))
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: camera: yfov %g is not in (0, pi)", s->source,
+			       yfov);
+	if (!(aspect >= 0.0f) || !isfinite(aspect))
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: camera: aspect ratio %g is not >= 0", s->source,
+			       aspect);
+	if (!(v3_len2(forward) > 0.0f))
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: camera: zero view direction", s->source);
+	V3 f = v3_norm(forward);
+	/* Keep only the part of `up` orthogonal to the view direction, so the
+	 * camera basis is orthonormal whatever the caller passes. */
+	V3 u = v3_madd(up, f, -v3_dot(up, f));
+	if (!(v3_len2(u) > 1e-12f * v3_len2(up)) || !(v3_len2(up) > 0.0f))
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: camera: up vector is zero or parallel to the view",
+			       s->source);
+	s->has_camera = 1;
+	s->cam_pos = pos;
+	s->cam_forward = f;
+	s->cam_up = v3_norm(u);
+	s->cam_yfov = yfov;
+	s->cam_aspect = aspect;
+	return AJAR_OK;
+}
+
+void scene_set_env_color(Scene *s, V3 rgb)
+{
+	free(s->env_rgb);
+	s->env_rgb = NULL;
+	s->env_width = s->env_height = 0;
+	s->env_type = ENV_COLOR;
+	s->env_color = rgb;
+	s->env_strength = 1.0f;
+}
+
+ajar_status scene_set_env_image(Scene *s, uint32_t w, uint32_t h, float *rgb, float strength)
+{
+	if (!rgb || w == 0 || h == 0) {
+		free(rgb);
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: environment: empty image (%ux%u)", s->source, w, h);
+	}
+	if (!(strength >= 0.0f) || !isfinite(strength)) {
+		free(rgb);
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: environment: strength %g is not >= 0", s->source,
+			       strength);
+	}
+	size_t n = (size_t)w * h * 3;
+	for (size_t i = 0; i < n; i++)
+		if (!(rgb[i] >= 0.0f) || !isfinite(rgb[i])) {
+			size_t px = i / 3;
+			float bad = rgb[i];
+			free(rgb);
+			return err_set(AJAR_ERROR_BAD_INPUT,
+				       "%s: environment: pixel (%zu, %zu) has value %g (must be finite and >= 0)",
+				       s->source, px % w, px / w, bad);
+		}
+	free(s->env_rgb);
+	s->env_rgb = rgb;
+	s->env_width = w;
+	s->env_height = h;
+	s->env_strength = strength;
+	s->env_type = ENV_IMAGE;
+	return AJAR_OK;
+}
+
+void scene_bounds(const Scene *s, V3 *bmin, V3 *bmax)
+{
+	V3 lo = v3(AJAR_INF, AJAR_INF, AJAR_INF), hi = v3(-AJAR_INF, -AJAR_INF, -AJAR_INF);
+	for (uint32_t i = 0; i < s->ntris; i++) {
+		const Tri *t = &s->tris[i];
+		lo = v3_min(lo, v3_min(t->p0, v3_min(t->p1, t->p2)));
+		hi = v3_max(hi, v3_max(t->p0, v3_max(t->p1, t->p2)));
+	}
+	for (uint32_t i = 0; i < s->nportal_tris; i++) {
+		const PortalTri *t = &s->portals[i];
+		lo = v3_min(lo, v3_min(t->p0, v3_min(t->p1, t->p2)));
+		hi = v3_max(hi, v3_max(t->p0, v3_max(t->p1, t->p2)));
+	}
+	if (lo.x > hi.x)
+		lo = hi = v3(0.0f, 0.0f, 0.0f);
+	*bmin = lo;
+	*bmax = hi;
+}
+
+uint32_t scene_count_emissive(const Scene *s)
+{
+	uint32_t n = 0;
+	for (uint32_t i = 0; i < s->ntris; i++) {
+		int m = s->tris[i].material;
+		if (m >= 0 && (uint32_t)m < s->nmaterials && !v3_is_zero(s->materials[m].emission))
+			n++;
+	}
+	return n;
+}
+
+void scene_camera(const Scene *s, V3 *pos, V3 *forward, V3 *up, float *yfov)
+{
+	if (s->has_camera) {
+		*pos = s->cam_pos;
+		*forward = s->cam_forward;
+		*up = s->cam_up;
+		*yfov = s->cam_yfov;
+		return;
+	}
+	V3 lo, hi;
+	scene_bounds(s, &lo, &hi);
+	V3 c = v3_scale(v3_add(lo, hi), 0.5f);
+	float r = 0.5f * v3_len(v3_sub(hi, lo));
+	if (!(r > 0.0f))
+		r = 1.0f;
+	float fov = 45.0f * AJAR_PI / 180.0f;
+	/* Far enough that the bounding sphere fits the vertical field of view. */
+	float d = r / sin(0.5f * fov);
+	*pos = v3(c.x, c.y, c.z + d);
+	*forward = v3(0.0f, 0.0f, -1.0f);
+	*up = v3(0.0f, 1.0f, 0.0f);
+	*yfov = fov;
+}

@@ -1,0 +1,822 @@
+/* test_scene.c — the host scene, the scene API and the glTF loader.
+ *
+ * The shipped scenes load with the counts their SOURCE.md files state;
+ * scenes built through the API end up where their transforms put them;
+ * small glTF files written here exercise one loader feature each (node
+ * hierarchies, strips and fans, interleaved, sparse and normalized
+ * accessors, data URIs, .glb, portals, environments); broken files fail
+ * with the right status and a message naming the file and the element. */
+#include "testutil.h"
+
+#include <dirent.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "ajar.h"
+#include "scene.h"
+
+#define EPS 1e-5f
+
+static char *tmpdir;
+
+static void assert_v3(V3 a, float x, float y, float z)
+{
+	if (fabsf(a.x - x) > EPS || fabsf(a.y - y) > EPS || fabsf(a.z - z) > EPS)
+		fail_msg("(%g, %g, %g) != (%g, %g, %g)", a.x, a.y, a.z, x, y, z);
+}
+
+static char *tmp_path(const char *name)
+{
+	char *p = malloc(strlen(tmpdir) + strlen(name) + 2);
+	assert_non_null(p);
+	sprintf(p, "%s/%s", tmpdir, name);
+	return p;
+}
+
+static void write_bytes(const char *name, const void *data, size_t n)
+{
+	char *p = tmp_path(name);
+	FILE *f = fopen(p, "wb");
+	assert_non_null(f);
+	assert_int_equal(fwrite(data, 1, n, f), n);
+	assert_int_equal(fclose(f), 0);
+	free(p);
+}
+
+static void write_text(const char *name, const char *text) { write_bytes(name, text, strlen(text)); }
+
+static Scene *load_ok(const char *name)
+{
+	char *p = tmp_path(name);
+	ajar_scene *s = NULL;
+	ajar_status st = ajar_scene_load(p, &s);
+	if (st)
+		fail_msg("%s: %s", ajar_status_name(st), ajar_last_error());
+	free(p);
+	return s;
+}
+
+/* The load fails with `status`, and the message names the file and holds
+ * `needle` (the element and what is wrong with it). */
+static void load_fails(const char *name, ajar_status status, const char *needle)
+{
+	char *p = tmp_path(name);
+	static char sentinel;
+	ajar_scene *s = (ajar_scene *)(void *)&sentinel; /* must come back NULL */
+	ajar_status st = ajar_scene_load(p, &s);
+	const char *msg = ajar_last_error();
+	if (st != status || !strstr(msg, name) || !strstr(msg, needle))
+		fail_msg("%s: got %s \"%s\", want %s with \"%s\"", name, ajar_status_name(st), msg,
+			 ajar_status_name(status), needle);
+	assert_null(s);
+	free(p);
+}
+
+/* ---- The standard one-triangle buffer ------------------------------------
+ * (0,0,0) (1,0,0) (0,1,0), normals +Z, u16 indices 0 1 2: 78 bytes with
+ * views at 0 (positions), 36 (normals), 72 (indices). */
+static size_t tri_bin(uint8_t *b, const uint16_t idx[3], float bad)
+{
+	const float pos[9] = {0, 0, 0, bad, 0, 0, 0, 1, 0};
+	const float nrm[9] = {0, 0, 1, 0, 0, 1, 0, 0, 1};
+	memcpy(b, pos, 36);
+	memcpy(b + 36, nrm, 36);
+	memcpy(b + 72, idx, 6);
+	return 78;
+}
+
+static const uint16_t idx012[3] = {0, 1, 2};
+
+#define TRI_BUFFERS(uri)                                                                                         \
+	"\"buffers\":[{\"uri\":\"" uri "\",\"byteLength\":78}],"                                               \
+	"\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":36},"                                  \
+	"{\"buffer\":0,\"byteOffset\":36,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":72,\"byteLength\":6}]," \
+	"\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2}]}]"
+
+#define TRI_ACCESSORS(npos)                                                                                   \
+	"\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":" #npos ",\"type\":\"VEC3\"},"      \
+	"{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"                            \
+	"{\"bufferView\":2,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]"
+
+static void write_tri_bin(void)
+{
+	uint8_t bin[80];
+	write_bytes("tri.bin", bin, tri_bin(bin, idx012, 1.0f));
+}
+
+/* One triangle mesh in tri.bin, with the given scene nodes, nodes, and
+ * `more` added to the scene object (its extras). */
+static void write_tri_gltf(const char *name, const char *scene_nodes, const char *nodes, const char *more)
+{
+	write_tri_bin();
+	char json[4096];
+	snprintf(json, sizeof json,
+		 "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[%s]%s}],\"nodes\":[%s]," TRI_BUFFERS(
+			 "tri.bin") "," TRI_ACCESSORS(3) "}",
+		 scene_nodes, more, nodes);
+	write_text(name, json);
+}
+
+/* ---- Shipped scenes --------------------------------------------------- */
+
+static Scene *load_shipped(const char *path, ajar_scene_info *info)
+{
+	ajar_scene *s = NULL;
+	ajar_status st = ajar_scene_load(path, &s);
+	if (st)
+		fail_msg("%s: %s", path, ajar_last_error());
+	assert_int_equal(ajar_scene_info_get(s, info), AJAR_OK);
+	return s;
+}
+
+static void test_cornell(void **state)
+{
+	ajar_scene_info in;
+	Scene *s = load_shipped(SCENE("cornell/cornell.gltf"), &in);
+	/* Counted from cornell.gltf: 5 walls and the light are 2 triangles
+	 * each, the two blocks 10 each. */
+	assert_int_equal(in.triangles, 32);
+	assert_int_equal(in.materials, 4);
+	assert_int_equal(in.emissive_triangles, 2);
+	assert_int_equal(in.portals, 0);
+	assert_int_equal(in.portal_triangles, 0);
+	assert_int_equal(in.textures, 0);
+	assert_int_equal(in.environment, 0);
+	assert_true(in.has_camera);
+	assert_int_equal(in.width, 0);
+	/* Camera node: translation (0.278, 0.273, -0.8), 180 degrees about Y. */
+	assert_v3(s->cam_pos, 0.278f, 0.273f, -0.8f);
+	assert_v3(s->cam_forward, 0.0f, 0.0f, 1.0f);
+	assert_v3(s->cam_up, 0.0f, 1.0f, 0.0f);
+	assert_float_equal(s->cam_yfov, 0.6860478808414068f, 1e-7);
+	assert_float_equal(s->cam_aspect, 1.0f, 0.0);
+	assert_v3(v3(in.bounds_min[0], in.bounds_min[1], in.bounds_min[2]), 0.0f, 0.0f, 0.0f);
+	assert_v3(v3(in.bounds_max[0], in.bounds_max[1], in.bounds_max[2]), 0.556f, 0.5488f, 0.5592f);
+	/* The light: emissiveFactor x strength 17, single-sided, Lambertian. */
+	const Material *light = &s->materials[3];
+	assert_v3(light->emission, 17.0f, 12.0f, 4.0f);
+	assert_int_equal(light->flags & MATERIAL_DOUBLE_SIDED, 0);
+	assert_float_equal(light->specular, 0.0f, 0.0);
+	const Material *white = &s->materials[0];
+	assert_v3(white->base_color, 0.725f, 0.71f, 0.68f);
+	assert_int_equal(white->flags, MATERIAL_DOUBLE_SIDED);
+	assert_int_equal(white->base_tex, -1);
+	assert_float_equal(white->ior, 1.5f, 0.0);
+	for (uint32_t i = 0; i < s->ntris; i++) {
+		assert_int_equal(s->tris[i].emitter, -1);
+		assert_int_equal(s->shade[i].has_normals, 1);
+	}
+	ajar_scene_destroy(&s);
+	assert_null(s);
+}
+
+static void test_window_room(void **state)
+{
+	ajar_scene_info in;
+	Scene *s = load_shipped(SCENE("window-room/window-room.gltf"), &in);
+	assert_int_equal(in.triangles, 28);
+	assert_int_equal(in.portals, 1);
+	assert_int_equal(in.portal_triangles, 2);
+	assert_int_equal(in.emissive_triangles, 0);
+	assert_int_equal(in.environment, 1);
+	assert_v3(s->env_color, 1.0f, 1.0f, 1.0f);
+	assert_true(in.has_camera);
+	/* The portal is a 0.8 x 0.8 m quad. */
+	assert_float_equal(s->portals[0].area + s->portals[1].area, 0.64f, 1e-5);
+	ajar_scene_destroy(&s);
+}
+
+static void test_living_room(void **state)
+{
+	ajar_scene_info in;
+	Scene *s = load_shipped(SCENE("living-room/living-room.gltf"), &in);
+	assert_int_equal(in.triangles, 143163);
+	assert_int_equal(in.portals, 4);
+	assert_int_equal(in.portal_triangles, 8);
+	assert_int_equal(in.emissive_triangles, 0);
+	assert_int_equal(in.materials, 20);
+	assert_int_equal(in.environment, 1);
+	assert_true(in.has_camera);
+	assert_int_equal(in.width, 1280);
+	assert_int_equal(in.height, 720);
+	assert_float_equal(s->cam_aspect, 16.0f / 9.0f, 1e-6);
+	/* SOURCE.md: camera at (5.105, 0.731, -2.318) looking (-0.962, 0.074, 0.263). */
+	assert_float_equal(s->cam_pos.x, 5.105f, 1e-3);
+	assert_float_equal(s->cam_forward.x, -0.962f, 1e-3);
+	assert_float_equal(s->cam_forward.z, 0.263f, 1e-3);
+	/* leaf.png 365x271 and picture8.png 1280x853, as RGBA8. */
+	assert_int_equal(in.textures, 2);
+	int found = 0;
+	for (uint32_t i = 0; i < s->ntextures; i++)
+		found |= (s->textures[i].width == 365 && s->textures[i].height == 271) ? 1
+			 : (s->textures[i].width == 1280 && s->textures[i].height == 853) ? 2
+											   : 4;
+	assert_int_equal(found, 3);
+	assert_int_equal(s->ntexels, 365 * 271 + 1280 * 853);
+	ajar_scene_destroy(&s);
+}
+
+static void test_bathroom(void **state)
+{
+	ajar_scene_info in;
+	Scene *s = load_shipped(SCENE("bathroom/bathroom.gltf"), &in);
+	assert_int_equal(in.triangles, 592188);
+	assert_int_equal(in.portals, 2);
+	assert_int_equal(in.portal_triangles, 4);
+	/* One emissive quad outside the window, radiance 30. */
+	assert_int_equal(in.emissive_triangles, 2);
+	for (uint32_t i = 0; i < s->ntris; i++)
+		if (!v3_is_zero(s->materials[s->tris[i].material].emission)) {
+			assert_v3(s->materials[s->tris[i].material].emission, 30.0f, 30.0f, 30.0f);
+			assert_float_equal(s->tris[i].p0.x, -2.898f, 1e-3);
+		}
+	assert_int_equal(in.environment, 0);
+	assert_int_equal(in.textures, 3);
+	assert_true(in.has_camera);
+	assert_int_equal(in.width, 1024);
+	assert_int_equal(in.height, 1024);
+	assert_float_equal(s->cam_forward.x, -0.752f, 1e-3);
+	assert_float_equal(s->cam_forward.z, -0.659f, 1e-3);
+	assert_float_equal(in.bounds_min[0], -2.898f, 1e-3);
+	assert_float_equal(in.bounds_max[1], 2.792f, 1e-3);
+	ajar_scene_destroy(&s);
+}
+
+/* ---- API-built scenes -------------------------------------------------- */
+
+static void test_api_scene(void **state)
+{
+	ajar_scene *as = NULL;
+	assert_int_equal(ajar_scene_create(&as), AJAR_OK);
+	Scene *s = as;
+
+	ajar_material m;
+	ajar_material_default(&m);
+	assert_float_equal(m.base_color[1], 0.8f, 0.0);
+	assert_float_equal(m.specular, 0.0f, 0.0);
+	uint32_t white, lamp;
+	assert_int_equal(ajar_scene_add_material(as, &m, &white), AJAR_OK);
+	m.emission[0] = m.emission[1] = m.emission[2] = 5.0f;
+	assert_int_equal(ajar_scene_add_material(as, &m, &lamp), AJAR_OK);
+	assert_int_equal(lamp, 1);
+	ajar_material bad = m;
+	bad.roughness = NAN;
+	assert_int_equal(ajar_scene_add_material(as, &bad, NULL), AJAR_ERROR_INVALID_ARGUMENT);
+	bad = m;
+	bad.base_color[2] = -0.1f;
+	assert_int_equal(ajar_scene_add_material(as, &bad, NULL), AJAR_ERROR_INVALID_ARGUMENT);
+	bad = m;
+	bad.emission[0] = -1.0f;
+	assert_int_equal(ajar_scene_add_material(as, &bad, NULL), AJAR_ERROR_INVALID_ARGUMENT);
+	assert_int_equal(s->nmaterials, 2);
+
+	/* A unit quad in z = 0, scaled by 2 in x and moved by (1, 2, 3). */
+	const float pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+	const float r = 0.70710678f;
+	const float nrm[12] = {r, 0, r, r, 0, r, r, 0, r, 0, 0, 0};
+	const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+	const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+	const float xf[16] = {2, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 1, 2, 3, 1};
+	ajar_mesh mesh = {pos, nrm, uv, 4, idx, 2, white, xf};
+	assert_int_equal(ajar_scene_add_mesh(as, &mesh), AJAR_OK);
+	assert_int_equal(s->ntris, 2);
+	assert_v3(s->tris[0].p0, 1, 2, 3);
+	assert_v3(s->tris[0].p1, 3, 2, 3);
+	assert_v3(s->tris[0].p2, 3, 3, 3);
+	assert_v3(s->tris[1].p2, 1, 3, 3);
+	/* Normals by the inverse transpose diag(1/2, 1, 1): (1, 0, 1) becomes
+	 * (1/2, 0, 1), renormalized. */
+	assert_int_equal(s->shade[0].has_normals, 1);
+	assert_v3(s->shade[0].n0, 0.4472136f, 0.0f, 0.8944272f);
+	/* The second triangle has a zero normal: geometric normal instead. */
+	assert_int_equal(s->shade[1].has_normals, 0);
+	assert_float_equal(s->shade[0].u2, 1.0f, 0.0);
+	assert_float_equal(s->shade[0].v2, 1.0f, 0.0);
+	assert_int_equal(s->tris[0].emitter, -1);
+
+	/* Mirrored (det < 0), non-indexed, emissive: the winding is reversed
+	 * so the front face stays counter-clockwise. */
+	const float mirror[16] = {-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+	ajar_mesh lamp_mesh = {pos, NULL, NULL, 3, NULL, 1, lamp, mirror};
+	assert_int_equal(ajar_scene_add_mesh(as, &lamp_mesh), AJAR_OK);
+	assert_v3(s->tris[2].p0, 0, 0, 0);
+	assert_v3(s->tris[2].p1, -1, 1, 0);
+	assert_v3(s->tris[2].p2, -1, 0, 0);
+	assert_int_equal(s->shade[2].has_normals, 0);
+
+	/* Caller mistakes. */
+	ajar_mesh wrong = mesh;
+	wrong.material = 7;
+	assert_int_equal(ajar_scene_add_mesh(as, &wrong), AJAR_ERROR_INVALID_ARGUMENT);
+	const uint32_t far_idx[3] = {0, 1, 9};
+	wrong = mesh;
+	wrong.indices = far_idx;
+	wrong.triangle_count = 1;
+	assert_int_equal(ajar_scene_add_mesh(as, &wrong), AJAR_ERROR_INVALID_ARGUMENT);
+	assert_non_null(strstr(ajar_last_error(), "index 9"));
+	const float singular[16] = {0};
+	wrong = mesh;
+	wrong.transform = singular;
+	assert_int_equal(ajar_scene_add_mesh(as, &wrong), AJAR_ERROR_INVALID_ARGUMENT);
+	assert_int_equal(s->ntris, 3);
+
+	/* A portal: the quad moved to z = 5, area 1; invisible, not a triangle. */
+	const float up5[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 5, 1};
+	ajar_mesh portal = {pos, NULL, NULL, 4, idx, 2, 0, up5};
+	assert_int_equal(ajar_scene_add_portal(as, &portal), AJAR_OK);
+	assert_int_equal(s->nportals, 1);
+	assert_int_equal(s->nportal_tris, 2);
+	assert_v3(s->portals[1].p2, 0, 1, 5);
+	assert_float_equal(s->portals[0].area, 0.5f, 1e-6);
+	assert_float_equal(s->portals[0].pdf_select, 0.0f, 0.0);
+
+	ajar_scene_info in;
+	assert_int_equal(ajar_scene_info_get(as, &in), AJAR_OK);
+	assert_int_equal(in.triangles, 3);
+	assert_int_equal(in.emissive_triangles, 1);
+	assert_int_equal(in.portals, 1);
+	assert_int_equal(in.portal_triangles, 2);
+	assert_int_equal(in.has_camera, 0);
+	/* Bounds include the portal. */
+	assert_v3(v3(in.bounds_min[0], in.bounds_min[1], in.bounds_min[2]), -1, 0, 0);
+	assert_v3(v3(in.bounds_max[0], in.bounds_max[1], in.bounds_max[2]), 3, 3, 5);
+	/* Default view: along -Z from outside the bounding sphere, 45 degrees. */
+	assert_float_equal(in.camera.yfov, 45.0f * AJAR_PI / 180.0f, 1e-6);
+	assert_float_equal(in.camera.position[0], 1.0f, 1e-6);
+	assert_true(in.camera.position[2] > 5.0f);
+	assert_float_equal(in.camera.target[2] - in.camera.position[2], -1.0f, 1e-6);
+	assert_float_equal(in.camera.up[1], 1.0f, 0.0);
+
+	ajar_camera cam = {{0, 1, 10}, {0, 1, 0}, {0, 2, 0}, 0.8f, 1.5f};
+	assert_int_equal(ajar_scene_set_camera(as, &cam), AJAR_OK);
+	assert_int_equal(ajar_scene_info_get(as, &in), AJAR_OK);
+	assert_int_equal(in.has_camera, 1);
+	assert_float_equal(in.camera.target[2], 9.0f, 1e-6);
+	assert_float_equal(in.camera.up[1], 1.0f, 1e-6);
+	assert_float_equal(in.camera.aspect, 1.5f, 0.0);
+	ajar_camera flat = {{0, 0, 0}, {0, 1, 0}, {0, 1, 0}, 0.8f, 0.0f};
+	assert_int_equal(ajar_scene_set_camera(as, &flat), AJAR_ERROR_INVALID_ARGUMENT);
+
+	const float sky[3] = {0.1f, 0.2f, 0.3f}, neg[3] = {0.1f, -1.0f, 0.3f};
+	assert_int_equal(ajar_scene_set_environment_color(as, neg), AJAR_ERROR_INVALID_ARGUMENT);
+	assert_int_equal(ajar_scene_set_environment_color(as, sky), AJAR_OK);
+	assert_int_equal(ajar_scene_info_get(as, &in), AJAR_OK);
+	assert_int_equal(in.environment, 1);
+	ajar_scene_destroy(&as);
+	assert_null(as);
+}
+
+/* ---- Loader features --------------------------------------------------- */
+
+static void test_hierarchy_trs(void **state)
+{
+	/* Parent: translate (1,2,3), scale 2; child 1: 90 degrees about +Y with
+	 * the mesh; child 2: the camera, 1 unit along the parent's +Z. */
+	char json[4096];
+	write_tri_bin();
+	snprintf(json, sizeof json,
+		 "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":["
+		 "{\"translation\":[1,2,3],\"scale\":[2,2,2],\"children\":[1,2]},"
+		 "{\"rotation\":[0,0.7071067811865476,0,0.7071067811865476],\"mesh\":0},"
+		 "{\"camera\":0,\"translation\":[0,0,1],\"extras\":{\"resolution\":[320,240]}}],"
+		 "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.5,\"znear\":0.1}}]," TRI_BUFFERS(
+			 "tri.bin") "," TRI_ACCESSORS(3) "}");
+	write_text("trs.gltf", json);
+	Scene *s = load_ok("trs.gltf");
+	assert_int_equal(s->ntris, 1);
+	assert_v3(s->tris[0].p0, 1, 2, 3);
+	assert_v3(s->tris[0].p1, 1, 2, 1);
+	assert_v3(s->tris[0].p2, 1, 4, 3);
+	assert_v3(s->shade[0].n0, 1, 0, 0);
+	assert_true(s->has_camera);
+	assert_v3(s->cam_pos, 1, 2, 5);
+	assert_v3(s->cam_forward, 0, 0, -1);
+	assert_v3(s->cam_up, 0, 1, 0);
+	assert_float_equal(s->cam_yfov, 0.5f, 0.0);
+	assert_float_equal(s->cam_aspect, 0.0f, 0.0);
+	assert_int_equal(s->width, 320);
+	assert_int_equal(s->height, 240);
+	/* No material: glTF's default (white, metallic 1, roughness 1). */
+	assert_int_equal(s->nmaterials, 1);
+	assert_v3(s->materials[0].base_color, 1, 1, 1);
+	assert_float_equal(s->materials[0].metallic, 1.0f, 0.0);
+	assert_float_equal(s->materials[0].roughness, 1.0f, 0.0);
+	assert_int_equal(s->materials[0].base_tex, -1);
+	ajar_scene_destroy(&s);
+}
+
+static void test_hierarchy_matrix(void **state)
+{
+	/* Column-major matrix: mirror x, then move to z = 5. Mirroring keeps
+	 * the normal (inverse transpose) and reverses the winding. */
+	write_tri_gltf("matrix.gltf", "0", "{\"matrix\":[-1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,5,1],\"mesh\":0}", "");
+	Scene *s = load_ok("matrix.gltf");
+	assert_int_equal(s->ntris, 1);
+	assert_v3(s->tris[0].p0, 0, 0, 5);
+	assert_v3(s->tris[0].p1, 0, 1, 5);
+	assert_v3(s->tris[0].p2, -1, 0, 5);
+	V3 ng = v3_cross(v3_sub(s->tris[0].p1, s->tris[0].p0), v3_sub(s->tris[0].p2, s->tris[0].p0));
+	assert_v3(ng, 0, 0, 1);
+	assert_v3(s->shade[0].n1, 0, 0, 1);
+	assert_false(s->has_camera);
+	ajar_scene_destroy(&s);
+}
+
+static void test_no_scenes_all_roots(void **state)
+{
+	/* No "scenes": every root node is shown; node 1 is node 0's child. */
+	write_tri_bin();
+	write_text("roots.gltf", "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0,\"children\":[1]},"
+				 "{\"mesh\":0,\"translation\":[0,0,1]},{\"mesh\":0,\"translation\":[0,0,2]}]," TRI_BUFFERS(
+					 "tri.bin") "," TRI_ACCESSORS(3) "}");
+	Scene *s = load_ok("roots.gltf");
+	assert_int_equal(s->ntris, 3);
+	assert_float_equal(s->tris[1].p0.z, 1.0f, 0.0);
+	assert_float_equal(s->tris[2].p0.z, 2.0f, 0.0);
+	ajar_scene_destroy(&s);
+}
+
+static void test_non_indexed_and_materials(void **state)
+{
+	/* Two non-indexed triangles, drawn twice: with a material using every
+	 * extension we read, and without a material. */
+	const float pos[18] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 0, 1, 1};
+	write_bytes("flat.bin", pos, sizeof pos);
+	write_text("flat.gltf",
+		   "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+		   "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":0},"
+		   "{\"attributes\":{\"POSITION\":0}}]}],"
+		   "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.25,0.125,1],"
+		   "\"metallicFactor\":0.2,\"roughnessFactor\":0.3},\"emissiveFactor\":[1,0.5,0],"
+		   "\"doubleSided\":true,\"alphaMode\":\"MASK\",\"alphaCutoff\":0.25,\"extensions\":{"
+		   "\"KHR_materials_emissive_strength\":{\"emissiveStrength\":4},"
+		   "\"KHR_materials_transmission\":{\"transmissionFactor\":0.75},"
+		   "\"KHR_materials_ior\":{\"ior\":1.33},\"KHR_materials_specular\":{\"specularFactor\":0.5}}}],"
+		   "\"extensionsUsed\":[\"KHR_materials_emissive_strength\",\"KHR_materials_transmission\","
+		   "\"KHR_materials_ior\",\"KHR_materials_specular\"],"
+		   "\"extensionsRequired\":[\"KHR_materials_transmission\"],"
+		   "\"buffers\":[{\"uri\":\"flat.bin\",\"byteLength\":72}],"
+		   "\"bufferViews\":[{\"buffer\":0,\"byteLength\":72}],"
+		   "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":6,\"type\":\"VEC3\"}]}");
+	Scene *s = load_ok("flat.gltf");
+	assert_int_equal(s->ntris, 4);
+	assert_v3(s->tris[1].p0, 0, 0, 1);
+	assert_v3(s->tris[1].p2, 0, 1, 1);
+	assert_int_equal(s->shade[0].has_normals, 0);
+	assert_int_equal(s->nmaterials, 2);
+	const Material *m = &s->materials[0];
+	assert_v3(m->base_color, 0.5f, 0.25f, 0.125f);
+	assert_v3(m->emission, 4.0f, 2.0f, 0.0f);
+	assert_float_equal(m->metallic, 0.2f, 1e-7);
+	assert_float_equal(m->roughness, 0.3f, 1e-7);
+	assert_float_equal(m->transmission, 0.75f, 0.0);
+	assert_float_equal(m->ior, 1.33f, 1e-7);
+	assert_float_equal(m->specular, 0.5f, 0.0);
+	assert_int_equal(m->flags, MATERIAL_DOUBLE_SIDED | MATERIAL_ALPHA_MASK);
+	assert_float_equal(m->alpha_cutoff, 0.25f, 0.0);
+	assert_int_equal(s->tris[0].material, 0);
+	assert_int_equal(s->tris[2].material, 1);
+	assert_float_equal(s->materials[1].metallic, 1.0f, 0.0);
+	assert_int_equal(scene_count_emissive(s), 2);
+	ajar_scene_destroy(&s);
+}
+
+static void test_interleaved_strip_fan(void **state)
+{
+	/* Four vertices interleaved (position, normal, normalized u16 uv;
+	 * stride 28) and three primitives over u8 indices: a triangle list, a
+	 * strip, a fan; plus a point primitive that is skipped. */
+	struct {
+		float p[3], n[3];
+		uint16_t uv[2];
+	} v[4] = {
+		{{0, 0, 0}, {0, 0, 1}, {0, 0}},
+		{{1, 0, 0}, {0, 0, 1}, {65535, 0}},
+		{{0, 1, 0}, {0, 0, 1}, {0, 32768}},
+		{{1, 1, 0}, {0, 0, 1}, {65535, 65535}},
+	};
+	_Static_assert(sizeof v == 112, "packed vertices");
+	uint8_t bin[124];
+	const uint8_t idx[11] = {0, 1, 2, 0, 1, 2, 3, 0, 1, 3, 2};
+	memcpy(bin, v, 112);
+	memcpy(bin + 112, idx, 11);
+	write_bytes("inter.bin", bin, 123);
+	write_text("inter.gltf",
+		   "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+		   "\"meshes\":[{\"primitives\":["
+		   "{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"TEXCOORD_0\":2},\"indices\":3},"
+		   "{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"TEXCOORD_0\":2},\"indices\":4,\"mode\":5},"
+		   "{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"TEXCOORD_0\":2},\"indices\":5,\"mode\":6},"
+		   "{\"attributes\":{\"POSITION\":0},\"mode\":0}]}],"
+		   "\"buffers\":[{\"uri\":\"inter.bin\",\"byteLength\":123}],"
+		   "\"bufferViews\":[{\"buffer\":0,\"byteLength\":112,\"byteStride\":28},"
+		   "{\"buffer\":0,\"byteOffset\":112,\"byteLength\":11}],"
+		   "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
+		   "{\"bufferView\":0,\"byteOffset\":12,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
+		   "{\"bufferView\":0,\"byteOffset\":24,\"componentType\":5123,\"normalized\":true,\"count\":4,"
+		   "\"type\":\"VEC2\"},"
+		   "{\"bufferView\":1,\"componentType\":5121,\"count\":3,\"type\":\"SCALAR\"},"
+		   "{\"bufferView\":1,\"byteOffset\":3,\"componentType\":5121,\"count\":4,\"type\":\"SCALAR\"},"
+		   "{\"bufferView\":1,\"byteOffset\":7,\"componentType\":5121,\"count\":4,\"type\":\"SCALAR\"}]}");
+	Scene *s = load_ok("inter.gltf");
+	assert_int_equal(s->ntris, 5);
+	assert_v3(s->tris[0].p1, 1, 0, 0);
+	assert_v3(s->shade[0].n2, 0, 0, 1);
+	assert_float_equal(s->shade[0].u1, 1.0f, 0.0);
+	assert_float_equal(s->shade[0].v2, 32768.0f / 65535.0f, 1e-7);
+	/* Strip 0 1 2 3: (0 1 2), (1 3 2). Fan 0 1 3 2: (1 3 0), (3 2 0). */
+	assert_v3(s->tris[2].p0, 1, 0, 0);
+	assert_v3(s->tris[2].p1, 1, 1, 0);
+	assert_v3(s->tris[2].p2, 0, 1, 0);
+	assert_v3(s->tris[3].p0, 1, 0, 0);
+	assert_v3(s->tris[3].p2, 0, 0, 0);
+	assert_v3(s->tris[4].p0, 1, 1, 0);
+	assert_v3(s->tris[4].p1, 0, 1, 0);
+	for (uint32_t i = 0; i < s->ntris; i++) {
+		V3 ng = v3_cross(v3_sub(s->tris[i].p1, s->tris[i].p0), v3_sub(s->tris[i].p2, s->tris[i].p0));
+		assert_true(ng.z > 0.0f); /* all counter-clockwise seen from +Z */
+	}
+	ajar_scene_destroy(&s);
+}
+
+static void test_sparse(void **state)
+{
+	/* POSITION: the triangle with vertex 2 replaced by (5, 5, 5) through a
+	 * sparse u8 index; NORMAL: no buffer view (zeros) with one sparse
+	 * value at vertex 1, so the triangle falls back to its geometric normal. */
+	uint8_t bin[128];
+	tri_bin(bin, idx012, 1.0f); /* bytes 0..77 */
+	const uint8_t sidx[4] = {2, 1, 0, 0};
+	const float sval[6] = {5, 5, 5, 0, 0, 3};
+	memcpy(bin + 80, sidx, 4);
+	memcpy(bin + 84, sval, 24);
+	write_bytes("sparse.bin", bin, 108);
+	write_text("sparse.gltf",
+		   "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+		   "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2}]}],"
+		   "\"buffers\":[{\"uri\":\"sparse.bin\",\"byteLength\":108}],"
+		   "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":72,\"byteLength\":6},"
+		   "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":4},{\"buffer\":0,\"byteOffset\":84,\"byteLength\":24}],"
+		   "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\","
+		   "\"sparse\":{\"count\":1,\"indices\":{\"bufferView\":2,\"componentType\":5121},"
+		   "\"values\":{\"bufferView\":3}}},"
+		   "{\"componentType\":5126,\"count\":3,\"type\":\"VEC3\","
+		   "\"sparse\":{\"count\":1,\"indices\":{\"bufferView\":2,\"byteOffset\":1,\"componentType\":5121},"
+		   "\"values\":{\"bufferView\":3,\"byteOffset\":12}}},"
+		   "{\"bufferView\":1,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}");
+	Scene *s = load_ok("sparse.gltf");
+	assert_int_equal(s->ntris, 1);
+	assert_v3(s->tris[0].p1, 1, 0, 0);
+	assert_v3(s->tris[0].p2, 5, 5, 5);
+	assert_int_equal(s->shade[0].has_normals, 0);
+	ajar_scene_destroy(&s);
+}
+
+static char *base64(const uint8_t *p, size_t n)
+{
+	static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+	char *out = malloc(4 * ((n + 2) / 3) + 1), *o = out;
+	assert_non_null(out);
+	for (size_t i = 0; i < n; i += 3) {
+		uint32_t v = (uint32_t)p[i] << 16 | (i + 1 < n ? (uint32_t)p[i + 1] << 8 : 0) | (i + 2 < n ? p[i + 2] : 0);
+		*o++ = tab[v >> 18];
+		*o++ = tab[(v >> 12) & 63];
+		*o++ = i + 1 < n ? tab[(v >> 6) & 63] : '=';
+		*o++ = i + 2 < n ? tab[v & 63] : '=';
+	}
+	*o = '\0';
+	return out;
+}
+
+static void test_data_uri(void **state)
+{
+	uint8_t bin[80];
+	char *b64 = base64(bin, tri_bin(bin, idx012, 1.0f));
+	char *json = malloc(8192);
+	assert_non_null(json);
+	snprintf(json, 8192,
+		 "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0,"
+		 "\"translation\":[0,0,-1]}],\"buffers\":[{\"uri\":\"data:application/octet-stream;base64,%s\","
+		 "\"byteLength\":78}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},"
+		 "{\"buffer\":0,\"byteOffset\":36,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":72,\"byteLength\":6}],"
+		 "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2}]}]," TRI_ACCESSORS(
+			 3) "}",
+		 b64);
+	write_text("datauri.gltf", json);
+	free(json);
+	free(b64);
+	Scene *s = load_ok("datauri.gltf");
+	assert_int_equal(s->ntris, 1);
+	assert_v3(s->tris[0].p2, 0, 1, -1);
+	ajar_scene_destroy(&s);
+}
+
+static void put_u32(uint8_t *p, uint32_t v)
+{
+	for (int i = 0; i < 4; i++)
+		p[i] = (uint8_t)(v >> (8 * i));
+}
+
+static void test_glb(void **state)
+{
+	/* GLB: 12-byte header, a JSON chunk padded with spaces, a BIN chunk
+	 * padded with zeros, all little-endian. The file has no extension
+	 * hint (.glb) that the loader relies on; it checks the magic. */
+	char json[2048];
+	snprintf(json, sizeof json,
+		 "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+		 "\"buffers\":[{\"byteLength\":78}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},"
+		 "{\"buffer\":0,\"byteOffset\":36,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":72,\"byteLength\":6}],"
+		 "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2}]}]," TRI_ACCESSORS(
+			 3) "}");
+	size_t jlen = strlen(json), jpad = (jlen + 3) & ~(size_t)3, blen = 80;
+	size_t total = 12 + 8 + jpad + 8 + blen;
+	uint8_t *glb = calloc(1, total);
+	assert_non_null(glb);
+	memcpy(glb, "glTF", 4);
+	put_u32(glb + 4, 2);
+	put_u32(glb + 8, (uint32_t)total);
+	put_u32(glb + 12, (uint32_t)jpad);
+	put_u32(glb + 16, 0x4E4F534A); /* "JSON" */
+	memcpy(glb + 20, json, jlen);
+	memset(glb + 20 + jlen, ' ', jpad - jlen);
+	uint8_t *b = glb + 20 + jpad;
+	put_u32(b, (uint32_t)blen);
+	put_u32(b + 4, 0x004E4942); /* "BIN" */
+	tri_bin(b + 8, idx012, 1.0f);
+	write_bytes("tri.glb", glb, total);
+	free(glb);
+	Scene *s = load_ok("tri.glb");
+	assert_int_equal(s->ntris, 1);
+	assert_v3(s->tris[0].p1, 1, 0, 0);
+	assert_v3(s->shade[0].n0, 0, 0, 1);
+	ajar_scene_destroy(&s);
+}
+
+static void test_portals_and_environment(void **state)
+{
+	/* Node 0 is a portal (marked 1, as Blender writes custom properties);
+	 * its child is not; node 2 is a portal marked true at z = 3; the
+	 * environment colour is scaled by its strength. */
+	write_tri_gltf("portal.gltf", "0,2",
+		       "{\"mesh\":0,\"extras\":{\"portal\":1},\"children\":[1]},"
+		       "{\"mesh\":0,\"translation\":[0,0,1]},"
+		       "{\"mesh\":0,\"translation\":[0,0,3],\"extras\":{\"portal\":true}}",
+		       ",\"extras\":{\"environment\":{\"color\":[0.5,1,2],\"strength\":2},\"resolution\":[64,32]}");
+	Scene *s = load_ok("portal.gltf");
+	assert_int_equal(s->ntris, 1);
+	assert_float_equal(s->tris[0].p0.z, 1.0f, 0.0);
+	assert_int_equal(s->nportals, 2);
+	assert_int_equal(s->nportal_tris, 2);
+	assert_float_equal(s->portals[1].p0.z, 3.0f, 0.0);
+	assert_float_equal(s->portals[0].area, 0.5f, 1e-7);
+	assert_int_equal(s->env_type, ENV_COLOR);
+	assert_v3(s->env_color, 1, 2, 4);
+	assert_int_equal(s->width, 64);
+	assert_int_equal(s->height, 32);
+	ajar_scene_destroy(&s);
+}
+
+static void test_environment_image(void **state)
+{
+	/* An 8x4 EXR next to the glTF, named relative to it. */
+	float rgba[8 * 4 * 4];
+	for (int i = 0; i < 8 * 4; i++) {
+		rgba[4 * i] = (float)i;
+		rgba[4 * i + 1] = 0.5f;
+		rgba[4 * i + 2] = 0.25f * (float)(i % 8);
+		rgba[4 * i + 3] = 1.0f;
+	}
+	char *exr = tmp_path("sky.exr");
+	assert_int_equal(ajar_write_exr(exr, rgba, 8, 4, NULL, 0), AJAR_OK);
+	free(exr);
+	write_tri_gltf("envimg.gltf", "0", "{\"mesh\":0}",
+		       ",\"extras\":{\"environment\":{\"image\":\"sky.exr\",\"strength\":0.5}}");
+	Scene *s = load_ok("envimg.gltf");
+	assert_int_equal(s->env_type, ENV_IMAGE);
+	assert_int_equal(s->env_width, 8);
+	assert_int_equal(s->env_height, 4);
+	assert_float_equal(s->env_strength, 0.5f, 0.0);
+	assert_float_equal(s->env_rgb[3 * 13], 13.0f, 0.0);
+	assert_float_equal(s->env_rgb[3 * 13 + 1], 0.5f, 0.0);
+	assert_float_equal(s->env_rgb[3 * 13 + 2], 1.25f, 0.0);
+	ajar_scene_destroy(&s);
+
+	write_tri_gltf("envmissing.gltf", "0", "{\"mesh\":0}",
+		       ",\"extras\":{\"environment\":{\"image\":\"nosky.exr\"}}");
+	load_fails("envmissing.gltf", AJAR_ERROR_IO, "scenes[0].extras.environment.image");
+}
+
+/* ---- Broken files ------------------------------------------------------ */
+
+static void test_broken_files(void **state)
+{
+	/* Truncated JSON. */
+	FILE *f = fopen(SCENE("cornell/cornell.gltf"), "rb");
+	assert_non_null(f);
+	char head[3000];
+	assert_int_equal(fread(head, 1, sizeof head, f), sizeof head);
+	fclose(f);
+	write_bytes("trunc.gltf", head, sizeof head);
+	load_fails("trunc.gltf", AJAR_ERROR_BAD_INPUT, "parse error");
+
+	/* A buffer file that is not there. */
+	write_text("nobin.gltf", "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+		   TRI_BUFFERS("missing.bin") "," TRI_ACCESSORS(3) "}");
+	load_fails("nobin.gltf", AJAR_ERROR_BAD_INPUT, "missing.bin");
+
+	/* Index 7 with 3 vertices. */
+	uint8_t bin[80];
+	const uint16_t idx017[3] = {0, 1, 7};
+	write_bytes("badidx.bin", bin, tri_bin(bin, idx017, 1.0f));
+	write_text("badidx.gltf", "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+		   TRI_BUFFERS("badidx.bin") "," TRI_ACCESSORS(3) "}");
+	load_fails("badidx.gltf", AJAR_ERROR_BAD_INPUT, "meshes[0].primitives[0]: index 7 (at 2) out of range (3 vertices)");
+
+	/* POSITION claims 4 vertices (48 bytes) of a 36-byte view. */
+	write_tri_bin();
+	write_text("pastend.gltf", "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+		   TRI_BUFFERS("tri.bin") "," TRI_ACCESSORS(4) "}");
+	load_fails("pastend.gltf", AJAR_ERROR_BAD_INPUT,
+		   "meshes[0].primitives[0]: accessors[0] (POSITION): needs 48 bytes at offset 0 but bufferViews[0] has 36");
+
+	/* A buffer view past the end of its buffer. */
+	write_text("viewpast.gltf", "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+		   "\"buffers\":[{\"uri\":\"tri.bin\",\"byteLength\":78}],"
+		   "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":60,\"byteLength\":36},"
+		   "{\"buffer\":0,\"byteOffset\":36,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":72,\"byteLength\":6}],"
+		   "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2}]}],"
+		   TRI_ACCESSORS(3) "}");
+	load_fails("viewpast.gltf", AJAR_ERROR_BAD_INPUT, "bufferViews[0]: needs 36 bytes at offset 60 but buffers[0] has 78");
+
+	/* A NaN position. */
+	write_bytes("nan.bin", bin, tri_bin(bin, idx012, NAN));
+	write_text("nan.gltf", "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+		   TRI_BUFFERS("nan.bin") "," TRI_ACCESSORS(3) "}");
+	load_fails("nan.gltf", AJAR_ERROR_BAD_INPUT, "meshes[0].primitives[0]: vertex 1: position is not finite");
+
+	/* Nothing to render: a portal alone. */
+	write_tri_gltf("onlyportal.gltf", "0", "{\"mesh\":0,\"extras\":{\"portal\":true}}", "");
+	load_fails("onlyportal.gltf", AJAR_ERROR_BAD_INPUT, "scenes[0]: no triangles to render (portals do not count)");
+
+	/* A node that is its own grandchild. */
+	write_tri_gltf("cycle.gltf", "0", "{\"mesh\":0,\"children\":[1]},{\"children\":[0]}", "");
+	load_fails("cycle.gltf", AJAR_ERROR_BAD_INPUT, "nodes[0]: reached twice");
+
+	/* An extension we cannot honour. */
+	write_text("draco.gltf", "{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_draco_mesh_compression\"],"
+		   "\"extensionsRequired\":[\"KHR_draco_mesh_compression\"]}");
+	load_fails("draco.gltf", AJAR_ERROR_BAD_INPUT, "extensionsRequired: KHR_draco_mesh_compression");
+
+	/* A missing file is an I/O error. */
+	load_fails("nonexistent.gltf", AJAR_ERROR_IO, "cannot open");
+}
+
+static int setup(void **state)
+{
+	tmpdir = test_tmpdir();
+	return tmpdir ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+	DIR *d = opendir(tmpdir);
+	struct dirent *e;
+	while (d && (e = readdir(d)))
+		if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) {
+			char *p = tmp_path(e->d_name);
+			unlink(p);
+			free(p);
+		}
+	if (d)
+		closedir(d);
+	rmdir(tmpdir);
+	free(tmpdir);
+	return 0;
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_cornell),
+		cmocka_unit_test(test_window_room),
+		cmocka_unit_test(test_living_room),
+		cmocka_unit_test(test_bathroom),
+		cmocka_unit_test(test_api_scene),
+		cmocka_unit_test(test_hierarchy_trs),
+		cmocka_unit_test(test_hierarchy_matrix),
+		cmocka_unit_test(test_no_scenes_all_roots),
+		cmocka_unit_test(test_non_indexed_and_materials),
+		cmocka_unit_test(test_interleaved_strip_fan),
+		cmocka_unit_test(test_sparse),
+		cmocka_unit_test(test_data_uri),
+		cmocka_unit_test(test_glb),
+		cmocka_unit_test(test_portals_and_environment),
+		cmocka_unit_test(test_environment_image),
+		cmocka_unit_test(test_broken_files),
+	};
+	return cmocka_run_group_tests(tests, setup, teardown);
+}
