@@ -1,0 +1,451 @@
+/* test_bsdf.c — kernels/bsdf.h on the host.
+ *
+ * For every material family and several outgoing directions (both sides of
+ * the surface, a tilted normal): a chi-square test of bsdf_sample's
+ * directions against bsdf_eval's pdf_w, integrated numerically over
+ * (cos theta, phi) cells of the sphere as Mitsuba's chi2 test does; pdf_w
+ * integrating to 1 - P(delta); sample and eval agreeing; reciprocity and
+ * the adjoint (importance) relation; Monte Carlo albedo <= 1; exact
+ * Lambertian; delta mirror and smooth glass directions and Fresnel weights;
+ * no NaN at grazing and degenerate directions. */
+#include "testutil.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "../kernels/bsdf.h"
+#include "../kernels/rng.h"
+
+#ifdef __SANITIZE_ADDRESS__
+#define N_CHI2 150000 /* sanitizers are ~10x slower; fewer samples, same cells */
+#else
+#define N_CHI2 600000
+#endif
+#define N_ALBEDO 100000
+#define NZ 30
+#define NPHI 60
+#define SUB 12 /* midpoint sub-cells per cell side for the expected counts */
+#define ALPHA_TOTAL 1e-3
+
+typedef struct {
+	const char *name;
+	float r, g, b, metallic, roughness, transmission, ior, specular;
+} Mat;
+
+static const Mat mats[] = {
+	{"lambert", 0.8f, 0.6f, 0.4f, 0, 1.0f, 0, 1.5f, 0},
+	{"plastic r0.5", 0.5f, 0.7f, 0.2f, 0, 0.5f, 0, 1.5f, 1},
+	{"plastic r0.3 s0.5 ior1.8", 0.9f, 0.2f, 0.2f, 0, 0.3f, 0, 1.8f, 0.5f},
+	{"plastic r1", 0.3f, 0.3f, 0.9f, 0, 1.0f, 0, 1.5f, 1},
+	{"metal r0.4", 0.9f, 0.6f, 0.3f, 1, 0.4f, 0, 1.5f, 1},
+	{"metal r0.8", 0.95f, 0.95f, 0.95f, 1, 0.8f, 0, 1.5f, 1},
+	{"glass r0.4", 1.0f, 0.9f, 0.8f, 0, 0.4f, 1, 1.5f, 1},
+	{"glass r0.7 ior1.33", 1, 1, 1, 0, 0.7f, 1, 1.33f, 1},
+	{"mix", 0.8f, 0.5f, 0.3f, 0.4f, 0.5f, 0.5f, 1.5f, 1},
+	{"diffuse + mirror", 0.7f, 0.7f, 0.7f, 0.5f, 0, 0, 1.5f, 0},
+	{"diffuse + smooth glass", 0.6f, 0.8f, 0.7f, 0, 0, 0.5f, 1.5f, 0},
+};
+#define N_MATS ((int)(sizeof(mats) / sizeof(mats[0])))
+
+/* Outgoing directions as (cos theta, phi) about the shading normal;
+ * negative cos is the back side. */
+static const float wos[][2] = {{0.9f, 0.3f}, {0.5f, 2.0f}, {0.15f, 4.0f}, {-0.6f, 1.0f}};
+#define N_WOS ((int)(sizeof(wos) / sizeof(wos[0])))
+
+static Material material(const Mat *m)
+{
+	Material x;
+	memset(&x, 0, sizeof(x));
+	x.base_color = v3(m->r, m->g, m->b);
+	x.base_tex = -1;
+	x.metallic = m->metallic;
+	x.roughness = m->roughness;
+	x.transmission = m->transmission;
+	x.ior = m->ior;
+	x.specular = m->specular;
+	return x;
+}
+
+/* A tilted normal so the frame code is exercised; ns == ng. */
+static Bsdf make_bsdf(const Material *m)
+{
+	Bsdf bs;
+	V3 n = v3_norm(v3(0.3f, -0.2f, 1.0f));
+	bsdf_setup(&bs, m, m->base_color, n, n);
+	return bs;
+}
+
+static V3 dir(const Bsdf *bs, float z, float phi)
+{
+	float r = sqrt(fmax(0.0f, 1.0f - z * z));
+	return v3_norm(v3_from_local(v3(r * cos(phi), r * sin(phi), z), bs->t, bs->b, bs->n));
+}
+
+static int finite3(V3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
+
+static int cell_of(const Bsdf *bs, V3 w)
+{
+	double z = v3_dot(w, bs->n);
+	double phi = atan2((double)v3_dot(w, bs->b), (double)v3_dot(w, bs->t));
+	if (phi < 0)
+		phi += 2 * M_PI;
+	int iz = (int)floor((z + 1) * 0.5 * NZ), ip = (int)(phi / (2 * M_PI) * NPHI);
+	iz = iz < 0 ? 0 : (iz >= NZ ? NZ - 1 : iz);
+	ip = ip < 0 ? 0 : (ip >= NPHI ? NPHI - 1 : ip);
+	return iz * NPHI + ip;
+}
+
+/* Relative closeness; values below 1e-2 are compared absolutely (float
+ * cancellation in 1 - F near total internal reflection). */
+static int rel_close(float a, float b, float tol) { return fabs(a - b) <= tol * fmax(fmax(fabs(a), fabs(b)), 1e-2f); }
+
+/* One chi-square test; returns its p-value. Also checks that the pdf
+ * integrates to the non-delta probability and that samples agree with eval. */
+static double chi2_one(const Mat *mm, int wo_index, int mode, double alpha_each)
+{
+	static double obs[NZ * NPHI], expct[NZ * NPHI];
+	Material m = material(mm);
+	Bsdf bs = make_bsdf(&m);
+	V3 wo = dir(&bs, wos[wo_index][0], wos[wo_index][1]);
+	memset(obs, 0, sizeof(obs));
+	Rng r = rng_init(1234, (uint)(mm - mats), (uint)wo_index, (uint)mode);
+	int ndelta = 0, nok = 0;
+	for (int i = 0; i < N_CHI2; i++) {
+		BsdfSample s;
+		float u0 = rng_f(&r), u1 = rng_f(&r), u2 = rng_f(&r);
+		if (!bsdf_sample(&bs, wo, u0, u1, u2, mode, &s))
+			continue;
+		if (!finite3(s.f) || !finite3(s.wi) || !(s.pdf_w > 0.0f) || !isfinite(s.pdf_w))
+			fail_msg("%s: bad sample f (%g %g %g) pdf %g", mm->name, s.f.x, s.f.y, s.f.z, s.pdf_w);
+		if (s.delta) {
+			ndelta++;
+			continue;
+		}
+		float pdf, pdf_rev, pdf2, pdf_rev2;
+		V3 f = bsdf_eval(&bs, wo, s.wi, mode, &pdf, &pdf_rev);
+		if (!rel_close(f.x, s.f.x, 1e-5f) || !rel_close(f.y, s.f.y, 1e-5f) || !rel_close(pdf, s.pdf_w, 1e-5f) ||
+		    !rel_close(pdf_rev, s.pdf_rev_w, 1e-5f))
+			fail_msg("%s: sample and eval disagree", mm->name);
+		/* pdf_rev_w(wo, wi) is pdf_w(wi, wo) */
+		bsdf_eval(&bs, s.wi, wo, mode, &pdf2, &pdf_rev2);
+		if (!rel_close(pdf_rev, pdf2, 1e-5f) || !rel_close(pdf_rev2, pdf, 1e-5f))
+			fail_msg("%s: pdf_rev_w %g != reverse pdf_w %g", mm->name, pdf_rev, pdf2);
+		obs[cell_of(&bs, s.wi)] += 1;
+		nok++;
+	}
+	/* Expected counts: midpoint rule on SUB x SUB sub-cells; the solid angle
+	 * element is dz dphi. */
+	double total = 0;
+	for (int iz = 0; iz < NZ; iz++)
+		for (int ip = 0; ip < NPHI; ip++) {
+			double sum = 0, dz = 2.0 / NZ / SUB, dp = 2 * M_PI / NPHI / SUB;
+			for (int a = 0; a < SUB; a++)
+				for (int b = 0; b < SUB; b++) {
+					float z = (float)(-1 + (iz * SUB + a + 0.5) * dz);
+					float phi = (float)((ip * SUB + b + 0.5) * dp);
+					float pdf, pdf_rev;
+					V3 f = bsdf_eval(&bs, wo, dir(&bs, z, phi), mode, &pdf, &pdf_rev);
+					if (!finite3(f) || !isfinite(pdf) || pdf < 0)
+						fail_msg("%s: eval not finite", mm->name);
+					sum += pdf;
+				}
+			expct[iz * NPHI + ip] = sum * dz * dp * N_CHI2;
+			total += sum * dz * dp;
+		}
+	/* The pdf integrates to the probability of non-delta samples: at most
+	 * 1 - P(delta), less by the visible normals whose reflection points
+	 * below the surface (those samples fail). */
+	double p_delta = (double)ndelta / N_CHI2, p_ok = (double)nok / N_CHI2;
+	double sigma = sqrt(p_ok * (1 - p_ok) / N_CHI2) + sqrt(p_delta * (1 - p_delta) / N_CHI2);
+	if (fabs(total - p_ok) > 5 * sigma + 2e-3 || total > 1 - p_delta + 5 * sigma + 2e-3)
+		fail_msg("%s wo %d: pdf integrates to %g; non-delta samples %g, delta %g", mm->name, wo_index, total,
+			 p_ok, p_delta);
+	double p = chi2_test(obs, expct, NZ * NPHI, 5.0);
+	double zero_obs = 0;
+	for (int i = 0; i < NZ * NPHI; i++)
+		if (expct[i] == 0)
+			zero_obs += obs[i];
+	if (zero_obs > 1e-4 * N_CHI2)
+		fail_msg("%s wo %d: %g samples where pdf_w is 0", mm->name, wo_index, zero_obs);
+	if (p < alpha_each) {
+		for (int i = 0; i < NZ * NPHI; i++) /* where it went wrong */
+			if (fabs(obs[i] - expct[i]) > 5 * sqrt(expct[i] + 1))
+				print_message("cell z%d phi%d: observed %g expected %g\n", i / NPHI, i % NPHI, obs[i], expct[i]);
+		fail_msg("%s wo %d mode %d: chi-square p-value %g < %g (pdf total %g)", mm->name, wo_index, mode, p,
+			 alpha_each, total);
+	}
+	return p;
+}
+
+static void test_chi2(void **state)
+{
+	(void)state;
+	int ntests = N_MATS * N_WOS + 2; /* + glass in importance mode */
+	double alpha_each = 1.0 - pow(1.0 - ALPHA_TOTAL, 1.0 / ntests);
+	double pmin = 1;
+	for (int i = 0; i < N_MATS; i++)
+		for (int k = 0; k < N_WOS; k++)
+			pmin = fmin(pmin, chi2_one(&mats[i], k, BSDF_RADIANCE, alpha_each));
+	/* Importance mode changes only f, but the sampling path is shared:
+	 * check it once from each side of the glass. */
+	pmin = fmin(pmin, chi2_one(&mats[6], 1, BSDF_IMPORTANCE, alpha_each));
+	pmin = fmin(pmin, chi2_one(&mats[6], 3, BSDF_IMPORTANCE, alpha_each));
+	print_message("chi2: %d tests, smallest p-value %g (threshold %g)\n", ntests, pmin, alpha_each);
+}
+
+/* Random pairs: f(wo, wi) == f(wi, wo) for reflection, and for every pair
+ * f_radiance(wo, wi) == f_importance(wi, wo) (the adjoint BSDF), and
+ * pdf_rev_w(wo, wi) == pdf_w(wi, wo). */
+static void test_reciprocity(void **state)
+{
+	(void)state;
+	Rng r = rng_init(99, 0, 0, 0);
+	for (int i = 0; i < N_MATS; i++) {
+		Material m = material(&mats[i]);
+		Bsdf bs = make_bsdf(&m);
+		int nonzero = 0;
+		for (int k = 0; k < 20000; k++) {
+			V3 wo = sample_uniform_sphere(rng_f(&r), rng_f(&r));
+			V3 wi = sample_uniform_sphere(rng_f(&r), rng_f(&r));
+			float p1, r1, p2, r2, p3, r3;
+			V3 f1 = bsdf_eval(&bs, wo, wi, BSDF_RADIANCE, &p1, &r1);
+			V3 f2 = bsdf_eval(&bs, wi, wo, BSDF_RADIANCE, &p2, &r2);
+			V3 f3 = bsdf_eval(&bs, wi, wo, BSDF_IMPORTANCE, &p3, &r3);
+			nonzero += !v3_is_zero(f1);
+			int same_side = v3_dot(wo, bs.ng) * v3_dot(wi, bs.ng) > 0;
+			/* Dielectric Fresnel near the critical angle is a steep sqrt:
+			 * float rounding of the cosines alone reaches ~1e-3 there. */
+			float tol = mats[i].transmission > 0 ? 2e-3f : 1e-4f;
+			if (!rel_close(f1.x, f3.x, tol) || !rel_close(f1.y, f3.y, tol))
+				fail_msg("%s: f_radiance(wo,wi) %g != f_importance(wi,wo) %g", mats[i].name, f1.x, f3.x);
+			if (same_side && (!rel_close(f1.x, f2.x, tol) || !rel_close(f1.z, f2.z, tol)))
+				fail_msg("%s: f not reciprocal: %g vs %g", mats[i].name, f1.x, f2.x);
+			if (!rel_close(r1, p2, 1e-5f) || !rel_close(p1, r2, 1e-5f))
+				fail_msg("%s: pdf_rev_w mismatch", mats[i].name);
+			if (p1 < 0 || !isfinite(p1) || !finite3(f1))
+				fail_msg("%s: bad eval", mats[i].name);
+		}
+		assert_true(nonzero > 1000);
+	}
+}
+
+/* Monte Carlo albedo of f |cos_i| / pdf per channel, delta samples included.
+ * Importance mode is the energy-conservation integral for every BSDF (the
+ * radiance mode of glass from the inside is scaled by eta^2 on purpose). */
+static V3 albedo(const Bsdf *bs, V3 wo, int mode, uint seed, V3 *sigma)
+{
+	Rng r = rng_init(seed, 0, 0, 0);
+	double s[3] = {0}, s2[3] = {0};
+	for (int i = 0; i < N_ALBEDO; i++) {
+		BsdfSample x;
+		float u0 = rng_f(&r), u1 = rng_f(&r), u2 = rng_f(&r);
+		if (!bsdf_sample(bs, wo, u0, u1, u2, mode, &x))
+			continue;
+		V3 w = v3_scale(x.f, fabs(v3_dot(x.wi, bs->n)) / x.pdf_w);
+		assert_true(finite3(w));
+		for (int c = 0; c < 3; c++) {
+			s[c] += v3_comp(w, c);
+			s2[c] += v3_comp(w, c) * v3_comp(w, c);
+		}
+	}
+	V3 mean, sd;
+	float *pm = &mean.x, *ps = &sd.x;
+	for (int c = 0; c < 3; c++) {
+		double mu = s[c] / N_ALBEDO;
+		pm[c] = (float)mu;
+		ps[c] = (float)sqrt(fmax(s2[c] / N_ALBEDO - mu * mu, 0) / N_ALBEDO);
+	}
+	*sigma = sd;
+	return mean;
+}
+
+static void test_energy(void **state)
+{
+	(void)state;
+	const float cos_list[] = {1.0f, 0.7f, 0.3f, 0.05f, -0.4f, -0.02f};
+	for (int i = 0; i < N_MATS; i++) {
+		Material m = material(&mats[i]);
+		Bsdf bs = make_bsdf(&m);
+		for (int k = 0; k < (int)(sizeof(cos_list) / sizeof(cos_list[0])); k++) {
+			V3 wo = dir(&bs, cos_list[k], 0.7f);
+			V3 sd, a = albedo(&bs, wo, BSDF_IMPORTANCE, (uint)(i * 16 + k), &sd);
+			if (v3_maxc(v3_sub(a, v3_scale(sd, 5.0f))) > 1.0f + 1e-3f)
+				fail_msg("%s cos %g: albedo (%g %g %g) > 1", mats[i].name, cos_list[k], a.x, a.y, a.z);
+			if (i == 0) /* Lambertian: exactly the base colour */
+				for (int c = 0; c < 3; c++)
+					assert_float_equal(v3_comp(a, c), v3_comp(bs.base_color, c),
+							   5 * v3_comp(sd, c) + 1e-4);
+		}
+	}
+	/* Lambertian f and pdf are exact. */
+	Material m = material(&mats[0]);
+	Bsdf bs = make_bsdf(&m);
+	V3 wo = dir(&bs, 0.8f, 1.0f), wi = dir(&bs, 0.3f, 4.0f);
+	float pdf, pdf_rev;
+	V3 f = bsdf_eval(&bs, wo, wi, BSDF_RADIANCE, &pdf, &pdf_rev);
+	assert_float_equal(f.x, 0.8f / M_PI, 1e-6);
+	assert_float_equal(f.z, 0.4f / M_PI, 1e-6);
+	assert_float_equal(pdf, 0.3f / M_PI, 1e-6);
+	assert_float_equal(pdf_rev, 0.8f / M_PI, 1e-6);
+	/* Glass from outside in radiance mode is 1/eta^2 of importance mode. */
+	m = material(&mats[6]);
+	bs = make_bsdf(&m);
+	wo = dir(&bs, 0.8f, 1.0f);
+	wi = dir(&bs, -0.7f, 1.0f + (float)M_PI);
+	V3 fr = bsdf_eval(&bs, wo, wi, BSDF_RADIANCE, &pdf, &pdf_rev);
+	V3 fi = bsdf_eval(&bs, wo, wi, BSDF_IMPORTANCE, &pdf, &pdf_rev);
+	assert_true(fi.x > 0.0f);
+	assert_float_equal(fr.x * 1.5f * 1.5f, fi.x, 1e-5 * fi.x);
+}
+
+/* Perfect mirror: the reflected direction, weight Schlick(base, cos). */
+static void test_mirror(void **state)
+{
+	(void)state;
+	Mat mm = {"mirror", 0.9f, 0.5f, 0.2f, 1, 0, 0, 1.5f, 1};
+	Material m = material(&mm);
+	Bsdf bs = make_bsdf(&m);
+	assert_true(bsdf_is_delta(&bs) && bsdf_has_delta(&bs));
+	for (int k = 0; k < 4; k++) {
+		float c = k < 3 ? wos[k][0] : -0.3f;
+		V3 wo = dir(&bs, c, 1.0f);
+		BsdfSample s;
+		assert_true(bsdf_sample(&bs, wo, 0.5f, 0.3f, 0.6f, BSDF_RADIANCE, &s));
+		assert_true(s.delta);
+		V3 want = v3_sub(v3_scale(bs.n, 2 * v3_dot(wo, bs.n)), wo);
+		assert_float_equal(v3_len(v3_sub(s.wi, want)), 0, 1e-5);
+		float w = bsdf_schlick_w(fabs(c));
+		V3 thr = v3_scale(s.f, fabs(v3_dot(s.wi, bs.n)) / s.pdf_w);
+		assert_float_equal(thr.x, 0.9f + 0.1f * w, 1e-5);
+		assert_float_equal(thr.z, 0.2f + 0.8f * w, 1e-5);
+		assert_float_equal(s.pdf_w, 1.0f, 1e-6);
+		assert_float_equal(s.pdf_rev_w, 1.0f, 1e-6);
+		float pdf, pdf_rev;
+		assert_true(v3_is_zero(bsdf_eval(&bs, wo, s.wi, BSDF_RADIANCE, &pdf, &pdf_rev)));
+		assert_true(pdf == 0.0f && pdf_rev == 0.0f);
+	}
+	/* A rough surface and a plastic are not delta; a mix is partly. */
+	Mat rough = mm, mix = mm;
+	rough.roughness = 0.5f;
+	mix.metallic = 0.5f;
+	m = material(&rough);
+	bs = make_bsdf(&m);
+	assert_false(bsdf_is_delta(&bs) || bsdf_has_delta(&bs));
+	m = material(&mix);
+	bs = make_bsdf(&m);
+	assert_false(bsdf_is_delta(&bs));
+	assert_true(bsdf_has_delta(&bs));
+}
+
+/* Smooth glass: reflection with probability F, refraction by Snell's law,
+ * weights 1 and tint (/ eta^2 in radiance mode), total internal reflection. */
+static void test_smooth_glass(void **state)
+{
+	(void)state;
+	Mat mm = {"glass", 1.0f, 0.8f, 0.6f, 0, 0, 1, 1.5f, 1};
+	Material m = material(&mm);
+	Bsdf bs = make_bsdf(&m);
+	assert_true(bsdf_is_delta(&bs) && bsdf_has_delta(&bs));
+	const float cs[] = {1.0f, 0.7f, 0.2f, -0.9f, -0.8f, -0.5f};
+	for (int k = 0; k < 6; k++) {
+		float c = cs[k];
+		float eta = c > 0 ? 1.5f : 1 / 1.5f; /* eta_t / eta_i */
+		double fresnel = bsdf_fresnel_dielectric(fabs(c), eta);
+		V3 wo = dir(&bs, c, 2.0f);
+		int n = 20000, nrefl = 0;
+		Rng r = rng_init(5, (uint)k, 0, 0);
+		for (int i = 0; i < n; i++) {
+			BsdfSample s;
+			int mode = i & 1 ? BSDF_RADIANCE : BSDF_IMPORTANCE;
+			float u0 = rng_f(&r), u1 = rng_f(&r), u2 = rng_f(&r);
+			if (!bsdf_sample(&bs, wo, u0, u1, u2, mode, &s))
+				fail_msg("glass: no sample");
+			assert_true(s.delta);
+			float ci = v3_dot(s.wi, bs.n);
+			V3 thr = v3_scale(s.f, fabs(ci) / s.pdf_w);
+			if (ci * c > 0) {
+				nrefl++;
+				V3 want = v3_sub(v3_scale(bs.n, 2 * v3_dot(wo, bs.n)), wo);
+				assert_float_equal(v3_len(v3_sub(s.wi, want)), 0, 1e-5);
+				assert_float_equal(thr.x, 1, 1e-5);
+				assert_float_equal(thr.z, 1, 1e-5);
+				assert_float_equal(s.pdf_w, fresnel, 1e-5);
+			} else {
+				/* Snell: eta_i sin_i = eta_t sin_t; coplanar, opposite side */
+				float so = sqrt(1 - c * c), si = sqrt(fmax(0.0f, 1 - ci * ci));
+				assert_float_equal(so, eta * si, 1e-4);
+				assert_float_equal(v3_dot(v3_cross(wo, s.wi), bs.n), 0, 1e-5);
+				assert_true(v3_dot(s.wi, v3_sub(wo, v3_scale(bs.n, v3_dot(wo, bs.n)))) <= 1e-6f);
+				float scale = mode == BSDF_RADIANCE ? 1 / (eta * eta) : 1;
+				assert_float_equal(thr.y, 0.8f * scale, 1e-5);
+				assert_float_equal(s.pdf_w, 1 - fresnel, 1e-5);
+				/* Fresnel transmittance is the same seen from wi's side */
+				assert_float_equal(s.pdf_rev_w, s.pdf_w, 1e-5);
+			}
+		}
+		double sd = sqrt(fresnel * (1 - fresnel) / n);
+		if (fabs((double)nrefl / n - fresnel) > 5 * sd + 1e-9)
+			fail_msg("glass cos %g: reflected fraction %g, Fresnel %g", c, (double)nrefl / n, fresnel);
+	}
+	/* At normal incidence F = ((1.5 - 1) / (1.5 + 1))^2 = 0.04; from inside
+	 * beyond the critical angle (sin > 1/1.5) F = 1. */
+	assert_float_equal(bsdf_fresnel_dielectric(1.0f, 1.5f), 0.04f, 1e-6);
+	assert_float_equal(bsdf_fresnel_dielectric(0.5f, 1 / 1.5f), 1.0f, 0);
+}
+
+/* Degenerate inputs: grazing, in-plane, opposite and zero directions, flipped
+ * or zero shading normals, extreme random numbers. Nothing may be NaN. */
+static void test_no_nan(void **state)
+{
+	(void)state;
+	const V3 dirs[] = {v3(0, 0, 1),         v3(0, 0, -1),         v3(1, 0, 0),
+			   v3(1, 0, 1e-8f),     v3(1, 0, -1e-8f),     v3_norm(v3(1, 1, 1e-4f)),
+			   v3(0, 0, 0),         v3_norm(v3(-1, 0, 1e-3f)), v3_norm(v3(0.3f, 0.2f, -1))};
+	const float us[] = {0.0f, 0.5f, 0.99999994f, 1e-7f};
+	const int nd = (int)(sizeof(dirs) / sizeof(dirs[0]));
+	const V3 normals[][2] = {{v3(0, 0, 1), v3(0, 0, 1)},
+				 {v3_norm(v3(0.5f, 0, 1)), v3(0, 0, 1)},
+				 {v3(0, 0, -1), v3(0, 0, 1)},
+				 {v3(0, 0, 0), v3(0, 0, 1)},
+				 {v3(1, 0, 0), v3(0, 0, 1)}};
+	Mat extra[] = {{"tiny", 0.5f, 0.5f, 0.5f, 0.3f, 0.01f, 0.3f, 1.0f, 1},
+		       {"ior big", 0.5f, 0.5f, 0.5f, 0, 0.2f, 1, 10.0f, 1},
+		       {"black", 0, 0, 0, 0, 0.5f, 0, 1.5f, 1},
+		       {"black lambert", 0, 0, 0, 0, 0.5f, 0, 1.5f, 0}};
+	for (int mi = 0; mi < N_MATS + 4; mi++) {
+		const Mat *mm = mi < N_MATS ? &mats[mi] : &extra[mi - N_MATS];
+		Material m = material(mm);
+		for (int ni = 0; ni < 5; ni++) {
+			Bsdf bs;
+			bsdf_setup(&bs, &m, m.base_color, normals[ni][0], normals[ni][1]);
+			for (int a = 0; a < nd; a++)
+				for (int b = 0; b < nd; b++) {
+					float pdf, pdf_rev;
+					V3 f = bsdf_eval(&bs, dirs[a], dirs[b], BSDF_RADIANCE, &pdf, &pdf_rev);
+					if (!finite3(f) || !isfinite(pdf) || !isfinite(pdf_rev) || pdf < 0 || pdf_rev < 0)
+						fail_msg("%s: eval NaN (normal %d, dirs %d %d)", mm->name, ni, a, b);
+				}
+			for (int a = 0; a < nd; a++)
+				for (int i = 0; i < 4; i++)
+					for (int j = 0; j < 4; j++)
+						for (int k = 0; k < 4; k++) {
+							BsdfSample s;
+							if (!bsdf_sample(&bs, dirs[a], us[i], us[j], us[k], BSDF_RADIANCE, &s))
+								continue;
+							if (!finite3(s.f) || !finite3(s.wi) || !(s.pdf_w > 0) || !isfinite(s.pdf_w) ||
+							    !isfinite(s.pdf_rev_w))
+								fail_msg("%s: sample NaN (normal %d, dir %d)", mm->name, ni, a);
+						}
+		}
+	}
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_chi2),   cmocka_unit_test(test_reciprocity),  cmocka_unit_test(test_energy),
+		cmocka_unit_test(test_mirror), cmocka_unit_test(test_smooth_glass), cmocka_unit_test(test_no_nan),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,297 @@
+/* test_sampling.c — kernels/sampling.h and kernels/rng.h on the host.
+ *
+ * Every warp is histogrammed and compared with its density by a chi-square
+ * test (cells whose exact probability is known in closed form); sample_cdf
+ * against its discrete probabilities, zero-width buckets included; the RNG
+ * for determinism, range, uniformity and decorrelation of neighbours. */
+#include "testutil.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../kernels/rng.h"
+#include "../kernels/sampling.h"
+
+#define N_SAMPLES 1000000
+#define N_TESTS 10 /* chi-square tests in this file, for the Sidak correction */
+#define ALPHA_TOTAL 1e-3
+
+static double alpha_each(void) { return 1.0 - pow(1.0 - ALPHA_TOTAL, 1.0 / N_TESTS); }
+
+static void check_chi2(const char *what, const double *obs, const double *expct, int n)
+{
+	double p = chi2_test(obs, expct, n, 5.0);
+	if (p < alpha_each())
+		fail_msg("%s: chi-square p-value %g below %g", what, p, alpha_each());
+	/* chi2_test pools cells of small expectation; samples where the
+	 * density is exactly zero must not occur at all. */
+	for (int i = 0; i < n; i++)
+		if (expct[i] == 0.0 && obs[i] > 0.0)
+			fail_msg("%s: %g samples in cell %d of zero probability", what, obs[i], i);
+}
+
+/* Histogram of directions over (cos theta in [zmin, 1], phi) cells. */
+#define NZ 30
+#define NPHI 60
+static int dir_cell(V3 w, float zmin)
+{
+	int iz = (int)floor((w.z - zmin) / (1.0f - zmin) * NZ);
+	double phi = atan2((double)w.y, (double)w.x);
+	if (phi < 0)
+		phi += 2 * M_PI;
+	int ip = (int)(phi / (2 * M_PI) * NPHI);
+	iz = iz < 0 ? 0 : (iz >= NZ ? NZ - 1 : iz);
+	ip = ip < 0 ? 0 : (ip >= NPHI ? NPHI - 1 : ip);
+	return iz * NPHI + ip;
+}
+
+static void test_cosine_hemisphere(void **state)
+{
+	(void)state;
+	static double obs[NZ * NPHI], expct[NZ * NPHI];
+	memset(obs, 0, sizeof(obs));
+	Rng r = rng_init(1, 2, 3, 4);
+	for (int i = 0; i < N_SAMPLES; i++) {
+		V3 w = sample_cosine_hemisphere(rng_f(&r), rng_f(&r));
+		assert_true(fabs(v3_len(w) - 1.0f) < 1e-5f && w.z >= 0.0f);
+		obs[dir_cell(w, 0.0f)] += 1;
+	}
+	/* integral of cos / pi over a (z, phi) cell = (z1^2 - z0^2) / 2 * dphi / pi */
+	for (int iz = 0; iz < NZ; iz++)
+		for (int ip = 0; ip < NPHI; ip++) {
+			double z0 = (double)iz / NZ, z1 = (double)(iz + 1) / NZ;
+			expct[iz * NPHI + ip] = N_SAMPLES * (z1 * z1 - z0 * z0) / 2 * (2 * M_PI / NPHI) / M_PI;
+		}
+	check_chi2("cosine hemisphere", obs, expct, NZ * NPHI);
+	assert_float_equal(pdf_cosine_hemisphere_w(0.5f), 0.5f / M_PI, 1e-7);
+	assert_float_equal(pdf_cosine_hemisphere_w(-0.5f), 0.0f, 0.0);
+}
+
+/* Uniform sphere and cone: constant density over z in [zmin, 1]. */
+static void check_uniform_cap(const char *what, float zmin, int cone)
+{
+	static double obs[NZ * NPHI], expct[NZ * NPHI];
+	memset(obs, 0, sizeof(obs));
+	Rng r = rng_init(7, (uint)(zmin * 1000.0f + 1000.0f), 0, 1);
+	for (int i = 0; i < N_SAMPLES; i++) {
+		float u1 = rng_f(&r), u2 = rng_f(&r);
+		V3 w = cone ? sample_uniform_cone(u1, u2, zmin) : sample_uniform_sphere(u1, u2);
+		assert_true(fabs(v3_len(w) - 1.0f) < 1e-5f && w.z >= zmin - 1e-6f);
+		obs[dir_cell(w, zmin)] += 1;
+	}
+	for (int i = 0; i < NZ * NPHI; i++)
+		expct[i] = (double)N_SAMPLES / (NZ * NPHI);
+	check_chi2(what, obs, expct, NZ * NPHI);
+	double pdf = cone ? pdf_uniform_cone_w(zmin) : pdf_uniform_sphere_w();
+	assert_float_equal(pdf * 2 * M_PI * (1 - zmin), 1.0, 1e-5);
+}
+
+static void test_uniform_sphere(void **state)
+{
+	(void)state;
+	check_uniform_cap("uniform sphere", -1.0f, 0);
+}
+
+static void test_uniform_cone(void **state)
+{
+	(void)state;
+	check_uniform_cap("uniform cone 0.3", 0.3f, 1);
+	check_uniform_cap("uniform cone 0.99", 0.99f, 1);
+	assert_float_equal(pdf_uniform_cone_w(1.0f), 0.0f, 0.0);
+}
+
+/* Square cells of [-1, 1]^2; expected from the disk's area in each cell. */
+#define ND 40
+static void test_concentric_disk(void **state)
+{
+	(void)state;
+	static double obs[ND * ND], expct[ND * ND];
+	memset(obs, 0, sizeof(obs));
+	Rng r = rng_init(11, 0, 0, 0);
+	for (int i = 0; i < N_SAMPLES; i++) {
+		float x, y;
+		sample_concentric_disk(rng_f(&r), rng_f(&r), &x, &y);
+		assert_true(x * x + y * y <= 1.0f + 1e-6f);
+		int ix = (int)((x + 1.0f) * 0.5f * ND), iy = (int)((y + 1.0f) * 0.5f * ND);
+		ix = ix >= ND ? ND - 1 : ix;
+		iy = iy >= ND ? ND - 1 : iy;
+		obs[iy * ND + ix] += 1;
+	}
+	/* Area of the disk in each cell by a fine midpoint grid. */
+	const int sub = 64;
+	for (int iy = 0; iy < ND; iy++)
+		for (int ix = 0; ix < ND; ix++) {
+			int in = 0;
+			for (int j = 0; j < sub; j++)
+				for (int k = 0; k < sub; k++) {
+					double x = -1 + 2.0 * (ix + (k + 0.5) / sub) / ND;
+					double y = -1 + 2.0 * (iy + (j + 0.5) / sub) / ND;
+					in += x * x + y * y < 1;
+				}
+			double area = (2.0 / ND) * (2.0 / ND) * in / (sub * sub);
+			expct[iy * ND + ix] = N_SAMPLES * area / M_PI;
+		}
+	/* Cells cut by the circle have only approximate expectations; the
+	 * midpoint grid is accurate to ~1e-4 of a cell, well inside the noise. */
+	double p = chi2_test(obs, expct, ND * ND, 5.0);
+	if (p < alpha_each())
+		fail_msg("concentric disk: chi-square p-value %g", p);
+	float x, y;
+	sample_concentric_disk(0.5f, 0.5f, &x, &y);
+	assert_true(x == 0.0f && y == 0.0f);
+}
+
+/* Barycentrics on a square grid over [0, 1]^2: the diagonal b1 + b2 = 1
+ * passes through cell corners, so cells are whole, half or empty. */
+#define NT 40
+static void test_triangle(void **state)
+{
+	(void)state;
+	static double obs[NT * NT], expct[NT * NT];
+	memset(obs, 0, sizeof(obs));
+	Rng r = rng_init(13, 0, 0, 0);
+	for (int i = 0; i < N_SAMPLES; i++) {
+		float b1, b2;
+		sample_triangle(rng_f(&r), rng_f(&r), &b1, &b2);
+		assert_true(b1 >= 0.0f && b2 >= 0.0f && b1 + b2 <= 1.0f + 1e-6f);
+		int i1 = (int)(b1 * NT), i2 = (int)(b2 * NT);
+		i1 = i1 >= NT ? NT - 1 : i1;
+		i2 = i2 >= NT ? NT - 1 : i2;
+		obs[i2 * NT + i1] += 1;
+	}
+	double cell = 2.0 / (NT * NT); /* probability of a whole cell (density 2) */
+	for (int i2 = 0; i2 < NT; i2++)
+		for (int i1 = 0; i1 < NT; i1++)
+			expct[i2 * NT + i1] = N_SAMPLES * (i1 + i2 < NT - 1 ? cell : (i1 + i2 == NT - 1 ? cell / 2 : 0));
+	check_chi2("triangle", obs, expct, NT * NT);
+}
+
+static void test_cdf(void **state)
+{
+	(void)state;
+	/* Zero-width buckets first, inside, and last. */
+	const float w[] = {0, 1, 3, 0, 0, 2, 0.5f, 0};
+	const int n = (int)(sizeof(w) / sizeof(w[0]));
+	float cdf[sizeof(w) / sizeof(w[0]) + 1];
+	double sum = 0;
+	for (int i = 0; i < n; i++)
+		sum += w[i];
+	double acc = 0;
+	cdf[0] = 0;
+	for (int i = 0; i < n; i++) {
+		acc += w[i];
+		cdf[i + 1] = (float)(acc / sum);
+	}
+	cdf[n] = 1;
+	double obs[sizeof(w) / sizeof(w[0])] = {0}, expct[sizeof(w) / sizeof(w[0])];
+	enum { NR = 20 };
+	double remap[NR] = {0}, remap_exp[NR];
+	Rng r = rng_init(17, 0, 0, 0);
+	for (int s = 0; s < N_SAMPLES; s++) {
+		float pdf, ur, u = rng_f(&r);
+		int i = sample_cdf(cdf, n, u, &pdf, &ur);
+		assert_true(i >= 0 && i < n);
+		assert_true(w[i] > 0);
+		assert_float_equal(pdf, w[i] / sum, 1e-6);
+		assert_true(ur >= 0.0f && ur < 1.0f);
+		obs[i] += 1;
+		if (i == 2)
+			remap[(int)(ur * NR)] += 1;
+	}
+	for (int i = 0; i < n; i++)
+		expct[i] = N_SAMPLES * w[i] / sum;
+	check_chi2("sample_cdf buckets", obs, expct, n);
+	for (int i = 0; i < NR; i++)
+		remap_exp[i] = obs[2] / NR;
+	check_chi2("sample_cdf u_remap", remap, remap_exp, NR);
+
+	/* The ends: u = 0 skips the leading empty bucket, u just below 1 (and
+	 * u = 1) stay out of the trailing one. */
+	float pdf, ur;
+	assert_int_equal(sample_cdf(cdf, n, 0.0f, &pdf, &ur), 1);
+	assert_float_equal(ur, 0.0f, 0.0);
+	assert_int_equal(sample_cdf(cdf, n, 0.99999994f, &pdf, &ur), 6);
+	assert_int_equal(sample_cdf(cdf, n, 1.0f, &pdf, &ur), 6);
+	assert_true(ur < 1.0f);
+	/* Exactly on an interior boundary: the bucket that starts there. */
+	assert_int_equal(sample_cdf(cdf, n, cdf[5], &pdf, &ur), 5);
+	/* An empty table gives no bucket. */
+	const float empty[3] = {0, 0, 0};
+	assert_int_equal(sample_cdf(empty, 2, 0.5f, &pdf, &ur), -1);
+	assert_float_equal(pdf, 0.0f, 0.0);
+	/* One bucket. */
+	const float one[2] = {0, 1};
+	assert_int_equal(sample_cdf(one, 1, 0.25f, &pdf, &ur), 0);
+	assert_float_equal(pdf, 1.0f, 0.0);
+	assert_float_equal(ur, 0.25f, 0.0);
+}
+
+static void test_rng_deterministic(void **state)
+{
+	(void)state;
+	Rng a = rng_init(42, 1000, 7, 2), b = rng_init(42, 1000, 7, 2);
+	for (int i = 0; i < 1000; i++)
+		assert_int_equal(rng_u32(&a), rng_u32(&b));
+	/* Any one input changed gives another sequence. */
+	const uint in[5][4] = {{43, 1000, 7, 2}, {42, 1001, 7, 2}, {42, 1000, 8, 2}, {42, 1000, 7, 3}, {0, 0, 0, 0}};
+	for (int k = 0; k < 5; k++) {
+		Rng x = rng_init(42, 1000, 7, 2), y = rng_init(in[k][0], in[k][1], in[k][2], in[k][3]);
+		int same = 0;
+		for (int i = 0; i < 64; i++)
+			same += rng_u32(&x) == rng_u32(&y);
+		assert_true(same < 4);
+	}
+	/* Pinned values: renders are repeatable across versions only if the
+	 * stream never changes (PoCL gave these same bits when written). */
+	Rng z = rng_init(0, 0, 0, 0);
+	assert_int_equal(rng_u32(&z), 758717757u);
+	assert_int_equal(rng_u32(&z), 2854040001u);
+	Rng q = rng_init(42, 1000, 7, 2);
+	assert_int_equal(rng_u32(&q), 1420759174u);
+	assert_int_equal(rng_u32(&q), 3694288159u);
+}
+
+static void test_rng_uniform(void **state)
+{
+	(void)state;
+	enum { NB = 100 };
+	double obs[NB] = {0}, expct[NB];
+	Rng r = rng_init(5, 6, 7, 8);
+	for (int i = 0; i < N_SAMPLES; i++) {
+		float u = rng_f(&r);
+		assert_true(u >= 0.0f && u < 1.0f);
+		obs[(int)(u * NB)] += 1;
+	}
+	for (int i = 0; i < NB; i++)
+		expct[i] = (double)N_SAMPLES / NB;
+	check_chi2("rng_f uniform", obs, expct, NB);
+
+	/* Neighbouring pixels (and samples) must be independent: the pair of
+	 * first numbers of pixel p and p + 1 is uniform on the square. */
+	enum { NP = 32 };
+	static double pair[NP * NP], pair_exp[NP * NP];
+	memset(pair, 0, sizeof(pair));
+	const int npairs = N_SAMPLES / 4;
+	for (int p = 0; p < npairs; p++) {
+		Rng a = rng_init(9, (uint)p, 0, 0), b = rng_init(9, (uint)p + 1, 0, 0);
+		Rng c = rng_init(9, (uint)p, 1, 0);
+		float ua = rng_f(&a), ub = rng_f(&b), uc = rng_f(&c);
+		pair[(int)(ua * NP) * NP + (int)(ub * NP)] += 1;
+		pair[(int)(ua * NP) * NP + (int)(uc * NP)] += 1;
+	}
+	for (int i = 0; i < NP * NP; i++)
+		pair_exp[i] = 2.0 * npairs / (NP * NP);
+	check_chi2("rng neighbours", pair, pair_exp, NP * NP);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_cosine_hemisphere), cmocka_unit_test(test_uniform_sphere),
+		cmocka_unit_test(test_uniform_cone),      cmocka_unit_test(test_concentric_disk),
+		cmocka_unit_test(test_triangle),          cmocka_unit_test(test_cdf),
+		cmocka_unit_test(test_rng_deterministic), cmocka_unit_test(test_rng_uniform),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
