@@ -1,0 +1,185 @@
+/* args.c — hand-written parsing of `ajar render`'s options: each option
+ * takes its value as the next argument or after '=' (`--spp 16`,
+ * `--spp=16`), numbers are checked whole (no sign, no trailing text, in
+ * range) and every error names the option it is about. */
+#include "args.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Largest image side we accept; far beyond any sensible render, small
+ * enough that width * height * 16 bytes cannot overflow anywhere. */
+#define MAX_SIDE 65536u
+
+int args_usage_error(const char *fmt, ...)
+{
+	va_list ap;
+	fputs("ajar: error: ", stderr);
+	va_start(ap, fmt);
+	vfprintf(stderr, fmt, ap);
+	va_end(ap);
+	fputs(" (see 'ajar --help')\n", stderr);
+	return EXIT_USAGE;
+}
+
+const char *args_integrator_name(ajar_integrator i)
+{
+	switch (i) {
+	case AJAR_INTEGRATOR_PT: return "pt";
+	case AJAR_INTEGRATOR_BDPT: return "bdpt";
+	case AJAR_INTEGRATOR_PORTAL: return "portal";
+	}
+	return "?";
+}
+
+/* A decimal integer in [min, max], digits only. */
+static int parse_u32(const char *opt, const char *s, uint32_t min, uint32_t max, uint32_t *out)
+{
+	if (!isdigit((unsigned char)s[0]))
+		return args_usage_error("%s: '%s' is not a whole number >= %u", opt, s, min);
+	errno = 0;
+	char *end;
+	unsigned long long v = strtoull(s, &end, 10);
+	if (*end != '\0')
+		return args_usage_error("%s: '%s' is not a whole number >= %u", opt, s, min);
+	if (errno == ERANGE || v < min || v > max)
+		return args_usage_error("%s: %s is out of range (%u to %u)", opt, s, min, max);
+	*out = (uint32_t)v;
+	return EXIT_OK;
+}
+
+static int parse_seconds(const char *opt, const char *s, double *out)
+{
+	char *end;
+	errno = 0;
+	double v = strtod(s, &end);
+	if (end == s || *end != '\0' || errno == ERANGE || !isfinite(v) || !(v > 0) || isspace((unsigned char)s[0]))
+		return args_usage_error("%s: '%s' is not a positive number of seconds", opt, s);
+	*out = v;
+	return EXIT_OK;
+}
+
+/* WxH, both sides positive. */
+static int parse_size(const char *opt, const char *s, uint32_t *w, uint32_t *h)
+{
+	const char *x = strpbrk(s, "xX");
+	char ws[32];
+	if (!x || (size_t)(x - s) >= sizeof ws || x == s)
+		return args_usage_error("%s: '%s' is not WIDTHxHEIGHT (e.g. 640x480)", opt, s);
+	memcpy(ws, s, (size_t)(x - s));
+	ws[x - s] = '\0';
+	if (!isdigit((unsigned char)ws[0]) || !isdigit((unsigned char)x[1]))
+		return args_usage_error("%s: '%s' is not WIDTHxHEIGHT (e.g. 640x480)", opt, s);
+	if (parse_u32(opt, ws, 1, MAX_SIDE, w) != EXIT_OK || parse_u32(opt, x + 1, 1, MAX_SIDE, h) != EXIT_OK)
+		return EXIT_USAGE;
+	return EXIT_OK;
+}
+
+static int parse_integrator(const char *opt, const char *s, ajar_integrator *out)
+{
+	static const ajar_integrator all[] = {AJAR_INTEGRATOR_PT, AJAR_INTEGRATOR_BDPT, AJAR_INTEGRATOR_PORTAL};
+	for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
+		if (strcmp(s, args_integrator_name(all[i])) == 0) {
+			*out = all[i];
+			return EXIT_OK;
+		}
+	return args_usage_error("%s: '%s' is not one of pt, bdpt, portal", opt, s);
+}
+
+int args_parse_render(int argc, char **argv, RenderArgs *a)
+{
+	memset(a, 0, sizeof *a);
+	ajar_options_default(&a->opt);
+	int spp_given = 0, time_given = 0;
+	for (int i = 0; i < argc; i++) {
+		const char *arg = argv[i];
+		if (arg[0] != '-' || arg[1] == '\0') { /* "-" alone is a (strange) file name */
+			if (a->scene)
+				return args_usage_error("more than one scene given ('%s' and '%s')", a->scene, arg);
+			a->scene = arg;
+			continue;
+		}
+		if (!strcmp(arg, "--")) {
+			if (i + 2 != argc || a->scene)
+				return args_usage_error("'--' must be followed by exactly one scene");
+			a->scene = argv[++i];
+			continue;
+		}
+		if (!strcmp(arg, "-h") || !strcmp(arg, "--help")) {
+			a->help = 1;
+			return EXIT_OK;
+		}
+		if (!strcmp(arg, "-q") || !strcmp(arg, "--quiet")) {
+			a->quiet = 1;
+			continue;
+		}
+		/* Every other option takes a value: "--opt value" or "--opt=value". */
+		char name[32];
+		const char *val, *eq = strchr(arg, '=');
+		if (eq && arg[1] == '-') {
+			size_t n = (size_t)(eq - arg);
+			if (n >= sizeof name)
+				return args_usage_error("unknown option '%.*s'", (int)n, arg);
+			memcpy(name, arg, n);
+			name[n] = '\0';
+			val = eq + 1;
+		} else {
+			snprintf(name, sizeof name, "%s", arg);
+			val = NULL;
+		}
+		static const char *const known[] = {"-o", "--output", "--spp", "--time", "--size", "--integrator",
+						    "--max-depth", "--seed", "--device", "--png"};
+		size_t k = 0;
+		while (k < sizeof known / sizeof known[0] && strcmp(name, known[k]) != 0)
+			k++;
+		if (k == sizeof known / sizeof known[0])
+			return args_usage_error("unknown option '%s'", eq ? name : arg);
+		if (!val) {
+			if (i + 1 >= argc)
+				return args_usage_error("%s needs a value", name);
+			val = argv[++i];
+		}
+		if (val[0] == '\0')
+			return args_usage_error("%s: empty value", name);
+		int rc = EXIT_OK;
+		if (!strcmp(name, "-o") || !strcmp(name, "--output"))
+			a->exr = val;
+		else if (!strcmp(name, "--png"))
+			a->png = val;
+		else if (!strcmp(name, "--device"))
+			a->opt.device = val;
+		else if (!strcmp(name, "--spp")) {
+			rc = parse_u32(name, val, 1, UINT32_MAX, &a->opt.spp);
+			spp_given = 1;
+		} else if (!strcmp(name, "--time")) {
+			rc = parse_seconds(name, val, &a->opt.time_limit);
+			time_given = 1;
+		} else if (!strcmp(name, "--size"))
+			rc = parse_size(name, val, &a->opt.width, &a->opt.height);
+		else if (!strcmp(name, "--integrator"))
+			rc = parse_integrator(name, val, &a->opt.integrator);
+		else if (!strcmp(name, "--max-depth"))
+			rc = parse_u32(name, val, 1, 1024, &a->opt.max_depth);
+		else /* --seed */
+			rc = parse_u32(name, val, 0, UINT32_MAX, &a->opt.seed);
+		if (rc != EXIT_OK)
+			return rc;
+	}
+	if (!a->scene)
+		return args_usage_error("no scene given");
+	if (!a->exr)
+		return args_usage_error("no output given (-o OUT.exr)");
+	if (a->png && strcmp(a->png, a->exr) == 0)
+		return args_usage_error("--png: '%s' is also the EXR output", a->png);
+	/* 64 samples unless only a time limit was asked for. */
+	if (!spp_given)
+		a->opt.spp = time_given ? 0 : 64;
+	if (!time_given)
+		a->opt.time_limit = 0;
+	return EXIT_OK;
+}

@@ -1,0 +1,38 @@
+/* args.h — the command line of `ajar`, parsed by hand into plain structs.
+ * Parse errors print `ajar: error: <message naming the option>` and make
+ * the caller exit with EXIT_USAGE. */
+#ifndef AJAR_CLI_ARGS_H
+#define AJAR_CLI_ARGS_H
+#include <stdint.h>
+
+#include "ajar.h"
+
+/* Exit codes of `ajar`, listed in `ajar --help`. */
+enum {
+	EXIT_OK = 0,
+	EXIT_USAGE = 1,
+	EXIT_BAD_INPUT = 2,
+	EXIT_DEVICE = 3,
+	EXIT_IO = 4,
+	EXIT_INTERRUPTED = 5,
+	EXIT_NO_MEMORY = 6
+};
+
+typedef struct {
+	const char *scene;
+	const char *exr;   /* -o */
+	const char *png;   /* --png, or NULL */
+	ajar_options opt;  /* spp, time_limit, size, integrator, depth, seed, device */
+	int quiet;
+	int help;          /* --help was given: print render help, nothing else */
+} RenderArgs;
+
+/* Parses the arguments after `render`. Returns EXIT_OK or EXIT_USAGE
+ * (after printing the error). */
+int args_parse_render(int argc, char **argv, RenderArgs *a);
+
+/* Prints a usage error (printf-style) and returns EXIT_USAGE. */
+int args_usage_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+
+const char *args_integrator_name(ajar_integrator i);
+#endif

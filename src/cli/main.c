@@ -1,0 +1,426 @@
+/* main.c — the `ajar` command: `render`, `devices`, `info`, help and
+ * version, on top of the public API (include/ajar.h) and nothing else.
+ *
+ * Rules it keeps: no file is created before a render has succeeded (the
+ * library writes images atomically, so a failed or bad-input run leaves
+ * nothing behind); SIGINT/SIGTERM stop a render after the current pass and
+ * the samples so far are still written, a second signal kills as usual;
+ * every failure ends with one `ajar: error: ...` line and a documented exit
+ * code (see usage_main). */
+#include <errno.h>
+#include <libgen.h>
+#include <math.h>
+#include <signal.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "ajar.h"
+#include "args.h"
+#include "progress.h"
+
+/* More OpenCL devices than any machine we know of has. */
+#define MAX_DEVICES 256
+
+static const char usage_main[] =
+	"usage: ajar <command> [options]\n"
+	"\n"
+	"Ajar renders glTF 2.0 scenes with unbiased path tracing, bidirectional path\n"
+	"tracing, or portal-based BDPT for scenes lit through openings, on OpenCL devices.\n"
+	"\n"
+	"commands:\n"
+	"  render SCENE -o OUT.exr [options]  render a .gltf/.glb scene to OpenEXR (see 'ajar render --help')\n"
+	"  info SCENE                         what the scene holds: triangles, lights, portals, camera\n"
+	"  devices                            list OpenCL devices and how to select one\n"
+	"  help [render]                      this text, or the render options\n"
+	"  --version                          print the version\n"
+	"\n"
+	"exit codes:\n"
+	"  0  success\n"
+	"  1  usage error (unknown command or option, missing or bad value)\n"
+	"  2  bad input: the scene or an image it uses is missing or malformed\n"
+	"  3  device error: no OpenCL device, kernel build or run failure\n"
+	"  4  I/O error: cannot write the output\n"
+	"  5  interrupted (SIGINT/SIGTERM): the image of the samples done so far is\n"
+	"     written, unless the render had not started\n"
+	"  6  out of memory\n";
+
+static const char usage_render[] =
+	"usage: ajar render SCENE.gltf|SCENE.glb -o OUT.exr [options]\n"
+	"\n"
+	"  -o, --output OUT.exr   linear HDR result (float RGBA, ZIP); the header records\n"
+	"                         the samples per pixel done as \"ajar:spp\"\n"
+	"  --spp N                samples per pixel (default 64 unless --time is given)\n"
+	"  --time SECONDS         render until this time has passed (with --spp: whichever\n"
+	"                         comes first)\n"
+	"  --size WxH             image size (default: the scene's suggestion, else 512 wide)\n"
+	"  --integrator NAME      pt (default), bdpt or portal\n"
+	"  --max-depth N          maximum path segments\n"
+	"  --seed N               random seed (same seed, device and options: same image)\n"
+	"  --device SELECTOR      platform:device index (e.g. 0:1), cpu, gpu, or a part of\n"
+	"                         the device name; see 'ajar devices'\n"
+	"  --png OUT.png          also write a tone-mapped 8-bit sRGB preview\n"
+	"  -q, --quiet            print nothing but errors\n"
+	"  -h, --help             this text\n"
+	"\n"
+	"Ctrl-C (SIGINT) or SIGTERM stops after the current pass and writes the image so\n"
+	"far (exit code 5); a second one ends the program at once.\n";
+
+/* ---- Errors ---------------------------------------------------------------- */
+
+static int exit_code(ajar_status st)
+{
+	switch (st) {
+	case AJAR_OK: return EXIT_OK;
+	case AJAR_ERROR_INVALID_ARGUMENT: return EXIT_USAGE;
+	case AJAR_ERROR_BAD_INPUT: return EXIT_BAD_INPUT;
+	case AJAR_ERROR_IO: return EXIT_IO;
+	case AJAR_ERROR_DEVICE: return EXIT_DEVICE;
+	case AJAR_ERROR_OUT_OF_MEMORY: return EXIT_NO_MEMORY;
+	case AJAR_ERROR_CANCELLED: return EXIT_INTERRUPTED;
+	}
+	return EXIT_DEVICE;
+}
+
+/* Prints the library's message for a failure about `file` (prefixing the
+ * file name when the message does not already name it). */
+static void report(ajar_status st, const char *file)
+{
+	const char *msg = ajar_last_error();
+	if (!msg[0])
+		msg = ajar_status_name(st);
+	if (file && !strstr(msg, file))
+		fprintf(stderr, "ajar: error: %s: %s\n", file, msg);
+	else
+		fprintf(stderr, "ajar: error: %s\n", msg);
+}
+
+/* Loads a scene; a scene that cannot be read is bad input (exit 2) even
+ * when the library calls it an I/O error: exit 4 is for outputs. */
+static int load_scene(const char *path, ajar_scene **scene)
+{
+	ajar_status st = ajar_scene_load(path, scene);
+	if (st == AJAR_OK)
+		return EXIT_OK;
+	report(st, path);
+	return st == AJAR_ERROR_IO ? EXIT_BAD_INPUT : exit_code(st);
+}
+
+/* Before spending minutes on a render: can `path` be created? Checks the
+ * directory only, and creates nothing. */
+static int check_output(const char *opt, const char *path)
+{
+	struct stat sb;
+	if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode)) {
+		fprintf(stderr, "ajar: error: %s %s: is a directory\n", opt, path);
+		return EXIT_IO;
+	}
+	char *copy = strdup(path);
+	if (!copy) {
+		fprintf(stderr, "ajar: error: out of memory\n");
+		return EXIT_NO_MEMORY;
+	}
+	const char *dir = dirname(copy);
+	int rc = EXIT_OK;
+	if (stat(dir, &sb) != 0 || !S_ISDIR(sb.st_mode)) {
+		fprintf(stderr, "ajar: error: %s %s: directory '%s' does not exist\n", opt, path, dir);
+		rc = EXIT_IO;
+	} else if (access(dir, W_OK | X_OK) != 0) {
+		fprintf(stderr, "ajar: error: %s %s: cannot write to directory '%s': %s\n", opt, path, dir,
+			strerror(errno));
+		rc = EXIT_IO;
+	}
+	free(copy);
+	return rc;
+}
+
+/* ---- Signals --------------------------------------------------------------- */
+
+static ajar_renderer *_Atomic g_renderer;
+static volatile sig_atomic_t g_interrupted;
+
+static void on_signal(int sig)
+{
+	g_interrupted = 1;
+	/* The next SIGINT/SIGTERM takes the default action (ends the process). */
+	struct sigaction dfl;
+	memset(&dfl, 0, sizeof dfl);
+	dfl.sa_handler = SIG_DFL;
+	sigemptyset(&dfl.sa_mask);
+	sigaction(SIGINT, &dfl, NULL);
+	sigaction(SIGTERM, &dfl, NULL);
+	/* The library documents ajar_renderer_cancel as signal-safe. */
+	ajar_renderer *r = atomic_load(&g_renderer);
+	if (r)
+		ajar_renderer_cancel(r);
+}
+
+static void install_signals(void)
+{
+	struct sigaction sa;
+	memset(&sa, 0, sizeof sa);
+	sa.sa_handler = on_signal;
+	sigemptyset(&sa.sa_mask);
+	sa.sa_flags = SA_RESTART;
+	sigaction(SIGINT, &sa, NULL);
+	sigaction(SIGTERM, &sa, NULL);
+}
+
+/* ---- render ---------------------------------------------------------------- */
+
+static void on_log(ajar_log_level level, const char *message, void *user)
+{
+	Progress *progress = user;
+	/* Errors come back through statuses and are printed once, by report(). */
+	if (level != AJAR_LOG_WARNING || progress->quiet)
+		return;
+	progress_break_line(progress);
+	fprintf(stderr, "ajar: warning: %s\n", message);
+}
+
+static int on_progress(const ajar_progress *p, void *user)
+{
+	progress_update(user, p);
+	/* Also stops a render when the signal came before the renderer was
+	 * registered with the handler. */
+	return g_interrupted;
+}
+
+static int interrupted_early(void)
+{
+	fprintf(stderr, "ajar: interrupted before rendering started; no image written\n");
+	return EXIT_INTERRUPTED;
+}
+
+static int write_outputs(ajar_renderer *r, const RenderArgs *a)
+{
+	ajar_status st = ajar_renderer_write_exr(r, a->exr);
+	if (st != AJAR_OK) {
+		report(st, a->exr);
+		return exit_code(st) == EXIT_BAD_INPUT ? EXIT_IO : exit_code(st);
+	}
+	if (a->png) {
+		st = ajar_renderer_write_png(r, a->png);
+		if (st != AJAR_OK) {
+			report(st, a->png);
+			return exit_code(st) == EXIT_BAD_INPUT ? EXIT_IO : exit_code(st);
+		}
+	}
+	return EXIT_OK;
+}
+
+static int cmd_render(int argc, char **argv)
+{
+	RenderArgs a;
+	int rc = args_parse_render(argc, argv, &a);
+	if (rc != EXIT_OK)
+		return rc;
+	if (a.help) {
+		fputs(usage_render, stdout);
+		return EXIT_OK;
+	}
+	if ((rc = check_output("-o", a.exr)) != EXIT_OK || (a.png && (rc = check_output("--png", a.png)) != EXIT_OK))
+		return rc;
+
+	Progress progress;
+	progress_init(&progress, stderr, a.quiet);
+	ajar_set_log_callback(on_log, &progress);
+	install_signals();
+
+	ajar_scene *scene = NULL;
+	ajar_renderer *r = NULL;
+	if ((rc = load_scene(a.scene, &scene)) != EXIT_OK)
+		goto done;
+	if (g_interrupted) {
+		rc = interrupted_early();
+		goto done;
+	}
+	ajar_status st = ajar_renderer_create(scene, &a.opt, &r);
+	if (st != AJAR_OK) {
+		report(st, NULL);
+		rc = exit_code(st);
+		goto done;
+	}
+	atomic_store(&g_renderer, r);
+	if (g_interrupted) {
+		rc = interrupted_early();
+		goto done;
+	}
+	if (!a.quiet) {
+		char budget[64] = "";
+		if (a.opt.spp)
+			snprintf(budget, sizeof budget, "%u spp", a.opt.spp);
+		if (a.opt.time_limit > 0)
+			snprintf(budget + strlen(budget), sizeof budget - strlen(budget), "%s%g s",
+				 a.opt.spp ? ", at most " : "", a.opt.time_limit);
+		const char *device = ajar_renderer_device_name(r);
+		fprintf(stderr, "ajar: rendering %s with %s (%s) on %s\n", a.scene,
+			args_integrator_name(a.opt.integrator), budget, device ? device : "?");
+	}
+
+	st = ajar_renderer_render(r, on_progress, &progress);
+	progress_break_line(&progress);
+	if (st != AJAR_OK && st != AJAR_ERROR_CANCELLED) {
+		report(st, NULL);
+		rc = exit_code(st);
+		goto done;
+	}
+	uint32_t spp = ajar_renderer_spp(r);
+	if (spp == 0) {
+		rc = interrupted_early();
+		goto done;
+	}
+	if ((rc = write_outputs(r, &a)) != EXIT_OK)
+		goto done;
+	const ajar_progress *last = &progress.last;
+	char elapsed[24];
+	progress_format_time(last->elapsed, elapsed, sizeof elapsed);
+	if (st == AJAR_ERROR_CANCELLED || g_interrupted) {
+		fprintf(stderr, "ajar: interrupted after %u spp (%s); wrote %s%s%s\n", spp, elapsed, a.exr,
+			a.png ? " and " : "", a.png ? a.png : "");
+		rc = EXIT_INTERRUPTED;
+	} else if (!a.quiet) {
+		fprintf(stderr, "ajar: done: %u spp in %s (%.3g Msamples/s); wrote %s%s%s\n", spp, elapsed,
+			last->samples_per_second * 1e-6, a.exr, a.png ? " and " : "", a.png ? a.png : "");
+	}
+done:
+	atomic_store(&g_renderer, NULL);
+	ajar_renderer_destroy(&r);
+	ajar_scene_destroy(&scene);
+	ajar_set_log_callback(NULL, NULL);
+	return rc;
+}
+
+/* ---- devices --------------------------------------------------------------- */
+
+static void format_bytes(uint64_t b, char *buf, size_t cap)
+{
+	if (b >= (1ull << 30))
+		snprintf(buf, cap, "%.1f GiB", (double)b / (double)(1ull << 30));
+	else
+		snprintf(buf, cap, "%.0f MiB", (double)b / (double)(1ull << 20));
+}
+
+static int cmd_devices(int argc, char **argv)
+{
+	if (argc > 0)
+		return args_usage_error("devices: unexpected argument '%s'", argv[0]);
+	ajar_device_info *dev = calloc(MAX_DEVICES, sizeof *dev);
+	if (!dev) {
+		fprintf(stderr, "ajar: error: out of memory\n");
+		return EXIT_NO_MEMORY;
+	}
+	uint32_t n = 0;
+	ajar_status st = ajar_devices(dev, MAX_DEVICES, &n);
+	if (st != AJAR_OK) {
+		report(st, NULL);
+		free(dev);
+		return exit_code(st);
+	}
+	if (n == 0) {
+		fprintf(stderr, "ajar: error: no OpenCL device found; install an OpenCL driver "
+				"(for the CPU: PoCL, Debian package pocl-opencl-icd)\n");
+		free(dev);
+		return EXIT_DEVICE;
+	}
+	if (n > MAX_DEVICES)
+		n = MAX_DEVICES;
+	printf("%-8s %-6s %-40s %s\n", "SELECTOR", "TYPE", "NAME", "COMPUTE UNITS, MEMORY, PLATFORM");
+	for (uint32_t i = 0; i < n; i++) {
+		char mem[32];
+		format_bytes(dev[i].global_memory, mem, sizeof mem);
+		printf("%-8s %-6s %-40s %u CU, %s, %s\n", dev[i].selector, dev[i].type, dev[i].name,
+		       dev[i].compute_units, mem, dev[i].platform);
+	}
+	printf("\nSelect one with --device %s (platform:device), --device cpu, --device gpu,\n"
+	       "or --device NAME where NAME is any part of a device's name.\n",
+	       dev[0].selector);
+	free(dev);
+	return EXIT_OK;
+}
+
+/* ---- info ------------------------------------------------------------------ */
+
+static int cmd_info(int argc, char **argv)
+{
+	if (argc == 1 && (!strcmp(argv[0], "-h") || !strcmp(argv[0], "--help"))) {
+		fputs("usage: ajar info SCENE.gltf|SCENE.glb\n", stdout);
+		return EXIT_OK;
+	}
+	if (argc != 1)
+		return args_usage_error("info: expects one scene, got %d arguments", argc);
+	if (argv[0][0] == '-')
+		return args_usage_error("info: unknown option '%s'", argv[0]);
+	ajar_scene *scene = NULL;
+	int rc = load_scene(argv[0], &scene);
+	if (rc != EXIT_OK)
+		return rc;
+	ajar_scene_info in;
+	ajar_status st = ajar_scene_info_get(scene, &in);
+	if (st != AJAR_OK) {
+		report(st, argv[0]);
+		ajar_scene_destroy(&scene);
+		return exit_code(st);
+	}
+	static const char *const env[] = {"none", "colour", "image"};
+	printf("scene:        %s\n", argv[0]);
+	printf("triangles:    %llu\n", (unsigned long long)in.triangles);
+	printf("materials:    %u\n", in.materials);
+	printf("emissive:     %u triangles\n", in.emissive_triangles);
+	printf("portals:      %u objects, %u triangles\n", in.portals, in.portal_triangles);
+	printf("textures:     %u\n", in.textures);
+	printf("environment:  %s\n", in.environment >= 0 && in.environment <= 2 ? env[in.environment] : "?");
+	printf("bounds:       (%g, %g, %g) .. (%g, %g, %g)\n", in.bounds_min[0], in.bounds_min[1],
+	       in.bounds_min[2], in.bounds_max[0], in.bounds_max[1], in.bounds_max[2]);
+	const ajar_camera *c = &in.camera;
+	float d[3] = {c->target[0] - c->position[0], c->target[1] - c->position[1], c->target[2] - c->position[2]};
+	float len = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+	if (len > 0)
+		for (int k = 0; k < 3; k++)
+			d[k] /= len;
+	printf("camera:       %sposition (%g, %g, %g), direction (%.3f, %.3f, %.3f), yfov %.1f deg\n",
+	       in.has_camera ? "" : "none in the file; default view framing the bounds: ", c->position[0],
+	       c->position[1], c->position[2], d[0], d[1], d[2], c->yfov * 180.0 / M_PI);
+	if (in.width && in.height)
+		printf("resolution:   %ux%u (suggested by the scene)\n", in.width, in.height);
+	else
+		printf("resolution:   none suggested (renders 512 wide at the camera's aspect)\n");
+	ajar_scene_destroy(&scene);
+	return EXIT_OK;
+}
+
+/* ---- main ------------------------------------------------------------------ */
+
+int main(int argc, char **argv)
+{
+	if (argc < 2) {
+		fputs(usage_main, stderr);
+		return EXIT_USAGE;
+	}
+	const char *cmd = argv[1];
+	if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) {
+		if (argc > 2 && !strcmp(cmd, "help") && !strcmp(argv[2], "render"))
+			fputs(usage_render, stdout);
+		else
+			fputs(usage_main, stdout);
+		return EXIT_OK;
+	}
+	if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) {
+		printf("ajar %s\n", ajar_version());
+		return EXIT_OK;
+	}
+	if (!strcmp(cmd, "render"))
+		return cmd_render(argc - 2, argv + 2);
+	if (!strcmp(cmd, "devices"))
+		return cmd_devices(argc - 2, argv + 2);
+	if (!strcmp(cmd, "info"))
+		return cmd_info(argc - 2, argv + 2);
+	if (cmd[0] == '-')
+		fprintf(stderr, "ajar: error: unknown option '%s' (see 'ajar --help')\n", cmd);
+	else
+		fprintf(stderr, "ajar: error: unknown command '%s' (see 'ajar --help')\n", cmd);
+	return EXIT_USAGE;
+}

@@ -1,0 +1,32 @@
+/* exr.h — internal helpers of the image-file modules (exr.c, png.c)
+ * beyond the public ajar_write_exr / ajar_read_exr / ajar_write_png. */
+#ifndef AJAR_EXR_H
+#define AJAR_EXR_H
+#include <stddef.h>
+
+#include "ajar.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Copies the string attribute `name` of the first part of `path` into
+ * `value` (NUL-terminated, at most cap - 1 bytes). A missing attribute or
+ * one of another type is AJAR_ERROR_BAD_INPUT; a value longer than the
+ * buffer is AJAR_ERROR_INVALID_ARGUMENT. */
+ajar_status exr_read_attr(const char *path, const char *name, char *value, size_t cap);
+
+/* Atomic output, shared by the EXR and PNG writers: image_tmp_open creates
+ * a new file next to `path` (*tmp_path is malloc'd); image_tmp_finish
+ * closes it and, if `status` is AJAR_OK, renames it to `path`, else removes
+ * it, frees tmp_path and returns the final status. So a failed write never
+ * leaves a partial file, nor replaces an existing one. */
+ajar_status image_tmp_open(const char *path, char **tmp_path, int *fd);
+ajar_status image_tmp_finish(const char *path, char *tmp_path, int fd, ajar_status status);
+/* write() all of `data`, retrying short writes; errors name `path`. */
+ajar_status image_write_all(const char *path, int fd, const void *data, size_t size);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,350 @@
+/* test_cli.c — the `ajar` program as a user runs it: help and version,
+ * usage errors naming the option (exit 1), missing and broken scenes
+ * (exit 2, the file named, no output created), `info`, a tiny render with
+ * its EXR header and PNG, and SIGINT during a long render (exit 5 with the
+ * samples so far written). Runs build/ajar (or $AJAR_BIN) from the top of
+ * the source tree. */
+#include <fcntl.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "exr.h"
+#include "testutil.h"
+
+#define CORNELL SCENE("cornell/cornell.gltf")
+
+static char *tmpdir;
+
+static const char *ajar_bin(void)
+{
+	const char *b = getenv("AJAR_BIN");
+	return b && b[0] ? b : "build/ajar";
+}
+
+static char *path_in(const char *name)
+{
+	size_t n = strlen(tmpdir) + strlen(name) + 2;
+	char *p = malloc(n);
+	assert_non_null(p);
+	snprintf(p, n, "%s/%s", tmpdir, name);
+	return p;
+}
+
+static int file_exists(const char *path)
+{
+	struct stat st;
+	return stat(path, &st) == 0;
+}
+
+static char *read_file(const char *path)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f)
+		return calloc(1, 1);
+	fseek(f, 0, SEEK_END);
+	long n = ftell(f);
+	fseek(f, 0, SEEK_SET);
+	char *s = malloc((size_t)n + 1);
+	assert_non_null(s);
+	s[fread(s, 1, (size_t)n, f)] = '\0';
+	fclose(f);
+	return s;
+}
+
+/* Starts ajar with `args` (NULL-terminated), stdout and stderr going to
+ * files in tmpdir; returns the child's pid. */
+static pid_t spawn(const char *const *args)
+{
+	const char *argv[32];
+	int n = 0;
+	argv[n++] = ajar_bin();
+	while (args[n - 1] && n < 31) {
+		argv[n] = args[n - 1];
+		n++;
+	}
+	argv[n] = NULL;
+	char *out = path_in("stdout.txt"), *err = path_in("stderr.txt");
+	pid_t pid = fork();
+	assert_true(pid >= 0);
+	if (pid == 0) {
+		int fo = open(out, O_WRONLY | O_CREAT | O_TRUNC, 0644), fe = open(err, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+		if (fo < 0 || fe < 0 || dup2(fo, 1) < 0 || dup2(fe, 2) < 0)
+			_exit(127);
+		execv(argv[0], (char *const *)argv);
+		_exit(127);
+	}
+	free(out);
+	free(err);
+	return pid;
+}
+
+static int wait_exit(pid_t pid)
+{
+	int status;
+	assert_int_equal(waitpid(pid, &status, 0), pid);
+	assert_true(WIFEXITED(status)); /* not killed by a signal */
+	return WEXITSTATUS(status);
+}
+
+typedef struct {
+	int code;
+	char *out, *err;
+} Result;
+
+static Result run(const char *const *args)
+{
+	Result r;
+	r.code = wait_exit(spawn(args));
+	char *o = path_in("stdout.txt"), *e = path_in("stderr.txt");
+	r.out = read_file(o);
+	r.err = read_file(e);
+	unlink(o);
+	unlink(e);
+	free(o);
+	free(e);
+	return r;
+}
+
+static void result_free(Result *r)
+{
+	free(r->out);
+	free(r->err);
+}
+
+/* Runs and checks the exit code and that stderr contains `needle`. */
+static void expect(const char *const *args, int code, const char *needle)
+{
+	Result r = run(args);
+	if (r.code != code || (needle && !strstr(r.err, needle)))
+		print_error("ajar %s ...: exit %d, stderr:\n%s\n", args[0] ? args[0] : "", r.code, r.err);
+	assert_int_equal(r.code, code);
+	if (needle)
+		assert_non_null(strstr(r.err, needle));
+	result_free(&r);
+}
+
+/* Number of entries in tmpdir (outputs that should not exist show up). */
+static int count_tmp_entries(void)
+{
+	char cmd[512];
+	snprintf(cmd, sizeof cmd, "ls -A '%s' | wc -l", tmpdir);
+	FILE *p = popen(cmd, "r");
+	assert_non_null(p);
+	int n = -1;
+	assert_int_equal(fscanf(p, "%d", &n), 1);
+	pclose(p);
+	return n;
+}
+
+static int setup(void **state)
+{
+	tmpdir = test_tmpdir();
+	return tmpdir ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+	char cmd[512];
+	snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
+	int rc = system(cmd);
+	free(tmpdir);
+	return rc;
+}
+
+static void test_help_version(void **state)
+{
+	Result r = run((const char *[]){"--version", NULL});
+	assert_int_equal(r.code, 0);
+	assert_non_null(strstr(r.out, ajar_version()));
+	result_free(&r);
+
+	r = run((const char *[]){"--help", NULL});
+	assert_int_equal(r.code, 0);
+	assert_non_null(strstr(r.out, "render"));
+	assert_non_null(strstr(r.out, "exit codes"));
+	result_free(&r);
+
+	r = run((const char *[]){"render", "--help", NULL});
+	assert_int_equal(r.code, 0);
+	assert_non_null(strstr(r.out, "--spp"));
+	assert_non_null(strstr(r.out, "--device"));
+	result_free(&r);
+
+	r = run((const char *[]){"help", NULL});
+	assert_int_equal(r.code, 0);
+	result_free(&r);
+}
+
+static void test_usage_errors(void **state)
+{
+	char *out = path_in("never.exr");
+	expect((const char *[]){NULL}, 1, "usage");
+	expect((const char *[]){"frobnicate", NULL}, 1, "frobnicate");
+	expect((const char *[]){"--frobnicate", NULL}, 1, "--frobnicate");
+	expect((const char *[]){"render", CORNELL, "-o", out, "--bogus", NULL}, 1, "--bogus");
+	expect((const char *[]){"render", CORNELL, "-o", out, "--spp", "-3", NULL}, 1, "--spp");
+	expect((const char *[]){"render", CORNELL, "-o", out, "--spp", "12abc", NULL}, 1, "--spp");
+	expect((const char *[]){"render", CORNELL, "-o", out, "--spp", NULL}, 1, "--spp");
+	expect((const char *[]){"render", CORNELL, "-o", out, "--size", "0x5", NULL}, 1, "--size");
+	expect((const char *[]){"render", CORNELL, "-o", out, "--size", "abc", NULL}, 1, "--size");
+	expect((const char *[]){"render", CORNELL, "-o", out, "--size=64x", NULL}, 1, "--size");
+	expect((const char *[]){"render", CORNELL, "-o", out, "--time", "-1", NULL}, 1, "--time");
+	expect((const char *[]){"render", CORNELL, "-o", out, "--integrator", "magic", NULL}, 1, "--integrator");
+	expect((const char *[]){"render", CORNELL, "-o", out, "--max-depth", "0", NULL}, 1, "--max-depth");
+	expect((const char *[]){"render", CORNELL, NULL}, 1, "-o");
+	expect((const char *[]){"render", "-o", out, NULL}, 1, "scene");
+	expect((const char *[]){"info", NULL}, 1, "info");
+	assert_false(file_exists(out));
+	assert_int_equal(count_tmp_entries(), 0);
+	free(out);
+}
+
+static void test_bad_scenes(void **state)
+{
+	char *missing = path_in("missing.gltf"), *broken = path_in("broken.gltf"), *out = path_in("out.exr");
+	char *png = path_in("out.png");
+	expect((const char *[]){"render", missing, "-o", out, "--png", png, NULL}, 2, missing);
+	expect((const char *[]){"info", missing, NULL}, 2, missing);
+
+	FILE *f = fopen(broken, "w");
+	assert_non_null(f);
+	fputs("{\"asset\": {\"version\": \"2.0\"}, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0", f);
+	fclose(f);
+	expect((const char *[]){"render", broken, "-o", out, "--png", png, "--spp", "1", NULL}, 2, broken);
+	expect((const char *[]){"info", broken, NULL}, 2, broken);
+	assert_false(file_exists(out));
+	assert_false(file_exists(png));
+	assert_int_equal(count_tmp_entries(), 1); /* broken.gltf */
+	unlink(broken);
+
+	/* An output directory that does not exist is an I/O error, found
+	 * before rendering. */
+	char *nodir = path_in("no/such/dir/out.exr");
+	expect((const char *[]){"render", CORNELL, "-o", nodir, NULL}, 4, nodir);
+	free(nodir);
+	free(missing);
+	free(broken);
+	free(out);
+	free(png);
+}
+
+static void test_info(void **state)
+{
+	Result r = run((const char *[]){"info", CORNELL, NULL});
+	if (r.code != 0)
+		print_error("%s", r.err);
+	assert_int_equal(r.code, 0);
+	const char *t = strstr(r.out, "triangles:");
+	assert_non_null(t);
+	unsigned long long n = 0;
+	assert_int_equal(sscanf(t, "triangles: %llu", &n), 1);
+	assert_true(n > 0);
+	assert_non_null(strstr(r.out, "camera:"));
+	result_free(&r);
+}
+
+static void test_tiny_render(void **state)
+{
+	char *exr = path_in("tiny.exr"), *png = path_in("tiny.png");
+	Result r = run((const char *[]){"render", CORNELL, "-o", exr, "--png", png, "--size", "32x32", "--spp", "2",
+					"--seed", "7", NULL});
+	if (r.code != 0)
+		print_error("%s", r.err);
+	assert_int_equal(r.code, 0);
+	result_free(&r);
+
+	char spp[32];
+	assert_int_equal(exr_read_attr(exr, "ajar:spp", spp, sizeof spp), AJAR_OK);
+	assert_string_equal(spp, "2");
+	float *px;
+	uint32_t w, h;
+	assert_int_equal(ajar_read_exr(exr, &px, &w, &h), AJAR_OK);
+	assert_int_equal(w, 32);
+	assert_int_equal(h, 32);
+	free(px);
+
+	char *bytes = read_file(png);
+	assert_memory_equal(bytes, "\x89PNG\r\n\x1a\n", 8);
+	free(bytes);
+	/* --quiet prints nothing on success. */
+	r = run((const char *[]){"render", CORNELL, "-o", exr, "--size", "8x8", "--spp", "1", "--quiet", NULL});
+	assert_int_equal(r.code, 0);
+	assert_string_equal(r.err, "");
+	result_free(&r);
+	unlink(exr);
+	unlink(png);
+	free(exr);
+	free(png);
+}
+
+static double now(void)
+{
+	struct timespec t;
+	clock_gettime(CLOCK_MONOTONIC, &t);
+	return (double)t.tv_sec + (double)t.tv_nsec * 1e-9;
+}
+
+static void test_sigint(void **state)
+{
+	char *exr = path_in("long.exr"), *err = path_in("stderr.txt");
+	const uint32_t full_spp = 1000000;
+	char full[16];
+	snprintf(full, sizeof full, "%u", full_spp);
+	pid_t pid = spawn((const char *[]){"render", CORNELL, "-o", exr, "--size", "16x16", "--time", "60", "--spp",
+					   full, NULL});
+	/* Wait for the render to start (after kernels are built, which may
+	 * take long on a cold cache), then for a pass or two. */
+	int started = 0;
+	for (double t0 = now(); !started && now() - t0 < 300;) {
+		char *s = read_file(err);
+		started = strstr(s, "rendering") != NULL;
+		free(s);
+		if (waitpid(pid, NULL, WNOHANG) == pid)
+			fail_msg("ajar ended before rendering");
+		usleep(50000);
+	}
+	assert_true(started);
+	usleep(1500000);
+	assert_int_equal(kill(pid, SIGINT), 0);
+	/* A hang guard, not a timing check: stopping takes one short pass. */
+	int status = 0;
+	pid_t done = 0;
+	for (double t0 = now(); done == 0 && now() - t0 < 60; usleep(20000))
+		done = waitpid(pid, &status, WNOHANG);
+	if (done == 0) {
+		kill(pid, SIGKILL);
+		waitpid(pid, &status, 0);
+		fail_msg("ajar did not stop after SIGINT");
+	}
+	assert_true(WIFEXITED(status));
+	assert_int_equal(WEXITSTATUS(status), 5);
+
+	char spp[32];
+	assert_int_equal(exr_read_attr(exr, "ajar:spp", spp, sizeof spp), AJAR_OK);
+	unsigned long n = strtoul(spp, NULL, 10);
+	assert_true(n >= 1);
+	assert_true(n < full_spp);
+	unlink(exr);
+	unlink(err);
+	free(exr);
+	free(err);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_help_version),
+		cmocka_unit_test(test_usage_errors),
+		cmocka_unit_test(test_bad_scenes),
+		cmocka_unit_test(test_info),
+		cmocka_unit_test(test_tiny_render),
+		cmocka_unit_test(test_sigint),
+	};
+	return cmocka_run_group_tests(tests, setup, teardown);
+}

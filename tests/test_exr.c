@@ -1,0 +1,487 @@
+/* test_exr.c — image files: OpenEXR write/read round trips (bit-exact
+ * floats, header attributes), reading files of other layouts written here
+ * with OpenEXR's C API (half, uint, tiled, Y-only), error statuses and
+ * messages for missing, garbage, truncated and unwritable files, and the
+ * PNG encoder checked by decoding its chunks and IDAT with zlib. */
+#include <dirent.h>
+#include <float.h>
+#include <math.h>
+#include <openexr.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <zlib.h>
+
+#include "exr.h"
+#include "testutil.h"
+
+static char *join(const char *dir, const char *name)
+{
+	size_t n = strlen(dir) + strlen(name) + 2;
+	char *p = malloc(n);
+	assert_non_null(p);
+	snprintf(p, n, "%s/%s", dir, name);
+	return p;
+}
+
+/* Number of entries in `dir` other than . and .. */
+static int count_entries(const char *dir)
+{
+	DIR *d = opendir(dir);
+	assert_non_null(d);
+	int n = 0;
+	struct dirent *e;
+	while ((e = readdir(d)))
+		if (strcmp(e->d_name, ".") && strcmp(e->d_name, ".."))
+			n++;
+	closedir(d);
+	return n;
+}
+
+static void remove_tree(const char *dir)
+{
+	DIR *d = opendir(dir);
+	if (!d)
+		return;
+	struct dirent *e;
+	while ((e = readdir(d))) {
+		if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
+			continue;
+		char *p = join(dir, e->d_name);
+		struct stat st;
+		if (stat(p, &st) == 0 && S_ISDIR(st.st_mode))
+			remove_tree(p);
+		else
+			unlink(p);
+		free(p);
+	}
+	closedir(d);
+	rmdir(dir);
+}
+
+static int file_exists(const char *path)
+{
+	struct stat st;
+	return stat(path, &st) == 0;
+}
+
+/* ---- Writing test files with the OpenEXR C API directly -------------------- */
+
+typedef struct {
+	const char *name;
+	exr_pixel_type_t type;
+	const void *plane; /* width * height elements of 2 (half) or 4 bytes */
+} TestChannel;
+
+/* Writes a single-part file with the given planar channels; tile_w > 0
+ * makes it tiled (one level) with tile_w x tile_h tiles. */
+static void write_test_exr(const char *path, const TestChannel *chans, int nchans, int width, int height,
+			   int tile_w, int tile_h, exr_compression_t comp)
+{
+	exr_context_t ctxt;
+	exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+	int part;
+	assert_int_equal(exr_start_write(&ctxt, path, EXR_WRITE_FILE_DIRECTLY, &init), EXR_ERR_SUCCESS);
+	assert_int_equal(exr_add_part(ctxt, "test", tile_w ? EXR_STORAGE_TILED : EXR_STORAGE_SCANLINE, &part),
+			 EXR_ERR_SUCCESS);
+	assert_int_equal(exr_initialize_required_attr_simple(ctxt, part, width, height, comp), EXR_ERR_SUCCESS);
+	if (tile_w)
+		assert_int_equal(exr_set_tile_descriptor(ctxt, part, (uint32_t)tile_w, (uint32_t)tile_h,
+							 EXR_TILE_ONE_LEVEL, EXR_TILE_ROUND_DOWN),
+				 EXR_ERR_SUCCESS);
+	for (int c = 0; c < nchans; c++)
+		assert_int_equal(exr_add_channel(ctxt, part, chans[c].name, chans[c].type,
+						 EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1),
+				 EXR_ERR_SUCCESS);
+	assert_int_equal(exr_write_header(ctxt), EXR_ERR_SUCCESS);
+
+	int tiled = tile_w > 0;
+	if (!tiled) {
+		int32_t lines;
+		assert_int_equal(exr_get_scanlines_per_chunk(ctxt, part, &lines), EXR_ERR_SUCCESS);
+		tile_w = width;
+		tile_h = lines;
+	}
+	exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
+	int first = 1;
+	for (int ty = 0; ty * tile_h < height; ty++) {
+		for (int tx = 0; tx * tile_w < width; tx++) {
+			exr_chunk_info_t cinfo;
+			if (tiled)
+				assert_int_equal(exr_write_tile_chunk_info(ctxt, part, tx, ty, 0, 0, &cinfo),
+						 EXR_ERR_SUCCESS);
+			else
+				assert_int_equal(exr_write_scanline_chunk_info(ctxt, part, ty * tile_h, &cinfo),
+						 EXR_ERR_SUCCESS);
+			assert_int_equal(first ? exr_encoding_initialize(ctxt, part, &cinfo, &enc)
+					       : exr_encoding_update(ctxt, part, &cinfo, &enc),
+					 EXR_ERR_SUCCESS);
+			first = 0;
+			for (int i = 0; i < enc.channel_count; i++) {
+				exr_coding_channel_info_t *ch = &enc.channels[i];
+				int c = 0;
+				while (strcmp(chans[c].name, ch->channel_name))
+					c++;
+				int bpe = chans[c].type == EXR_PIXEL_HALF ? 2 : 4;
+				ch->user_pixel_stride = bpe;
+				ch->user_line_stride = width * bpe;
+				ch->user_bytes_per_element = (int16_t)bpe;
+				ch->user_data_type = (uint16_t)chans[c].type;
+				ch->encode_from_ptr = (const uint8_t *)chans[c].plane +
+						      ((size_t)ty * tile_h * width + (size_t)tx * tile_w) * bpe;
+			}
+			assert_int_equal(exr_encoding_choose_default_routines(ctxt, part, &enc), EXR_ERR_SUCCESS);
+			assert_int_equal(exr_encoding_run(ctxt, part, &enc), EXR_ERR_SUCCESS);
+		}
+	}
+	assert_int_equal(exr_encoding_destroy(ctxt, &enc), EXR_ERR_SUCCESS);
+	assert_int_equal(exr_finish(&ctxt), EXR_ERR_SUCCESS);
+}
+
+/* ---- EXR tests ------------------------------------------------------------ */
+
+/* Values that a lossy or converting path would change. */
+static float awkward(int i)
+{
+	static const float v[] = {0.0f, -0.0f, 1.0f, -1.5f, 3.0e38f, FLT_MAX, 1.0e-40f /* denormal */,
+				  -1.0e-45f, INFINITY, -INFINITY, 0.1f, 123456.789f, 1.0f / 3.0f};
+	int n = (int)(sizeof v / sizeof v[0]);
+	return i % 3 == 0 ? v[(i / 3) % n] : (float)(i % 97) * 0.37f - 11.0f;
+}
+
+static void test_roundtrip_bit_exact(void **state)
+{
+	char *dir = test_tmpdir();
+	char *path = join(dir, "round.exr");
+	/* 37 rows cross the 16-line ZIP chunks, the last one partial. */
+	const uint32_t w = 5, h = 37;
+	float *px = malloc(sizeof(float) * 4 * w * h);
+	for (uint32_t i = 0; i < 4 * w * h; i++)
+		px[i] = awkward((int)i);
+	px[7] = NAN;
+	const char *attrs[] = {"ajar:spp", "64", "ajar:integrator", "portal"};
+	assert_int_equal(ajar_write_exr(path, px, w, h, attrs, 2), AJAR_OK);
+	assert_int_equal(count_entries(dir), 1); /* no temporary left beside it */
+
+	float *back;
+	uint32_t bw, bh;
+	assert_int_equal(ajar_read_exr(path, &back, &bw, &bh), AJAR_OK);
+	assert_int_equal(bw, w);
+	assert_int_equal(bh, h);
+	assert_memory_equal(back, px, sizeof(float) * 4 * w * h);
+	free(back);
+
+	char value[32];
+	assert_int_equal(exr_read_attr(path, "ajar:spp", value, sizeof value), AJAR_OK);
+	assert_string_equal(value, "64");
+	assert_int_equal(exr_read_attr(path, "ajar:integrator", value, sizeof value), AJAR_OK);
+	assert_string_equal(value, "portal");
+	assert_int_equal(exr_read_attr(path, "ajar:nothing", value, sizeof value), AJAR_ERROR_BAD_INPUT);
+	assert_non_null(strstr(ajar_last_error(), "ajar:nothing"));
+	assert_int_equal(exr_read_attr(path, "ajar:integrator", value, 4), AJAR_ERROR_INVALID_ARGUMENT);
+
+	/* Overwriting an existing file replaces it. */
+	px[0] = 42.0f;
+	assert_int_equal(ajar_write_exr(path, px, w, h, NULL, 0), AJAR_OK);
+	assert_int_equal(ajar_read_exr(path, &back, &bw, &bh), AJAR_OK);
+	assert_true(back[0] == 42.0f);
+	free(back);
+	assert_int_equal(exr_read_attr(path, "ajar:spp", value, sizeof value), AJAR_ERROR_BAD_INPUT);
+
+	free(px);
+	free(path);
+	remove_tree(dir);
+	free(dir);
+}
+
+/* Half R, float G, uint B and no A, ZIP-compressed scanlines. */
+static void test_read_mixed_types(void **state)
+{
+	char *dir = test_tmpdir();
+	char *path = join(dir, "mixed.exr");
+	enum { W = 3, H = 19 };
+	/* 0.5, 2, -0.25, 1, 65504, 0 as IEEE half bits. */
+	static const uint16_t half_bits[6] = {0x3800, 0x4000, 0xB400, 0x3C00, 0x7BFF, 0x0000};
+	static const float half_vals[6] = {0.5f, 2.0f, -0.25f, 1.0f, 65504.0f, 0.0f};
+	uint16_t r[W * H];
+	float g[W * H];
+	uint32_t b[W * H];
+	for (int i = 0; i < W * H; i++) {
+		r[i] = half_bits[i % 6];
+		g[i] = (float)i * 0.125f - 2.0f;
+		b[i] = (uint32_t)(i * 1000);
+	}
+	TestChannel chans[] = {{"R", EXR_PIXEL_HALF, r}, {"G", EXR_PIXEL_FLOAT, g}, {"B", EXR_PIXEL_UINT, b}};
+	write_test_exr(path, chans, 3, W, H, 0, 0, EXR_COMPRESSION_ZIP);
+
+	float *px;
+	uint32_t w, h;
+	assert_int_equal(ajar_read_exr(path, &px, &w, &h), AJAR_OK);
+	assert_int_equal(w, W);
+	assert_int_equal(h, H);
+	for (int i = 0; i < W * H; i++) {
+		assert_true(px[4 * i + 0] == half_vals[i % 6]);
+		assert_true(px[4 * i + 1] == g[i]);
+		assert_true(px[4 * i + 2] == (float)b[i]);
+		assert_true(px[4 * i + 3] == 1.0f);
+	}
+	free(px);
+	free(path);
+	remove_tree(dir);
+	free(dir);
+}
+
+/* A tiled, luminance-only file with alpha: edge tiles are partial. */
+static void test_read_tiled_y(void **state)
+{
+	char *dir = test_tmpdir();
+	char *path = join(dir, "tiled.exr");
+	enum { W = 7, H = 5 };
+	float y[W * H], a[W * H];
+	for (int i = 0; i < W * H; i++) {
+		y[i] = (float)i + 0.5f;
+		a[i] = (float)(i % 4) * 0.25f;
+	}
+	TestChannel chans[] = {{"Y", EXR_PIXEL_FLOAT, y}, {"A", EXR_PIXEL_FLOAT, a}};
+	write_test_exr(path, chans, 2, W, H, 2, 3, EXR_COMPRESSION_NONE);
+
+	float *px;
+	uint32_t w, h;
+	assert_int_equal(ajar_read_exr(path, &px, &w, &h), AJAR_OK);
+	assert_int_equal(w, W);
+	assert_int_equal(h, H);
+	for (int i = 0; i < W * H; i++) {
+		for (int c = 0; c < 3; c++)
+			assert_true(px[4 * i + c] == y[i]);
+		assert_true(px[4 * i + 3] == a[i]);
+	}
+	free(px);
+	free(path);
+	remove_tree(dir);
+	free(dir);
+}
+
+static void test_read_errors(void **state)
+{
+	char *dir = test_tmpdir();
+	float *px = (float *)&px; /* must be reset to NULL on failure */
+	uint32_t w, h;
+
+	char *missing = join(dir, "missing.exr");
+	assert_int_equal(ajar_read_exr(missing, &px, &w, &h), AJAR_ERROR_IO);
+	assert_null(px);
+	assert_non_null(strstr(ajar_last_error(), missing));
+
+	char *garbage = join(dir, "garbage.exr");
+	FILE *f = fopen(garbage, "wb");
+	assert_non_null(f);
+	fputs("this is not an OpenEXR file, only some text\n", f);
+	fclose(f);
+	assert_int_equal(ajar_read_exr(garbage, &px, &w, &h), AJAR_ERROR_BAD_INPUT);
+	assert_non_null(strstr(ajar_last_error(), garbage));
+
+	char *empty = join(dir, "empty.exr");
+	f = fopen(empty, "wb");
+	assert_non_null(f);
+	fclose(f);
+	assert_int_equal(ajar_read_exr(empty, &px, &w, &h), AJAR_ERROR_BAD_INPUT);
+	assert_non_null(strstr(ajar_last_error(), empty));
+
+	/* A valid file cut inside its header, then inside its pixel data. */
+	char *trunc = join(dir, "truncated.exr");
+	enum { W = 64, H = 64 };
+	float *img = malloc(sizeof(float) * 4 * W * H);
+	for (int i = 0; i < 4 * W * H; i++)
+		img[i] = (float)((i * 7919) % 1000) * 0.001f;
+	assert_int_equal(ajar_write_exr(trunc, img, W, H, NULL, 0), AJAR_OK);
+	struct stat st;
+	assert_int_equal(stat(trunc, &st), 0);
+	off_t cuts[2] = {40, st.st_size * 6 / 10};
+	for (int k = 0; k < 2; k++) {
+		assert_int_equal(truncate(trunc, cuts[k]), 0);
+		assert_int_equal(ajar_read_exr(trunc, &px, &w, &h), AJAR_ERROR_BAD_INPUT);
+		assert_null(px);
+		assert_non_null(strstr(ajar_last_error(), trunc));
+	}
+
+	/* A directory is not a file we can read. */
+	assert_int_equal(ajar_read_exr(dir, &px, &w, &h), AJAR_ERROR_IO);
+	assert_non_null(strstr(ajar_last_error(), dir));
+
+	free(img);
+	free(missing);
+	free(garbage);
+	free(empty);
+	free(trunc);
+	remove_tree(dir);
+	free(dir);
+}
+
+static void test_write_errors(void **state)
+{
+	char *dir = test_tmpdir();
+	float px[4 * 4] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16};
+
+	/* A directory that does not exist. */
+	char *nodir = join(dir, "no/such/dir/out.exr");
+	assert_int_equal(ajar_write_exr(nodir, px, 2, 2, NULL, 0), AJAR_ERROR_IO);
+	assert_non_null(strstr(ajar_last_error(), nodir));
+	assert_false(file_exists(nodir));
+	assert_int_equal(ajar_write_png(nodir, px, 2, 2), AJAR_ERROR_IO);
+	assert_non_null(strstr(ajar_last_error(), nodir));
+
+	/* The target is a non-empty directory: the temporary is written, the
+	 * rename fails, and nothing but the directory remains. */
+	char *sub = join(dir, "sub");
+	assert_int_equal(mkdir(sub, 0755), 0);
+	char *inner = join(sub, "keep");
+	fclose(fopen(inner, "wb"));
+	assert_int_equal(ajar_write_exr(sub, px, 2, 2, NULL, 0), AJAR_ERROR_IO);
+	assert_non_null(strstr(ajar_last_error(), sub));
+	assert_int_equal(ajar_write_png(sub, px, 2, 2), AJAR_ERROR_IO);
+	assert_int_equal(count_entries(dir), 1);
+	assert_int_equal(count_entries(sub), 1);
+
+	/* A header attribute OpenEXR refuses (name too long) fails after the
+	 * temporary was created: it is removed, no target appears. */
+	char *out = join(dir, "out.exr");
+	char longname[300];
+	memset(longname, 'n', sizeof longname - 1);
+	longname[sizeof longname - 1] = '\0';
+	const char *attrs[] = {longname, "x"};
+	assert_int_not_equal(ajar_write_exr(out, px, 2, 2, attrs, 1), AJAR_OK);
+	assert_non_null(strstr(ajar_last_error(), out));
+	assert_false(file_exists(out));
+	assert_int_equal(count_entries(dir), 1);
+
+	assert_int_equal(ajar_write_exr(out, px, 0, 2, NULL, 0), AJAR_ERROR_INVALID_ARGUMENT);
+	assert_int_equal(ajar_write_png(out, px, 2, 0), AJAR_ERROR_INVALID_ARGUMENT);
+	assert_false(file_exists(out));
+
+	free(nodir);
+	free(sub);
+	free(inner);
+	free(out);
+	remove_tree(dir);
+	free(dir);
+}
+
+/* ---- PNG ------------------------------------------------------------------ */
+
+static uint32_t be32(const unsigned char *p)
+{
+	return (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | p[3];
+}
+
+/* Reverses any of PNG's five filters on 3-byte pixels, in place. */
+static void png_unfilter(unsigned char *rows, uint32_t width, uint32_t height)
+{
+	size_t stride = (size_t)width * 3;
+	for (uint32_t y = 0; y < height; y++) {
+		unsigned char *r = rows + y * (stride + 1);
+		unsigned char *up = y ? rows + (y - 1) * (stride + 1) + 1 : NULL;
+		int type = r[0];
+		assert_in_range(type, 0, 4);
+		unsigned char *cur = r + 1;
+		for (size_t i = 0; i < stride; i++) {
+			int a = i >= 3 ? cur[i - 3] : 0, b = up ? up[i] : 0, c = (up && i >= 3) ? up[i - 3] : 0;
+			int pred = 0;
+			if (type == 1)
+				pred = a;
+			else if (type == 2)
+				pred = b;
+			else if (type == 3)
+				pred = (a + b) / 2;
+			else if (type == 4) {
+				int p = a + b - c, pa = abs(p - a), pb = abs(p - b), pc = abs(p - c);
+				pred = (pa <= pb && pa <= pc) ? a : (pb <= pc ? b : c);
+			}
+			cur[i] = (unsigned char)(cur[i] + pred);
+		}
+	}
+}
+
+static void test_png(void **state)
+{
+	char *dir = test_tmpdir();
+	char *path = join(dir, "small.png");
+	enum { W = 3, H = 2 };
+	/* Linear values and their sRGB 8-bit codes, worked out by hand:
+	 * 0.5 -> 1.055 * 0.5^(1/2.4) - 0.055 = 0.7354 -> 188; 0.2 -> 124;
+	 * 0.18 -> 118; 0.001 -> 12.92 * 0.001 = 0.0129 -> 3 (linear segment). */
+	const float px[4 * W * H] = {
+		0.0f, 1.0f, 0.5f, 1,   2.0f, -1.0f, NAN, 0,        0.001f, 0.2f, 0.18f, 1,
+		INFINITY, -INFINITY, 0.5f, 1, 0.18f, 0.18f, 0.18f, 1, 1.0f, 0.001f, 0.2f, 0.5f};
+	const unsigned char expect[3 * W * H] = {0, 255, 188, 255, 0, 0, 3, 124, 118,
+						 255, 0, 188, 118, 118, 118, 255, 3, 124};
+	assert_int_equal(ajar_write_png(path, px, W, H), AJAR_OK);
+	assert_int_equal(count_entries(dir), 1);
+
+	FILE *f = fopen(path, "rb");
+	assert_non_null(f);
+	unsigned char buf[4096];
+	size_t n = fread(buf, 1, sizeof buf, f);
+	fclose(f);
+	static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+	assert_true(n > 8);
+	assert_memory_equal(buf, sig, 8);
+
+	unsigned char idat[4096];
+	size_t nidat = 0, pos = 8;
+	int chunks = 0, seen_end = 0;
+	while (pos + 12 <= n) {
+		uint32_t len = be32(buf + pos);
+		const unsigned char *type = buf + pos + 4, *data = buf + pos + 8;
+		assert_true(pos + 12 + len <= n);
+		uLong crc = crc32(crc32(0L, Z_NULL, 0), type, 4 + len);
+		assert_int_equal(be32(data + len), (uint32_t)crc);
+		if (chunks == 0) {
+			assert_memory_equal(type, "IHDR", 4);
+			assert_int_equal(len, 13);
+			assert_int_equal(be32(data), W);
+			assert_int_equal(be32(data + 4), H);
+			assert_int_equal(data[8], 8);  /* bit depth */
+			assert_int_equal(data[9], 2);  /* RGB */
+			assert_int_equal(data[12], 0); /* not interlaced */
+		}
+		if (!memcmp(type, "IDAT", 4)) {
+			memcpy(idat + nidat, data, len);
+			nidat += len;
+		}
+		chunks++;
+		pos += 12 + len;
+		if (!memcmp(type, "IEND", 4)) {
+			seen_end = 1;
+			break;
+		}
+	}
+	assert_true(seen_end);
+	assert_int_equal(pos, n); /* nothing after IEND */
+
+	unsigned char rows[H * (1 + 3 * W) + 16];
+	uLongf rows_len = sizeof rows;
+	assert_int_equal(uncompress(rows, &rows_len, idat, nidat), Z_OK);
+	assert_int_equal(rows_len, H * (1 + 3 * W));
+	png_unfilter(rows, W, H);
+	for (int y = 0; y < H; y++)
+		assert_memory_equal(rows + y * (1 + 3 * W) + 1, expect + y * 3 * W, 3 * W);
+
+	free(path);
+	remove_tree(dir);
+	free(dir);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_roundtrip_bit_exact),
+		cmocka_unit_test(test_read_mixed_types),
+		cmocka_unit_test(test_read_tiled_y),
+		cmocka_unit_test(test_read_errors),
+		cmocka_unit_test(test_write_errors),
+		cmocka_unit_test(test_png),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
