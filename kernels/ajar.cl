@@ -9,9 +9,11 @@
 
 /* One work-item per pixel: samples [sample_first, sample_first + count) of
  * that pixel, added in fixed point to accum (3 longs per pixel; the pixel
- * is owned by this work-item, so no atomics). */
+ * is owned by this work-item, so no atomics). Light paths that reach the
+ * camera (t = 1) land in other pixels: they go to `splat` with 64-bit
+ * atomic adds. The host divides both by the samples per pixel. */
 __kernel void render_pass(AJAR_SCENE_BUFFERS(AJAR_KERNEL_ARG) __global long *accum,
-			  uint sample_first, uint sample_count)
+			  __global long *splat, uint sample_first, uint sample_count)
 {
 	SceneView sc;
 	AJAR_SCENE_BUFFERS(AJAR_VIEW_INIT)

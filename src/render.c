@@ -20,6 +20,7 @@
 #include "prepare.h"
 #include "scene.h"
 #include "upload.h"
+#include "../kernels/film.h"
 
 #define PASS_SECONDS 0.25
 #define DEFAULT_WIDTH 512
@@ -32,7 +33,7 @@ struct ajar_renderer {
 	cl_kernel k_render;
 	SceneBuffers bufs;
 	cl_uint arg_first; /* index of the render kernel's first non-scene argument */
-	cl_mem accum;
+	cl_mem accum, splat; /* fixed-point films: own pixel, and atomic splats */
 	uint32_t width, height;
 	uint32_t spp_done, spp_target;
 	double time_limit, elapsed;
@@ -40,7 +41,7 @@ struct ajar_renderer {
 	uint32_t seed, max_depth;
 	char scene_name[256];
 	atomic_int cancel;
-	long *film; /* host copy of accum */
+	long *film, *film_splat; /* host copies */
 };
 
 static double seconds(void)
@@ -99,11 +100,14 @@ static ajar_status upload(ajar_renderer *r)
 	    (st = upload_bind(d, r->k_render, &r->bufs, &r->arg_first)) != AJAR_OK)
 		return st;
 	size_t film_bytes = sizeof(cl_long) * 3 * (size_t)r->width * r->height;
-	if ((st = device_buffer(d, CL_MEM_READ_WRITE, film_bytes, NULL, &r->accum)) != AJAR_OK)
-		return st;
 	cl_long zero = 0;
+	if ((st = device_buffer(d, CL_MEM_READ_WRITE, film_bytes, NULL, &r->accum)) != AJAR_OK ||
+	    (st = device_buffer(d, CL_MEM_READ_WRITE, film_bytes, NULL, &r->splat)) != AJAR_OK)
+		return st;
 	CL_TRY(d, clEnqueueFillBuffer(d->queue, r->accum, &zero, sizeof zero, 0, film_bytes, 0, NULL, NULL));
+	CL_TRY(d, clEnqueueFillBuffer(d->queue, r->splat, &zero, sizeof zero, 0, film_bytes, 0, NULL, NULL));
 	CL_TRY(d, clSetKernelArg(r->k_render, r->arg_first, sizeof(cl_mem), &r->accum));
+	CL_TRY(d, clSetKernelArg(r->k_render, r->arg_first + 1, sizeof(cl_mem), &r->splat));
 	CL_TRY(d, clFinish(d->queue));
 	return AJAR_OK;
 }
@@ -151,7 +155,8 @@ ajar_status ajar_renderer_create(const ajar_scene *scene, const ajar_options *op
 	if ((st = upload(r)) != AJAR_OK)
 		goto fail;
 	r->film = calloc(3 * (size_t)r->width * r->height, sizeof *r->film);
-	if (!r->film) {
+	r->film_splat = calloc(3 * (size_t)r->width * r->height, sizeof *r->film_splat);
+	if (!r->film || !r->film_splat) {
 		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory for a %ux%u image", r->width, r->height);
 		goto fail;
 	}
@@ -172,11 +177,14 @@ void ajar_renderer_destroy(ajar_renderer **rp)
 	upload_free(&r->bufs);
 	if (r->accum)
 		clReleaseMemObject(r->accum);
+	if (r->splat)
+		clReleaseMemObject(r->splat);
 	if (r->k_render)
 		clReleaseKernel(r->k_render);
 	device_close(&r->dev);
 	prepare_free(&r->data);
 	free(r->film);
+	free(r->film_splat);
 	free(r);
 	*rp = NULL;
 }
@@ -195,8 +203,8 @@ static ajar_status run_pass(ajar_renderer *r, uint32_t count)
 {
 	Device *d = &r->dev;
 	cl_uint first = r->spp_done, n = count;
-	CL_TRY(d, clSetKernelArg(r->k_render, r->arg_first + 1, sizeof first, &first));
-	CL_TRY(d, clSetKernelArg(r->k_render, r->arg_first + 2, sizeof n, &n));
+	CL_TRY(d, clSetKernelArg(r->k_render, r->arg_first + 2, sizeof first, &first));
+	CL_TRY(d, clSetKernelArg(r->k_render, r->arg_first + 3, sizeof n, &n));
 	size_t global = (size_t)r->width * r->height;
 	CL_TRY(d, clEnqueueNDRangeKernel(d->queue, r->k_render, 1, NULL, &global, NULL, 0, NULL, NULL));
 	CL_TRY(d, clFinish(d->queue));
@@ -267,10 +275,12 @@ ajar_status ajar_renderer_image(ajar_renderer *r, float *rgba, uint32_t *width, 
 	size_t npix = (size_t)r->width * r->height;
 	CL_TRY(&r->dev, clEnqueueReadBuffer(r->dev.queue, r->accum, CL_TRUE, 0, sizeof(cl_long) * 3 * npix,
 					    r->film, 0, NULL, NULL));
-	double scale = r->spp_done ? 1.0 / (1048576.0 * r->spp_done) : 0.0;
+	CL_TRY(&r->dev, clEnqueueReadBuffer(r->dev.queue, r->splat, CL_TRUE, 0, sizeof(cl_long) * 3 * npix,
+					    r->film_splat, 0, NULL, NULL));
+	double scale = r->spp_done ? 1.0 / ((double)FILM_SCALE * r->spp_done) : 0.0;
 	for (size_t i = 0; i < npix; i++) {
 		for (int c = 0; c < 3; c++)
-			rgba[4 * i + c] = (float)((double)r->film[3 * i + c] * scale);
+			rgba[4 * i + c] = (float)((double)(r->film[3 * i + c] + r->film_splat[3 * i + c]) * scale);
 		rgba[4 * i + 3] = 1.0f;
 	}
 	return AJAR_OK;

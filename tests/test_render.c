@@ -7,7 +7,10 @@
  *
  * Tolerances come from the renders' own noise: an independent second
  * render estimates each pixel's variance, so a threshold in units of the
- * predicted standard error stays meaningful whatever the sample count. */
+ * predicted standard error stays meaningful whatever the sample count.
+ * Furnace means must lie within 4 standard errors (a false alarm once in
+ * ~16000 runs per check); the standard error comes from the spread of the
+ * pixels, which share one expected value. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -103,12 +106,13 @@ static void test_furnace_convex(void **state)
 	add_cube(s, mat, 0.0f, 1.0f, 0);
 	assert_int_equal(ajar_scene_set_environment_color(s, sky), AJAR_OK);
 	set_camera(s, 0.3f, 0.4f, 5.0f, 0.9f);
-	float *img = render(s, 48, 48, 64, 1, 64);
+	float *img = render(s, 48, 48, 512, 1, 64);
 	for (int c = 0; c < 3; c++) {
 		double mean, sem;
 		block_stats(img, 48, 16, 16, 16, c, &mean, &sem);
 		double want = 0.6 * sky[c];
-		if (fabs(mean - want) > 5 * sem + 1e-5)
+		print_message("furnace convex, channel %d: %.5f +- %.5f, want %.5f\n", c, mean, sem, want);
+		if (fabs(mean - want) > 4 * sem + 1e-5)
 			fail_msg("channel %d: cube radiance %.5f +- %.5f, want %.5f", c, mean, sem, want);
 		/* The corner sees the sky directly: exact. */
 		assert_float_equal(img[c], sky[c], 1e-5);
@@ -134,12 +138,13 @@ static void test_furnace_closed(void **state)
 	assert_int_equal(ajar_scene_add_material(s, &m, &mat), AJAR_OK);
 	add_cube(s, mat, 0.0f, 1.0f, 1);
 	set_camera(s, 0.2f, -0.1f, 0.5f, 1.2f);
-	float *img = render(s, 32, 32, 64, 3, depth);
+	float *img = render(s, 32, 32, 512, 3, depth);
 	double want = Le * (1 - pow(rho, depth)) / (1 - rho);
 	for (int c = 0; c < 3; c++) {
 		double mean, sem;
 		block_stats(img, 32, 0, 0, 32, c, &mean, &sem);
-		if (fabs(mean - want) > 5 * sem + 1e-5)
+		print_message("furnace closed, channel %d: %.5f +- %.5f, want %.5f\n", c, mean, sem, want);
+		if (fabs(mean - want) > 4 * sem + 1e-5)
 			fail_msg("channel %d: furnace %.5f +- %.5f, want %.5f", c, mean, sem, want);
 	}
 	free(img);
