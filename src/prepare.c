@@ -90,11 +90,11 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	d->emitters = d->lights.emitters;
 	d->n_emitters = d->lights.nemitters;
 	d->emitter_cdf = d->lights.emitter_cdf;
-	d->n_emitter_cdf = d->lights.nemitters ? d->lights.nemitters + 1 : 0;
+	d->n_emitter_cdf = d->lights.nemitters + 1; /* sample_cdf reads cdf[n] even for n = 0 */
 	d->env = d->lights.env;
 	d->n_env = d->lights.nenv;
 	d->portal_cdf = d->lights.portal_cdf;
-	d->n_portal_cdf = d->lights.nportals ? d->lights.nportals + 1 : 0;
+	d->n_portal_cdf = d->lights.nportals + 1;
 
 	Params *p = d->params;
 	d->n_params = 1;

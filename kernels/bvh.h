@@ -1,0 +1,212 @@
+/* bvh.h — ray queries against the flattened BVH (built by src/bvh.c) and
+ * the small geometry helpers that go with them.
+ *
+ * Triangles are tested with the watertight algorithm of Woop, Benthin and
+ * Wald (JCGT 2013), two-sided, so a ray through a shared edge or vertex
+ * cannot slip between neighbours. Traversal is iterative with a fixed stack
+ * (the builder bounds the tree depth by BVH_MAX_DEPTH = BVH_STACK_SIZE),
+ * visits the nearer child first, and widens box exits by 2 gamma(3) so the
+ * box test never rejects a triangle hit the exact test accepts (Ize 2013,
+ * "Robust BVH ray traversal"). */
+#ifndef AJAR_KERNEL_BVH_H
+#define AJAR_KERNEL_BVH_H
+#include "types.h"
+
+#define BVH_STACK_SIZE 64
+
+typedef struct {
+	float t;
+	float u, v; /* barycentrics of p1 and p2 */
+	int tri;
+} Hit;
+
+/* Per-ray constants of the watertight test and of the slab test. */
+typedef struct {
+	V3 o;
+	V3 inv_d;       /* 1/d; +inf for a zero component */
+	int kx, ky, kz; /* kz: dominant axis of d; kx, ky keep the winding */
+	float sx, sy, sz;
+} RayPre;
+
+INLINE RayPre ray_pre(V3 o, V3 d)
+{
+	RayPre r;
+	r.o = o;
+	/* A zero component gives +inf (never -inf: -0 becomes +0), which
+	 * box_slab relies on; a finite stand-in would cut the slab short. */
+	r.inv_d = v3(1.0f / (d.x == 0.0f ? 0.0f : d.x), 1.0f / (d.y == 0.0f ? 0.0f : d.y),
+		     1.0f / (d.z == 0.0f ? 0.0f : d.z));
+	float ax = fabs(d.x), ay = fabs(d.y), az = fabs(d.z);
+	r.kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
+	r.kx = r.kz == 2 ? 0 : r.kz + 1;
+	r.ky = r.kx == 2 ? 0 : r.kx + 1;
+	float dz = v3_comp(d, r.kz);
+	if (dz < 0.0f) {
+		int k = r.kx;
+		r.kx = r.ky;
+		r.ky = k;
+	}
+	r.sx = v3_comp(d, r.kx) / dz;
+	r.sy = v3_comp(d, r.ky) / dz;
+	r.sz = 1.0f / dz;
+	return r;
+}
+
+/* Watertight ray/triangle test. On a hit with 0 < t < tmax writes t and
+ * the barycentrics of p1 (u) and p2 (v) and returns 1. */
+INLINE int tri_intersect(const RayPre *r, GLOBAL const Tri *tri, float tmax, float *t, float *u,
+			 float *v)
+{
+	V3 a = v3_sub(tri->p0, r->o), b = v3_sub(tri->p1, r->o), c = v3_sub(tri->p2, r->o);
+	float az = v3_comp(a, r->kz), bz = v3_comp(b, r->kz), cz = v3_comp(c, r->kz);
+	float ax = v3_comp(a, r->kx) - r->sx * az, ay = v3_comp(a, r->ky) - r->sy * az;
+	float bx = v3_comp(b, r->kx) - r->sx * bz, by = v3_comp(b, r->ky) - r->sy * bz;
+	float cx = v3_comp(c, r->kx) - r->sx * cz, cy = v3_comp(c, r->ky) - r->sy * cz;
+	/* Edge functions: e0 weighs p0, e1 p1, e2 p2. Zero counts as inside,
+	 * so a ray exactly through an edge hits both neighbours, never none. */
+	float e0 = cx * by - cy * bx;
+	float e1 = ax * cy - ay * cx;
+	float e2 = bx * ay - by * ax;
+	if ((e0 < 0.0f || e1 < 0.0f || e2 < 0.0f) && (e0 > 0.0f || e1 > 0.0f || e2 > 0.0f))
+		return 0;
+	float det = e0 + e1 + e2;
+	if (det == 0.0f)
+		return 0;
+	float tt = (e0 * az + e1 * bz + e2 * cz) * r->sz;
+	if (det > 0.0f ? tt <= 0.0f : tt >= 0.0f) /* behind the origin: skip the divide */
+		return 0;
+	float inv = 1.0f / det;
+	float th = tt * inv;
+	if (!(th > 0.0f && th < tmax))
+		return 0;
+	*t = th;
+	*u = e1 * inv;
+	*v = e2 * inv;
+	return 1;
+}
+
+/* One slab of the box test, narrowing [*tn, *tf]. Written with
+ * comparisons, not fmin/fmax, so the NaN of 0 * inf (origin exactly on the
+ * plane of a slab the ray runs parallel to) leaves the interval alone: the
+ * ray is then inside that slab (pbrt's Bounds3::IntersectP). The far
+ * distance grows by 1 + 2 gamma(3) against rounding (Ize 2013). */
+INLINE void box_slab(float lo, float hi, float o, float inv_d, float *tn, float *tf)
+{
+	float a = (lo - o) * inv_d, b = (hi - o) * inv_d;
+	if (a > b) {
+		float t = a;
+		a = b;
+		b = t;
+	}
+	b *= 1.00000036f;
+	*tn = a > *tn ? a : *tn;
+	*tf = b < *tf ? b : *tf;
+}
+
+/* Entry distance of the ray into the node's box within [0, tmax], or -1.
+ * tmax is widened a little too: the triangle test and the slab test round
+ * differently, and a triangle whose computed distance lies a few ulps below
+ * the current closest hit must still be visited, or coplanar and touching
+ * triangles could return a hit a few ulps farther than the closest. */
+INLINE float box_enter(const RayPre *r, GLOBAL const BvhNode *n, float tmax)
+{
+	float tn = 0.0f, tf = tmax * 1.00001f;
+	box_slab(n->bmin.x, n->bmax.x, r->o.x, r->inv_d.x, &tn, &tf);
+	box_slab(n->bmin.y, n->bmax.y, r->o.y, r->inv_d.y, &tn, &tf);
+	box_slab(n->bmin.z, n->bmax.z, r->o.z, r->inv_d.z, &tn, &tf);
+	return tn <= tf ? tn : -1.0f;
+}
+
+/* Closest hit with 0 < t < tmax (any_hit = 0), or the first hit found
+ * (any_hit = 1). Shared by the two queries so the kernel holds one copy. */
+INLINE int bvh_traverse(const SceneView *sc, V3 o, V3 d, float tmax, int any_hit, Hit *hit)
+{
+	RayPre r = ray_pre(o, d);
+	int stack[BVH_STACK_SIZE];
+	int sp = 0;
+	int found = 0;
+	GLOBAL const BvhNode *nodes = sc->nodes;
+	if (box_enter(&r, &nodes[0], tmax) < 0.0f)
+		return 0;
+	int node = 0;
+	for (;;) {
+		GLOBAL const BvhNode *n = &nodes[node];
+		if (n->count > 0) {
+			for (int i = n->index; i < n->index + n->count; i++) {
+				float t, u, v;
+				if (tri_intersect(&r, &sc->tris[i], tmax, &t, &u, &v)) {
+					found = 1;
+					tmax = t;
+					hit->t = t;
+					hit->u = u;
+					hit->v = v;
+					hit->tri = i;
+					if (any_hit)
+						return 1;
+				}
+			}
+		} else {
+			int left = node + 1, right = n->index;
+			float tl = box_enter(&r, &nodes[left], tmax);
+			float tr = box_enter(&r, &nodes[right], tmax);
+			if (tl >= 0.0f && tr >= 0.0f) {
+				int near_first = tl <= tr;
+				stack[sp++] = near_first ? right : left;
+				node = near_first ? left : right;
+				continue;
+			}
+			if (tl >= 0.0f) {
+				node = left;
+				continue;
+			}
+			if (tr >= 0.0f) {
+				node = right;
+				continue;
+			}
+		}
+		if (sp == 0)
+			break;
+		node = stack[--sp];
+	}
+	return found;
+}
+
+/* Closest hit with 0 < t < tmax; returns 1 if there is one. */
+INLINE int bvh_intersect(const SceneView *sc, V3 o, V3 d, float tmax, Hit *hit)
+{
+	return bvh_traverse(sc, o, d, tmax, 0, hit);
+}
+
+/* Whether anything lies on the ray with 0 < t < tmax. */
+INLINE int bvh_occluded(const SceneView *sc, V3 o, V3 d, float tmax)
+{
+	Hit h;
+	return bvh_traverse(sc, o, d, tmax, 1, &h);
+}
+
+/* Unnormalized geometric normal; its side is the CCW front face. */
+INLINE V3 tri_normal(GLOBAL const Tri *t)
+{
+	return v3_cross(v3_sub(t->p1, t->p0), v3_sub(t->p2, t->p0));
+}
+
+/* Spawn point for a ray leaving surface point p in direction d: p moved
+ * off the surface along the geometric normal ng (any length), to d's side,
+ * by a few ulps of p's coordinates, or by a fixed small distance near the
+ * origin where ulps vanish (Waechter and Binder, Ray Tracing Gems ch. 6). */
+INLINE V3 ray_offset(V3 p, V3 ng, V3 d)
+{
+	V3 n = v3_norm(v3_dot(ng, d) < 0.0f ? v3_neg(ng) : ng);
+	const float origin = 1.0f / 32.0f, float_scale = 1.0f / 65536.0f, int_scale = 256.0f;
+	int ox = (int)(int_scale * n.x), oy = (int)(int_scale * n.y), oz = (int)(int_scale * n.z);
+	/* Adding to the bit pattern moves away from zero, so negative
+	 * coordinates take the opposite offset. */
+	float px = u2f(f2u(p.x) + (uint)(p.x < 0.0f ? -ox : ox));
+	float py = u2f(f2u(p.y) + (uint)(p.y < 0.0f ? -oy : oy));
+	float pz = u2f(f2u(p.z) + (uint)(p.z < 0.0f ? -oz : oz));
+	return v3(fabs(p.x) < origin ? p.x + float_scale * n.x : px,
+		  fabs(p.y) < origin ? p.y + float_scale * n.y : py,
+		  fabs(p.z) < origin ? p.z + float_scale * n.z : pz);
+}
+
+#endif

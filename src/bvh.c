@@ -1,0 +1,321 @@
+/* bvh.c — binned SAH build of the flattened BVH (see bvh.h).
+ *
+ * Top-down, one node at a time from an explicit stack (no recursion, so a
+ * million triangles or a pathological input cannot overflow the C stack).
+ * Each node bins its triangles' centroids into BVH_BINS bins on each axis
+ * and takes the cheapest surface-area-heuristic split (Wald 2007, "On fast
+ * construction of SAH-based bounding volume hierarchies"). Where SAH cannot
+ * split (all centroids equal, or every centroid in one bin) or the tree is
+ * getting deep, an object-median split halves the node instead, which keeps
+ * the depth within BVH_MAX_DEPTH whatever the input. Nodes are written
+ * depth-first: a node's left child is always the next node. */
+#include "bvh.h"
+
+#include <float.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "error.h"
+#include "../kernels/bvh.h"
+
+/* Traversal pushes at most one node per interior level. */
+_Static_assert(BVH_MAX_DEPTH <= BVH_STACK_SIZE, "kernels/bvh.h: traversal stack too small");
+
+#define BVH_BINS 32
+#define BVH_MAX_LEAF 4
+/* Traversal cost relative to one triangle test. */
+#define BVH_COST_TRAVERSE 1.0f
+/* From this depth on only median splits: each halves the node, so even
+ * 2^32 triangles in leaves of BVH_MAX_LEAF need at most 30 more levels. */
+#define BVH_MEDIAN_DEPTH (BVH_MAX_DEPTH - 32)
+
+typedef struct {
+	float lo[3], hi[3];
+} Box;
+
+/* A triangle's bounds and where it came from; the build permutes these. */
+typedef struct {
+	Box b;
+	uint32_t idx;
+} Ref;
+
+typedef struct {
+	uint32_t start, end;
+	uint32_t parent; /* node whose right child this is, or NO_PARENT */
+	uint32_t depth;
+} Task;
+
+#define NO_PARENT UINT32_MAX
+
+static void box_empty(Box *b)
+{
+	for (int a = 0; a < 3; a++) {
+		b->lo[a] = FLT_MAX;
+		b->hi[a] = -FLT_MAX;
+	}
+}
+
+static void box_grow(Box *b, const Box *o)
+{
+	for (int a = 0; a < 3; a++) {
+		if (o->lo[a] < b->lo[a])
+			b->lo[a] = o->lo[a];
+		if (o->hi[a] > b->hi[a])
+			b->hi[a] = o->hi[a];
+	}
+}
+
+/* Half the surface area; 0 for an empty box. */
+static float box_area(const Box *b)
+{
+	float d[3];
+	for (int a = 0; a < 3; a++) {
+		d[a] = b->hi[a] - b->lo[a];
+		if (d[a] < 0.0f)
+			return 0.0f;
+	}
+	return d[0] * d[1] + d[1] * d[2] + d[2] * d[0];
+}
+
+/* Centroid times two: only compared, never used as a position. */
+static float ref_key(const Ref *r, int axis) { return r->b.lo[axis] + r->b.hi[axis]; }
+
+static int bin_of(float key, float cmin, float scale, int nbins)
+{
+	int k = (int)((key - cmin) * scale);
+	return k < 0 ? 0 : (k >= nbins ? nbins - 1 : k);
+}
+
+/* Reorders r[0, n) so that r[k] has the k-th smallest key on `axis` and
+ * nothing before it is larger (Hoare partition, median-of-three pivot;
+ * stops on equal keys, so all-equal input stays linear). */
+static void select_nth(Ref *r, uint32_t n, uint32_t k, int axis)
+{
+	uint32_t lo = 0, hi = n - 1;
+	while (hi > lo) {
+		float a = ref_key(&r[lo], axis), b = ref_key(&r[lo + (hi - lo) / 2], axis);
+		float c = ref_key(&r[hi], axis);
+		float pivot = a < b ? (b < c ? b : (a < c ? c : a)) : (a < c ? a : (b < c ? c : b));
+		uint32_t i = lo, j = hi;
+		while (i <= j) {
+			while (ref_key(&r[i], axis) < pivot)
+				i++;
+			while (ref_key(&r[j], axis) > pivot)
+				j--;
+			if (i <= j) {
+				Ref t = r[i];
+				r[i] = r[j];
+				r[j] = t;
+				i++;
+				if (j == 0)
+					break;
+				j--;
+			}
+		}
+		if (k <= j)
+			hi = j;
+		else if (k >= i)
+			lo = i;
+		else
+			break;
+	}
+}
+
+/* Chooses a split of refs[0, n) with bounds `box` and centroid bounds
+ * `cbox`. Returns the number of refs put on the left (refs reordered), or
+ * 0 to make a leaf. */
+static uint32_t split_node(Ref *refs, uint32_t n, const Box *box, const Box *cbox, uint32_t depth)
+{
+	int axis = 0;
+	float ext[3];
+	for (int a = 0; a < 3; a++) {
+		ext[a] = cbox->hi[a] - cbox->lo[a];
+		if (ext[a] > ext[axis])
+			axis = a;
+	}
+	if (n <= 1)
+		return 0;
+	if (ext[axis] <= 0.0f) /* all centroids equal: any halving will do */
+		return n <= BVH_MAX_LEAF ? 0 : n / 2;
+
+	if (depth < BVH_MEDIAN_DEPTH) {
+		/* Small nodes get fewer bins: the sweep below costs per bin, and
+		 * most nodes are small. */
+		int nb = n < BVH_BINS ? (int)n : BVH_BINS;
+		uint32_t count[3][BVH_BINS] = {{0}};
+		Box bins[3][BVH_BINS];
+		float scale[3];
+		for (int a = 0; a < 3; a++) {
+			scale[a] = ext[a] > 0.0f ? (float)nb / ext[a] : 0.0f;
+			for (int k = 0; k < nb; k++)
+				box_empty(&bins[a][k]);
+		}
+		for (uint32_t i = 0; i < n; i++) {
+			for (int a = 0; a < 3; a++) {
+				int k = bin_of(ref_key(&refs[i], a), cbox->lo[a], scale[a], nb);
+				count[a][k]++;
+				box_grow(&bins[a][k], &refs[i].b);
+			}
+		}
+		/* Costs in units of one triangle test times the parent's area, so
+		 * a zero-area node still compares splits consistently. */
+		float best_cost = FLT_MAX;
+		int best_axis = -1, best_bin = 0;
+		for (int a = 0; a < 3; a++) {
+			if (ext[a] <= 0.0f)
+				continue;
+			float right_area[BVH_BINS];
+			uint32_t right_count[BVH_BINS];
+			Box acc;
+			box_empty(&acc);
+			uint32_t cnt = 0;
+			for (int k = nb - 1; k > 0; k--) {
+				box_grow(&acc, &bins[a][k]);
+				cnt += count[a][k];
+				right_area[k] = box_area(&acc);
+				right_count[k] = cnt;
+			}
+			box_empty(&acc);
+			cnt = 0;
+			for (int k = 0; k < nb - 1; k++) {
+				box_grow(&acc, &bins[a][k]);
+				cnt += count[a][k];
+				if (cnt == 0 || right_count[k + 1] == 0)
+					continue;
+				float cost = box_area(&acc) * (float)cnt +
+					     right_area[k + 1] * (float)right_count[k + 1];
+				if (cost < best_cost) {
+					best_cost = cost;
+					best_axis = a;
+					best_bin = k;
+				}
+			}
+		}
+		if (best_axis >= 0) {
+			float area = box_area(box);
+			if (n <= BVH_MAX_LEAF && (float)n * area <= BVH_COST_TRAVERSE * area + best_cost)
+				return 0;
+			uint32_t i = 0, j = n;
+			while (i < j) {
+				if (bin_of(ref_key(&refs[i], best_axis), cbox->lo[best_axis],
+					   scale[best_axis], nb) <= best_bin) {
+					i++;
+				} else {
+					Ref t = refs[i];
+					refs[i] = refs[--j];
+					refs[j] = t;
+				}
+			}
+			return i; /* both sides non-empty by construction of the bins */
+		}
+		/* Every centroid fell into one bin (float rounding on a tiny
+		 * extent): fall through to the median. */
+	}
+	if (n <= BVH_MAX_LEAF)
+		return 0;
+	select_nth(refs, n, n / 2, axis);
+	return n / 2;
+}
+
+static void node_set_box(BvhNode *node, const Box *b)
+{
+	node->bmin = v3(b->lo[0], b->lo[1], b->lo[2]);
+	node->bmax = v3(b->hi[0], b->hi[1], b->hi[2]);
+}
+
+ajar_status bvh_build(const Tri *tris, uint32_t ntris, Bvh *out)
+{
+	memset(out, 0, sizeof(*out));
+	if (ntris == 0)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "bvh_build: no triangles");
+
+	size_t max_nodes = 2 * (size_t)ntris - 1;
+	Ref *refs = malloc(sizeof(Ref) * ntris);
+	out->nodes = malloc(sizeof(BvhNode) * max_nodes);
+	out->order = malloc(sizeof(uint32_t) * ntris);
+	if (!refs || !out->nodes || !out->order) {
+		free(refs);
+		bvh_free(out);
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for %u triangles",
+			       ntris);
+	}
+	for (uint32_t i = 0; i < ntris; i++) {
+		const Tri *t = &tris[i];
+		Box *b = &refs[i].b;
+		b->lo[0] = fmin(t->p0.x, fmin(t->p1.x, t->p2.x));
+		b->lo[1] = fmin(t->p0.y, fmin(t->p1.y, t->p2.y));
+		b->lo[2] = fmin(t->p0.z, fmin(t->p1.z, t->p2.z));
+		b->hi[0] = fmax(t->p0.x, fmax(t->p1.x, t->p2.x));
+		b->hi[1] = fmax(t->p0.y, fmax(t->p1.y, t->p2.y));
+		b->hi[2] = fmax(t->p0.z, fmax(t->p1.z, t->p2.z));
+		refs[i].idx = i;
+	}
+
+	/* LIFO: a split pushes the right task, then the left, so the left
+	 * subtree is written completely before the right one starts. At most
+	 * one pending right sibling per level plus the current task. */
+	Task stack[BVH_MAX_DEPTH + 2];
+	int sp = 0;
+	uint32_t nnodes = 0, max_depth = 0;
+	stack[sp++] = (Task){0, ntris, NO_PARENT, 0};
+	while (sp > 0) {
+		Task task = stack[--sp];
+		uint32_t id = nnodes++;
+		if (task.parent != NO_PARENT)
+			out->nodes[task.parent].index = (int)id;
+		if (task.depth + 1 > max_depth)
+			max_depth = task.depth + 1;
+
+		Box box, cbox;
+		box_empty(&box);
+		box_empty(&cbox);
+		for (uint32_t i = task.start; i < task.end; i++) {
+			const Ref *r = &refs[i];
+			box_grow(&box, &r->b);
+			for (int a = 0; a < 3; a++) {
+				float k = ref_key(r, a);
+				if (k < cbox.lo[a])
+					cbox.lo[a] = k;
+				if (k > cbox.hi[a])
+					cbox.hi[a] = k;
+			}
+		}
+		BvhNode *node = &out->nodes[id];
+		node_set_box(node, &box);
+		uint32_t n = task.end - task.start;
+		uint32_t nleft = split_node(refs + task.start, n, &box, &cbox, task.depth);
+		if (nleft == 0) {
+			node->index = (int)task.start;
+			node->count = (int)n;
+			continue;
+		}
+		node->index = -1; /* patched when the right child is written */
+		node->count = 0;
+		uint32_t mid = task.start + nleft;
+		stack[sp++] = (Task){mid, task.end, id, task.depth + 1};
+		stack[sp++] = (Task){task.start, mid, NO_PARENT, task.depth + 1};
+	}
+	for (uint32_t i = 0; i < ntris; i++)
+		out->order[i] = refs[i].idx;
+	free(refs);
+
+	BvhNode *shrunk = realloc(out->nodes, sizeof(BvhNode) * nnodes);
+	if (shrunk)
+		out->nodes = shrunk;
+	out->nnodes = nnodes;
+	out->ntris = ntris;
+	out->depth = max_depth;
+	return AJAR_OK;
+}
+
+void bvh_free(Bvh *b)
+{
+	free(b->nodes);
+	free(b->order);
+	memset(b, 0, sizeof(*b));
+}
+
+size_t bvh_memory(const Bvh *b)
+{
+	return sizeof(BvhNode) * (size_t)b->nnodes + sizeof(uint32_t) * (size_t)b->ntris;
+}

@@ -1,0 +1,36 @@
+/* bvh.h — the bounding volume hierarchy over the scene's triangles, built
+ * on the host with binned SAH and flattened into the BvhNode array that
+ * kernels/bvh.h traverses (layout in kernels/types.h).
+ *
+ * The build reorders triangles so every leaf covers a contiguous range;
+ * `order` says where each reordered triangle came from, so the caller can
+ * permute Tri and TriShade the same way before upload. The tree is at most
+ * BVH_MAX_DEPTH levels deep, which the device's fixed traversal stack
+ * relies on. */
+#ifndef AJAR_BVH_H
+#define AJAR_BVH_H
+#include <stddef.h>
+#include <stdint.h>
+
+#include "ajar.h"
+#include "../kernels/types.h"
+
+/* Deepest root-to-leaf path, counted in nodes; the traversal stack
+ * (BVH_STACK_SIZE in kernels/bvh.h) holds one entry per interior level. */
+#define BVH_MAX_DEPTH 64
+
+typedef struct {
+	BvhNode *nodes;
+	uint32_t nnodes;
+	uint32_t *order; /* order[i] = original index of reordered triangle i */
+	uint32_t ntris;
+	uint32_t depth;  /* nodes on the longest root-to-leaf path */
+} Bvh;
+
+/* ntris >= 1. On failure *out is left empty (safe to bvh_free). */
+ajar_status bvh_build(const Tri *tris, uint32_t ntris, Bvh *out);
+void bvh_free(Bvh *b);
+/* Bytes of nodes + order. */
+size_t bvh_memory(const Bvh *b);
+
+#endif

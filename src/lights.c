@@ -1,0 +1,184 @@
+/* lights.c — builds the light tables of lights.h.
+ *
+ * Sums run in double so a few hundred thousand emitters or a large sky
+ * image still give a monotone CDF ending exactly at 1. Tables with nothing
+ * to weigh (an all-black row or image, zero-area portals) fall back to a
+ * uniform table or an empty one that sample_cdf refuses, never to NaN. */
+#include "lights.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "error.h"
+
+static float tri_area(V3 p0, V3 p1, V3 p2)
+{
+	return 0.5f * v3_len(v3_cross(v3_sub(p1, p0), v3_sub(p2, p0)));
+}
+
+/* cdf[0..n] from n non-negative weights (summed in double). With a zero
+ * total the table is uniform if `uniform_if_empty`, else all zeros (which
+ * sample_cdf treats as empty). Returns the total. */
+static double cdf_build(float *cdf, const double *w, uint32_t n, int uniform_if_empty)
+{
+	double total = 0.0;
+	for (uint32_t i = 0; i < n; i++)
+		total += w[i];
+	cdf[0] = 0.0f;
+	double acc = 0.0;
+	for (uint32_t i = 0; i < n; i++) {
+		acc += w[i];
+		if (total > 0.0)
+			cdf[i + 1] = (float)(acc / total);
+		else
+			cdf[i + 1] = uniform_if_empty ? (float)(i + 1) / (float)n : 0.0f;
+	}
+	if (n > 0 && (total > 0.0 || uniform_if_empty))
+		cdf[n] = 1.0f;
+	return total;
+}
+
+static ajar_status build_emitters(Tri *tris, uint32_t ntris, const Material *mats, LightTables *out)
+{
+	uint32_t n = 0;
+	for (uint32_t i = 0; i < ntris; i++) {
+		Tri *t = &tris[i];
+		t->emitter = -1;
+		if (v3_lum(mats[t->material].emission) > 0.0f && tri_area(t->p0, t->p1, t->p2) > 0.0f)
+			t->emitter = (int)n++;
+	}
+	out->nemitters = n;
+	out->emitters = calloc(n ? n : 1, sizeof(Emitter));
+	out->emitter_cdf = calloc((size_t)n + 1, sizeof(float));
+	double *power = calloc(n ? n : 1, sizeof(double));
+	if (!out->emitters || !out->emitter_cdf || !power) {
+		free(power);
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "lights: out of memory for %u emitters", n);
+	}
+	for (uint32_t i = 0; i < ntris; i++) {
+		const Tri *t = &tris[i];
+		if (t->emitter < 0)
+			continue;
+		Emitter *e = &out->emitters[t->emitter];
+		e->tri = (int)i;
+		e->area = tri_area(t->p0, t->p1, t->p2);
+		/* One-sided Lambertian emitter: exitance pi L over the area. */
+		power[t->emitter] = (double)e->area * AJAR_PI * v3_lum(mats[t->material].emission);
+	}
+	out->emitter_power = (float)cdf_build(out->emitter_cdf, power, n, 0);
+	for (uint32_t k = 0; k < n; k++)
+		out->emitters[k].pdf_select = out->emitter_cdf[k + 1] - out->emitter_cdf[k];
+	free(power);
+	return AJAR_OK;
+}
+
+/* Pixels x strength, then the marginal and conditional CDFs of
+ * luminance x sin(theta) at each row's centre (kernels/types.h). Returns
+ * the average radiance luminance over the sphere in *avg_lum. */
+static ajar_status build_env_image(const Scene *s, LightTables *out, double *avg_lum)
+{
+	uint32_t w = s->env_width, h = s->env_height;
+	out->nenv = ENV_FLOATS((size_t)w, (size_t)h);
+	out->env = malloc(sizeof(float) * out->nenv);
+	double *wt = malloc(sizeof(double) * (w > h ? w : h));
+	double *rows = malloc(sizeof(double) * h);
+	if (!out->env || !wt || !rows) {
+		free(wt);
+		free(rows);
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory for a %ux%u environment",
+			       s->source, w, h);
+	}
+	float *pix = out->env + ENV_PIXELS(w, h);
+	for (size_t i = 0; i < (size_t)w * h * 3; i++)
+		pix[i] = s->env_rgb[i] * s->env_strength;
+	double sum = 0.0;
+	for (uint32_t y = 0; y < h; y++) {
+		double sin_theta = sin(AJAR_PI * ((double)y + 0.5) / h);
+		for (uint32_t x = 0; x < w; x++) {
+			const float *p = pix + 3 * ((size_t)y * w + x);
+			float lum = v3_lum(v3(p[0], p[1], p[2]));
+			wt[x] = lum > 0.0f ? lum * sin_theta : 0.0;
+		}
+		float *cond = out->env + ENV_CONDITIONAL(w, h) + (size_t)y * (w + 1);
+		/* An all-black row is never picked (its marginal weight is 0),
+		 * but a uniform table keeps it well-formed. */
+		rows[y] = cdf_build(cond, wt, w, 1);
+		sum += rows[y];
+	}
+	cdf_build(out->env + ENV_MARGINAL(w, h), rows, h, 1);
+	/* Each texel spans (2 pi / w) x (pi / h) in (phi, theta). */
+	*avg_lum = sum * (2.0 * AJAR_PI / w) * (AJAR_PI / h) / (4.0 * AJAR_PI);
+	free(wt);
+	free(rows);
+	return AJAR_OK;
+}
+
+static ajar_status build_portals(PortalTri *portals, uint32_t n, LightTables *out)
+{
+	out->nportals = n;
+	out->portal_cdf = calloc((size_t)n + 1, sizeof(float));
+	double *area = calloc(n ? n : 1, sizeof(double));
+	if (!out->portal_cdf || !area) {
+		free(area);
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "lights: out of memory for %u portal triangles", n);
+	}
+	for (uint32_t i = 0; i < n; i++) {
+		portals[i].area = tri_area(portals[i].p0, portals[i].p1, portals[i].p2);
+		area[i] = portals[i].area;
+	}
+	cdf_build(out->portal_cdf, area, n, 0);
+	for (uint32_t i = 0; i < n; i++)
+		portals[i].pdf_select = out->portal_cdf[i + 1] - out->portal_cdf[i];
+	free(area);
+	return AJAR_OK;
+}
+
+ajar_status lights_build(const Scene *s, Tri *tris, uint32_t ntris, const Material *mats,
+			 PortalTri *portals, uint32_t nportal_tris, V3 scene_center, float scene_radius,
+			 LightTables *out)
+{
+	ajar_status st;
+	memset(out, 0, sizeof(*out));
+	if ((st = build_emitters(tris, ntris, mats, out)) != AJAR_OK ||
+	    (st = build_portals(portals, nportal_tris, out)) != AJAR_OK) {
+		lights_free(out);
+		return st;
+	}
+
+	double avg_lum = 0.0;
+	if (s->env_type == ENV_IMAGE) {
+		if ((st = build_env_image(s, out, &avg_lum)) != AJAR_OK) {
+			lights_free(out);
+			return st;
+		}
+	} else {
+		out->env = calloc(1, sizeof(float));
+		if (!out->env) {
+			lights_free(out);
+			return err_set(AJAR_ERROR_OUT_OF_MEMORY, "lights: out of memory");
+		}
+		if (s->env_type == ENV_COLOR)
+			avg_lum = fmax(v3_lum(s->env_color), 0.0f);
+	}
+	/* Power through a disk of the scene's radius, the cross-section a
+	 * light subpath leaving the environment starts from (design.md). */
+	out->env_power = (float)(AJAR_PI * (double)scene_radius * scene_radius * AJAR_PI * avg_lum);
+
+	if (s->env_type == ENV_NONE || !(out->env_power > 0.0f))
+		out->env_pdf_select = 0.0f;
+	else if (!(out->emitter_power > 0.0f))
+		out->env_pdf_select = 1.0f;
+	else
+		out->env_pdf_select = out->env_power / (out->env_power + out->emitter_power);
+	return AJAR_OK;
+}
+
+void lights_free(LightTables *t)
+{
+	free(t->emitters);
+	free(t->emitter_cdf);
+	free(t->env);
+	free(t->portal_cdf);
+	memset(t, 0, sizeof(*t));
+}

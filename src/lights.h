@@ -1,0 +1,45 @@
+/* lights.h — the host tables that light sampling reads on the device
+ * (kernels/lights.h): emissive triangles with a power CDF, the environment
+ * image with its 2-D CDF (layout in kernels/types.h), and the portal area
+ * CDF.
+ *
+ * All CDFs have n + 1 entries, cdf[0] = 0 and cdf[n] = 1 exactly, as
+ * sample_cdf (kernels/sampling.h) expects; every stored selection
+ * probability is the width cdf[i + 1] - cdf[i] itself, so a sample's
+ * probability and the pdf evaluated later agree to the bit. */
+#ifndef AJAR_LIGHTS_H
+#define AJAR_LIGHTS_H
+#include <stddef.h>
+#include <stdint.h>
+
+#include "ajar.h"
+#include "scene.h"
+
+typedef struct {
+	Emitter *emitters;
+	float *emitter_cdf;    /* nemitters + 1 (one float if none) */
+	uint32_t nemitters;
+	float emitter_power;   /* W: sum of area x pi x luminance(emission) */
+	/* ENV_IMAGE: ENV_FLOATS(w, h) floats, pixels already multiplied by the
+	 * strength (the kernels do not apply Params.env_strength again).
+	 * nenv = 0 for ENV_NONE / ENV_COLOR, with one float allocated so a
+	 * device buffer can exist. */
+	float *env;
+	size_t nenv;
+	float env_power;       /* W: pi R^2 x pi x average radiance luminance */
+	float *portal_cdf;     /* nportals + 1 (one float if none) */
+	uint32_t nportals;
+	float env_pdf_select;  /* probability that light sampling picks the environment */
+} LightTables;
+
+/* `tris` is the array as uploaded (BVH order): each triangle's `emitter`
+ * is set to its Emitter index or -1, and Emitter.tri indexes this array.
+ * `mats` has the scene's materials; `portals` (nportal_tris) get their
+ * area and pdf_select written. The environment comes from `s`. On failure
+ * *out is left empty (safe to lights_free). */
+ajar_status lights_build(const Scene *s, Tri *tris, uint32_t ntris, const Material *mats,
+			 PortalTri *portals, uint32_t nportal_tris, V3 scene_center, float scene_radius,
+			 LightTables *out);
+void lights_free(LightTables *t);
+
+#endif

@@ -1,0 +1,511 @@
+/* test_bvh.c — the BVH build (src/bvh.c) and traversal (kernels/bvh.h):
+ * structure invariants, closest hits identical to brute force over every
+ * triangle on random soups (uniform, clustered, coplanar, degenerate and
+ * sliver triangles, one triangle, all-identical triangles, a depth-hostile
+ * geometric progression) and on the shipped scenes, and any-hit agreeing
+ * with closest hit. Brute force uses the same triangle test, so hit
+ * distances must match exactly. */
+#include "testutil.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "bvh.h"
+#include "gltf.h"
+#include "scene.h"
+#include "../kernels/bvh.h"
+
+static uint64_t rng_state;
+
+static uint32_t rnd_u32(void)
+{
+	/* PCG32 (O'Neill), fixed seed per test. */
+	uint64_t old = rng_state;
+	rng_state = old * 6364136223846793005ULL + 1442695040888963407ULL;
+	uint32_t xs = (uint32_t)(((old >> 18) ^ old) >> 27), rot = (uint32_t)(old >> 59);
+	return (xs >> rot) | (xs << ((-rot) & 31));
+}
+
+static float rnd(void) { return (float)(rnd_u32() >> 8) * (1.0f / 16777216.0f); }
+static float rnd_range(float a, float b) { return a + (b - a) * rnd(); }
+
+/* Uniform in the box [lo, hi] (components drawn in a fixed order). */
+static V3 rnd_v3(V3 lo, V3 hi)
+{
+	V3 r;
+	r.x = rnd_range(lo.x, hi.x);
+	r.y = rnd_range(lo.y, hi.y);
+	r.z = rnd_range(lo.z, hi.z);
+	return r;
+}
+
+static V3 rnd_dir(void)
+{
+	float z = 1.0f - 2.0f * rnd(), phi = 2.0f * AJAR_PI * rnd();
+	float r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+	return v3(r * cosf(phi), r * sinf(phi), z);
+}
+
+static Tri make_tri(V3 a, V3 b, V3 c)
+{
+	Tri t;
+	memset(&t, 0, sizeof(t));
+	t.p0 = a;
+	t.p1 = b;
+	t.p2 = c;
+	t.emitter = -1;
+	return t;
+}
+
+/* Vertices within distance s of c (drawn in a fixed order). */
+static Tri rnd_tri_around(V3 c, float s)
+{
+	V3 a = v3_madd(c, rnd_dir(), s);
+	V3 b = v3_madd(c, rnd_dir(), s);
+	return make_tri(a, b, v3_madd(c, rnd_dir(), s));
+}
+
+/* A built BVH with the triangles reordered as the device would see them. */
+typedef struct {
+	Bvh bvh;
+	Tri *tris;
+	SceneView sc;
+	V3 lo, hi;
+} Built;
+
+static void built_make(const Tri *tris, uint32_t n, Built *b)
+{
+	memset(b, 0, sizeof(*b));
+	assert_int_equal(bvh_build(tris, n, &b->bvh), AJAR_OK);
+	b->tris = malloc(sizeof(Tri) * n);
+	assert_non_null(b->tris);
+	for (uint32_t i = 0; i < n; i++)
+		b->tris[i] = tris[b->bvh.order[i]];
+	b->sc.nodes = b->bvh.nodes;
+	b->sc.tris = b->tris;
+	b->lo = b->bvh.nodes[0].bmin;
+	b->hi = b->bvh.nodes[0].bmax;
+}
+
+static void built_free(Built *b)
+{
+	bvh_free(&b->bvh);
+	free(b->tris);
+}
+
+static int box_contains(const BvhNode *outer, V3 lo, V3 hi)
+{
+	return outer->bmin.x <= lo.x && outer->bmin.y <= lo.y && outer->bmin.z <= lo.z &&
+	       outer->bmax.x >= hi.x && outer->bmax.y >= hi.y && outer->bmax.z >= hi.z;
+}
+
+/* Every triangle in exactly one leaf, boxes nested, depth bounded. */
+static void check_structure(const Built *b, uint32_t n)
+{
+	const Bvh *bvh = &b->bvh;
+	assert_true(bvh->nnodes >= 1 && bvh->nnodes <= 2 * n - 1);
+	assert_true(bvh->depth >= 1 && bvh->depth <= BVH_MAX_DEPTH);
+	assert_int_equal(bvh_memory(bvh), bvh->nnodes * sizeof(BvhNode) + n * sizeof(uint32_t));
+	char *seen = calloc(n, 1);
+	uint32_t *covered = calloc(n, sizeof(uint32_t));
+	assert_non_null(seen);
+	assert_non_null(covered);
+	for (uint32_t i = 0; i < n; i++) {
+		assert_true(bvh->order[i] < n);
+		assert_false(seen[bvh->order[i]]);
+		seen[bvh->order[i]] = 1;
+	}
+	for (uint32_t i = 0; i < bvh->nnodes; i++) {
+		const BvhNode *nd = &bvh->nodes[i];
+		if (nd->count > 0) {
+			assert_true(nd->count <= 8);
+			assert_true(nd->index >= 0 && (uint32_t)(nd->index + nd->count) <= n);
+			for (int k = nd->index; k < nd->index + nd->count; k++) {
+				const Tri *t = &b->tris[k];
+				assert_true(box_contains(nd, v3_min(t->p0, v3_min(t->p1, t->p2)),
+							 v3_max(t->p0, v3_max(t->p1, t->p2))));
+				covered[k]++;
+			}
+		} else {
+			assert_int_equal(nd->count, 0);
+			assert_true(i + 1 < bvh->nnodes);
+			assert_true(nd->index > (int)i + 1 && (uint32_t)nd->index < bvh->nnodes);
+			const BvhNode *l = &bvh->nodes[i + 1], *r = &bvh->nodes[nd->index];
+			assert_true(box_contains(nd, l->bmin, l->bmax));
+			assert_true(box_contains(nd, r->bmin, r->bmax));
+		}
+	}
+	for (uint32_t i = 0; i < n; i++)
+		assert_int_equal(covered[i], 1);
+	free(seen);
+	free(covered);
+}
+
+static int brute_closest(const Built *b, uint32_t n, V3 o, V3 d, float tmax, Hit *hit)
+{
+	RayPre r = ray_pre(o, d);
+	int found = 0;
+	for (uint32_t i = 0; i < n; i++) {
+		float t, u, v;
+		if (tri_intersect(&r, &b->tris[i], tmax, &t, &u, &v)) {
+			tmax = t;
+			hit->t = t;
+			hit->u = u;
+			hit->v = v;
+			hit->tri = (int)i;
+			found = 1;
+		}
+	}
+	return found;
+}
+
+/* A random ray: from inside or around the bounds, aimed at a random point
+ * of a random triangle half the time (so most rays hit something), and
+ * along a coordinate axis now and then (zero direction components). */
+static void random_ray(const Built *b, uint32_t n, V3 *o, V3 *d)
+{
+	V3 ext = v3_sub(b->hi, b->lo);
+	V3 lo = v3_sub(b->lo, v3_scale(ext, 0.25f));
+	*o = rnd_v3(lo, v3_madd(lo, ext, 1.5f));
+	uint32_t kind = rnd_u32() % 8;
+	if (kind < 4) {
+		const Tri *t = &b->tris[rnd_u32() % n];
+		float b1 = rnd(), b2 = rnd();
+		if (b1 + b2 > 1.0f) {
+			b1 = 1.0f - b1;
+			b2 = 1.0f - b2;
+		}
+		V3 p = v3_add(t->p0, v3_add(v3_scale(v3_sub(t->p1, t->p0), b1),
+					   v3_scale(v3_sub(t->p2, t->p0), b2)));
+		V3 dd = v3_sub(p, *o);
+		*d = v3_len2(dd) > 0.0f ? v3_norm(dd) : rnd_dir();
+	} else if (kind == 4) {
+		int axis = (int)(rnd_u32() % 3);
+		float s = (rnd_u32() & 1) ? 1.0f : -1.0f;
+		*d = v3(axis == 0 ? s : 0.0f, axis == 1 ? s : 0.0f, axis == 2 ? s : 0.0f);
+	} else {
+		*d = rnd_dir();
+	}
+}
+
+/* Whether a hit's point lies on its triangle's bounds, give or take float
+ * noise. A triangle seen nearly edge-on from far away (relative to its
+ * size) gets edge functions and a distance that are pure rounding noise: a
+ * "hit" far off the triangle that no traversal can be asked to reproduce
+ * (its box test rightly rejects that point). */
+static int hit_is_sound(const Built *b, V3 o, V3 d, const Hit *h)
+{
+	const Tri *t = &b->tris[h->tri];
+	V3 p = v3_madd(o, d, h->t);
+	V3 lo = v3_min(t->p0, v3_min(t->p1, t->p2)), hi = v3_max(t->p0, v3_max(t->p1, t->p2));
+	/* about 100 ulps of the largest coordinate involved */
+	float tol = 1e-5f * (v3_maxc(v3_max(v3_max(o, v3_neg(o)), v3_max(hi, v3_neg(lo)))) + h->t);
+	return p.x >= lo.x - tol && p.y >= lo.y - tol && p.z >= lo.z - tol && p.x <= hi.x + tol &&
+	       p.y <= hi.y + tol && p.z <= hi.z + tol;
+}
+
+/* Compares BVH and brute force on `nrays` rays; returns the hit count. */
+static uint32_t check_rays(const Built *b, uint32_t n, uint32_t nrays)
+{
+	uint32_t hits = 0, unsound = 0;
+	for (uint32_t k = 0; k < nrays; k++) {
+		V3 o, d;
+		random_ray(b, n, &o, &d);
+		Hit hb = {0}, hf = {0};
+		int fb = brute_closest(b, n, o, d, AJAR_INF, &hb);
+		if (fb && !hit_is_sound(b, o, d, &hb)) {
+			unsound++;
+			continue;
+		}
+		int ff = bvh_intersect(&b->sc, o, d, AJAR_INF, &hf);
+		if (fb != ff || (fb && (hb.t != hf.t))) {
+			fprintf(stderr, "ray %u: o (%g %g %g) d (%g %g %g): brute %d t %.9g tri %d, bvh %d t %.9g tri %d\n",
+				k, o.x, o.y, o.z, d.x, d.y, d.z, fb, hb.t, hb.tri, ff, hf.t, hf.tri);
+			fail();
+		}
+		/* Same triangle, or another one at exactly the same distance. */
+		if (fb && hb.tri != hf.tri) {
+			assert_true(hb.t == hf.t);
+		} else if (fb) {
+			assert_true(hb.u == hf.u && hb.v == hf.v);
+		}
+		hits += (uint32_t)fb;
+		/* Any-hit: occluded below the closest hit's distance iff hit. */
+		if (fb) {
+			assert_true(bvh_occluded(&b->sc, o, d, hb.t * 1.5f + 1e-3f));
+			assert_false(bvh_occluded(&b->sc, o, d, hb.t * 0.5f));
+			assert_int_equal(bvh_occluded(&b->sc, o, d, hb.t), 0);
+		} else {
+			assert_false(bvh_occluded(&b->sc, o, d, AJAR_INF));
+		}
+		/* A shorter tmax must return the closest hit below it, which is
+		 * brute force's closest hit if that lies below tmax, else none
+		 * (the triangle test's t does not depend on tmax). */
+		float tmax = fb ? hb.t * rnd_range(0.5f, 2.0f) : rnd_range(0.1f, 10.0f);
+		Hit hf2 = {0};
+		int fb2 = fb && hb.t < tmax;
+		int ff2 = bvh_intersect(&b->sc, o, d, tmax, &hf2);
+		assert_int_equal(fb2, ff2);
+		if (fb2)
+			assert_true(hb.t == hf2.t);
+	}
+	/* Noise hits are rare; many would mean the soup tests nothing. */
+	if (unsound)
+		printf("  (%u rays skipped: closest hit is rounding noise)\n", unsound);
+	assert_true(unsound <= nrays / 50);
+	return hits;
+}
+
+static void run_soup(const Tri *tris, uint32_t n, uint32_t nrays, const char *name)
+{
+	Built b;
+	built_make(tris, n, &b);
+	check_structure(&b, n);
+	uint32_t hits = check_rays(&b, n, nrays);
+	printf("  %-12s %6u tris %6u nodes depth %2u: %u/%u rays hit\n", name, n, b.bvh.nnodes,
+	       b.bvh.depth, hits, nrays);
+	/* The soups are built so a good share of rays hits; a BVH that
+	 * missed everything would agree with a broken brute force. */
+	if (n > 1)
+		assert_true(hits > nrays / 4);
+	built_free(&b);
+}
+
+static void test_uniform_soup(void **state)
+{
+	rng_state = 1;
+	uint32_t n = 1000;
+	Tri *t = malloc(sizeof(Tri) * n);
+	for (uint32_t i = 0; i < n; i++) {
+		V3 c = rnd_v3(v3(0, 0, 0), v3(1, 1, 1));
+		t[i] = rnd_tri_around(c, rnd_range(0.01f, 0.2f));
+	}
+	run_soup(t, n, 20000, "uniform");
+	free(t);
+}
+
+static void test_clustered_soup(void **state)
+{
+	rng_state = 2;
+	uint32_t n = 1000;
+	Tri *t = malloc(sizeof(Tri) * n);
+	/* Few tight clusters at very different scales, far apart (but each
+	 * triangle still hundreds of ulps wide where it lies: smaller ones have
+	 * no meaningful hit distance in float, for any traversal). */
+	V3 centers[4] = {v3(0, 0, 0), v3(100, 3, -7), v3(100.01f, 3, -7), v3(-50, 80, 20)};
+	float scales[4] = {1.0f, 1e-2f, 1e-3f, 10.0f};
+	for (uint32_t i = 0; i < n; i++) {
+		int k = (int)(rnd_u32() % 4);
+		V3 dir = rnd_dir();
+		V3 c = v3_madd(centers[k], dir, scales[k] * rnd());
+		t[i] = rnd_tri_around(c, scales[k] * rnd_range(0.05f, 0.5f));
+	}
+	run_soup(t, n, 20000, "clustered");
+	free(t);
+}
+
+/* A grid of coplanar squares sharing edges (watertightness: rays through
+ * edges and vertices), with zero-area and sliver triangles mixed in. */
+static void test_coplanar_degenerate_soup(void **state)
+{
+	rng_state = 3;
+	uint32_t g = 16, n = 0;
+	Tri *t = malloc(sizeof(Tri) * (2 * g * g + 400));
+	for (uint32_t y = 0; y < g; y++)
+		for (uint32_t x = 0; x < g; x++) {
+			V3 a = v3((float)x, (float)y, 0), bb = v3((float)x + 1, (float)y, 0);
+			V3 c = v3((float)x + 1, (float)y + 1, 0), d = v3((float)x, (float)y + 1, 0);
+			t[n++] = make_tri(a, bb, c);
+			t[n++] = make_tri(a, c, d);
+		}
+	for (uint32_t i = 0; i < 400; i++) {
+		V3 a = rnd_v3(v3(0, 0, -2), v3(16, 16, 2));
+		V3 e = rnd_dir();
+		switch (i % 4) {
+		case 0: /* a point */
+			t[n++] = make_tri(a, a, a);
+			break;
+		case 1: /* collinear */
+			t[n++] = make_tri(a, v3_madd(a, e, 1.0f), v3_madd(a, e, 2.5f));
+			break;
+		case 2: /* long sliver */
+			t[n++] = make_tri(a, v3_madd(a, e, 8.0f), v3_madd(v3_madd(a, e, 4.0f), rnd_dir(), 1e-4f));
+			break;
+		default: /* coplanar with the grid, overlapping it */
+			a.z = 0.0f;
+			t[n++] = make_tri(a, v3(a.x + 1, a.y, 0), v3(a.x, a.y + 0.5f, 0));
+			break;
+		}
+	}
+	run_soup(t, n, 20000, "coplanar");
+	free(t);
+}
+
+static void test_single_triangle(void **state)
+{
+	rng_state = 4;
+	Tri t = make_tri(v3(0, 0, 0), v3(1, 0, 0), v3(0, 1, 0));
+	Built b;
+	built_make(&t, 1, &b);
+	assert_int_equal(b.bvh.nnodes, 1);
+	assert_int_equal(b.bvh.nodes[0].count, 1);
+	check_rays(&b, 1, 20000);
+	/* Known hit, both faces (no culling), barycentrics of p1 and p2. */
+	Hit h;
+	assert_true(bvh_intersect(&b.sc, v3(0.25f, 0.5f, 1), v3(0, 0, -1), AJAR_INF, &h));
+	assert_float_equal(h.t, 1.0f, 1e-6f);
+	assert_float_equal(h.u, 0.25f, 1e-6f);
+	assert_float_equal(h.v, 0.5f, 1e-6f);
+	assert_int_equal(h.tri, 0);
+	assert_true(bvh_intersect(&b.sc, v3(0.25f, 0.5f, -2), v3(0, 0, 1), AJAR_INF, &h));
+	assert_float_equal(h.t, 2.0f, 1e-6f);
+	assert_false(bvh_intersect(&b.sc, v3(0.25f, 0.5f, -2), v3(0, 0, 1), 1.5f, &h));
+	assert_false(bvh_intersect(&b.sc, v3(0.75f, 0.5f, 1), v3(0, 0, -1), AJAR_INF, &h));
+	/* The front face is CCW seen from +Z. */
+	V3 ng = tri_normal(&b.tris[0]);
+	assert_true(ng.z > 0.0f && ng.x == 0.0f && ng.y == 0.0f);
+	built_free(&b);
+}
+
+static void test_identical_triangles(void **state)
+{
+	rng_state = 5;
+	uint32_t n = 5000;
+	Tri *t = malloc(sizeof(Tri) * n);
+	for (uint32_t i = 0; i < n; i++)
+		t[i] = make_tri(v3(0, 0, 0), v3(1, 0, 0), v3(0, 1, 0));
+	Built b;
+	built_make(t, n, &b);
+	check_structure(&b, n);
+	Hit h;
+	assert_true(bvh_intersect(&b.sc, v3(0.2f, 0.2f, 1), v3(0, 0, -1), AJAR_INF, &h));
+	assert_float_equal(h.t, 1.0f, 1e-6f);
+	check_rays(&b, n, 500);
+	built_free(&b);
+	free(t);
+}
+
+/* Centroids at ±32^i along each axis, i = -25..24, every triangle a unit
+ * square's half across the other two axes (so those axes cannot separate
+ * them): in every node all but the outermost centroid share one bin, SAH
+ * can only peel one triangle per level (depth 58 uncapped), and only the
+ * median cap keeps the tree shallow. Coordinates span 2^-125..2^120, so
+ * random rays mean nothing here; each triangle is probed by a ray aimed
+ * straight at it instead. */
+static void test_depth_bounded(void **state)
+{
+	uint32_t n = 0;
+	Tri *t = malloc(sizeof(Tri) * 300);
+	for (int axis = 0; axis < 3; axis++)
+		for (int sign = -1; sign <= 1; sign += 2)
+			for (int i = -25; i < 25; i++) {
+				V3 ea = v3(axis == 0, axis == 1, axis == 2);
+				V3 eb = v3(axis == 1, axis == 2, axis == 0);
+				V3 ec = v3(axis == 2, axis == 0, axis == 1);
+				V3 c = v3_scale(ea, (float)sign * ldexpf(1.0f, 5 * i));
+				t[n++] = make_tri(c, v3_add(c, eb), v3_add(c, ec));
+			}
+	Built b;
+	built_make(t, n, &b);
+	check_structure(&b, n);
+	printf("  hostile      %6u tris %6u nodes depth %2u\n", n, b.bvh.nnodes, b.bvh.depth);
+	assert_true(b.bvh.depth > BVH_MAX_DEPTH - 32); /* the cap was needed */
+	for (uint32_t i = 0; i < n; i++) {
+		const Tri *tri = &b.tris[i];
+		V3 e1 = v3_sub(tri->p1, tri->p0), e2 = v3_sub(tri->p2, tri->p0);
+		V3 ng = v3_norm(tri_normal(tri));
+		V3 target = v3_madd(v3_madd(tri->p0, e1, 0.2f), e2, 0.2f);
+		V3 o = v3_madd(target, ng, 1.0f + v3_maxc(v3_max(tri->p0, v3_neg(tri->p0))));
+		Hit hb, hf;
+		assert_true(brute_closest(&b, n, o, v3_neg(ng), AJAR_INF, &hb));
+		assert_true(bvh_intersect(&b.sc, o, v3_neg(ng), AJAR_INF, &hf));
+		assert_true(hb.t == hf.t);
+		assert_true(hb.tri == hf.tri || b.tris[hb.tri].p0.x == b.tris[hf.tri].p0.x);
+		assert_true(bvh_occluded(&b.sc, o, v3_neg(ng), AJAR_INF));
+	}
+	built_free(&b);
+	free(t);
+}
+
+/* Small spawn offsets: a ray leaving a hit point through ray_offset must
+ * not hit the same triangle again, on either side. */
+static void test_ray_offset(void **state)
+{
+	rng_state = 7;
+	for (int k = 0; k < 20000; k++) {
+		float s = powf(10.0f, rnd_range(-3.0f, 4.0f));
+		V3 c = v3_scale(rnd_v3(v3(-1, -1, -1), v3(1, 1, 1)), s);
+		Tri t = rnd_tri_around(c, s * 0.1f);
+		V3 ng = tri_normal(&t);
+		if (v3_len2(ng) == 0.0f)
+			continue;
+		float b1 = rnd() * 0.5f, b2 = rnd() * 0.5f;
+		V3 p = v3_add(t.p0, v3_add(v3_scale(v3_sub(t.p1, t.p0), b1), v3_scale(v3_sub(t.p2, t.p0), b2)));
+		V3 d = rnd_dir();
+		V3 o = ray_offset(p, ng, d);
+		RayPre r = ray_pre(o, d);
+		float th, u, v;
+		assert_false(tri_intersect(&r, &t, AJAR_INF, &th, &u, &v));
+		/* and the offset is tiny relative to the scale */
+		assert_true(v3_len(v3_sub(o, p)) < 1e-3f * fmaxf(1.0f, s));
+	}
+}
+
+static double now_seconds(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* A shipped scene against brute force; rays scaled down with the
+ * triangle count so brute force stays around a second. */
+static void check_scene(const char *path)
+{
+	rng_state = 8;
+	Scene *s = NULL;
+	ajar_status st = gltf_load(path, &s);
+	if (st != AJAR_OK)
+		fprintf(stderr, "%s: %s\n", path, ajar_last_error());
+	assert_int_equal(st, AJAR_OK);
+	uint32_t n = s->ntris;
+	double t0 = now_seconds();
+	Built b;
+	built_make(s->tris, n, &b);
+	double secs = now_seconds() - t0;
+	check_structure(&b, n);
+	uint32_t nrays = (uint32_t)(1e8 / n);
+	nrays = nrays > 2000 ? 2000 : (nrays < 150 ? 150 : nrays);
+	uint32_t hits = check_rays(&b, n, nrays);
+	printf("  %-40s %6u tris %6u nodes depth %2u, %.3f s, %.1f MB: %u/%u rays hit\n", path, n,
+	       b.bvh.nnodes, b.bvh.depth, secs, bvh_memory(&b.bvh) / 1048576.0, hits, nrays);
+	assert_true(hits > nrays / 4);
+	built_free(&b);
+	scene_free(s);
+}
+
+static void test_scene_cornell(void **state) { check_scene(SCENE("cornell/cornell.gltf")); }
+static void test_scene_window_room(void **state) { check_scene(SCENE("window-room/window-room.gltf")); }
+static void test_scene_living_room(void **state) { check_scene(SCENE("living-room/living-room.gltf")); }
+static void test_scene_bathroom(void **state) { check_scene(SCENE("bathroom/bathroom.gltf")); }
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_single_triangle),
+		cmocka_unit_test(test_uniform_soup),
+		cmocka_unit_test(test_clustered_soup),
+		cmocka_unit_test(test_coplanar_degenerate_soup),
+		cmocka_unit_test(test_identical_triangles),
+		cmocka_unit_test(test_depth_bounded),
+		cmocka_unit_test(test_ray_offset),
+		cmocka_unit_test(test_scene_cornell),
+		cmocka_unit_test(test_scene_window_room),
+		cmocka_unit_test(test_scene_living_room),
+		cmocka_unit_test(test_scene_bathroom),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,596 @@
+/* test_lights.c — the light tables (src/lights.c) and light sampling
+ * (kernels/lights.h): environment orientation, env_sample against
+ * env_pdf_w, emitter selection by power and uniform points on emitters,
+ * portal selection by area, and light_sample's solid-angle density against
+ * light_pdf_w with environment and emitters mixed, all by chi-square
+ * against densities integrated numerically. */
+#include "testutil.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "lights.h"
+#include "scene.h"
+#include "../kernels/lights.h"
+
+static uint64_t rng_state;
+
+static uint32_t rnd_u32(void)
+{
+	/* PCG32 (O'Neill), fixed seed per test. */
+	uint64_t old = rng_state;
+	rng_state = old * 6364136223846793005ULL + 1442695040888963407ULL;
+	uint32_t xs = (uint32_t)(((old >> 18) ^ old) >> 27), rot = (uint32_t)(old >> 59);
+	return (xs >> rot) | (xs << ((-rot) & 31));
+}
+
+static float rnd(void) { return (float)(rnd_u32() >> 8) * (1.0f / 16777216.0f); }
+
+#define ALPHA 1e-3 /* chi-square significance; fixed seeds make it reproducible */
+
+/* A scene, its light tables and the SceneView the kernels read. */
+typedef struct {
+	Scene *s;
+	Tri *tris;
+	LightTables lt;
+	Params prm;
+	SceneView sc;
+} Lit;
+
+static uint32_t add_material(Scene *s, V3 emission)
+{
+	Material m;
+	memset(&m, 0, sizeof(m));
+	m.base_color = v3(0.5f, 0.5f, 0.5f);
+	m.base_tex = -1;
+	m.emission = emission;
+	m.roughness = 1.0f;
+	m.ior = 1.5f;
+	uint32_t id;
+	assert_int_equal(scene_add_material(s, &m, &id), AJAR_OK);
+	return id;
+}
+
+static void add_tri(Scene *s, V3 a, V3 b, V3 c, uint32_t mat)
+{
+	float pos[9] = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z};
+	uint32_t idx[3] = {0, 1, 2};
+	assert_int_equal(scene_add_triangles(s, "test", pos, NULL, NULL, 3, idx, 1, mat), AJAR_OK);
+}
+
+static void lit_build(Lit *l)
+{
+	Scene *s = l->s;
+	l->tris = malloc(sizeof(Tri) * (s->ntris ? s->ntris : 1));
+	assert_non_null(l->tris);
+	if (s->ntris)
+		memcpy(l->tris, s->tris, sizeof(Tri) * s->ntris);
+	assert_int_equal(lights_build(s, l->tris, s->ntris, s->materials, s->portals, s->nportal_tris,
+				      v3(0, 0, 0), 10.0f, &l->lt),
+			 AJAR_OK);
+	memset(&l->prm, 0, sizeof(l->prm));
+	l->prm.num_tris = (int)s->ntris;
+	l->prm.num_emitters = (int)l->lt.nemitters;
+	l->prm.num_portals = (int)s->nportal_tris;
+	l->prm.env_type = s->env_type;
+	l->prm.env_width = (int)s->env_width;
+	l->prm.env_height = (int)s->env_height;
+	l->prm.env_strength = s->env_strength;
+	l->prm.env_color = s->env_color;
+	l->prm.env_pdf_select = l->lt.env_pdf_select;
+	memset(&l->sc, 0, sizeof(l->sc));
+	l->sc.tris = l->tris;
+	l->sc.materials = s->materials;
+	l->sc.emitters = l->lt.emitters;
+	l->sc.emitter_cdf = l->lt.emitter_cdf;
+	l->sc.env = l->lt.env;
+	l->sc.portals = s->portals;
+	l->sc.portal_cdf = l->lt.portal_cdf;
+	l->sc.params = &l->prm;
+}
+
+static void lit_free(Lit *l)
+{
+	lights_free(&l->lt);
+	free(l->tris);
+	scene_free(l->s);
+}
+
+/* A w x h sky: a bright blob near the top, a dimmer one below the
+ * horizon, a black row and a black column, colour varying along u. */
+static float *synthetic_sky(uint32_t w, uint32_t h)
+{
+	float *rgb = malloc(sizeof(float) * 3 * w * h);
+	for (uint32_t y = 0; y < h; y++)
+		for (uint32_t x = 0; x < w; x++) {
+			float u = (x + 0.5f) / w, v = (y + 0.5f) / h;
+			float blob = 20.0f * expf(-((u - 0.3f) * (u - 0.3f) + (v - 0.2f) * (v - 0.2f)) * 40.0f);
+			float low = 3.0f * expf(-((u - 0.7f) * (u - 0.7f) + (v - 0.7f) * (v - 0.7f)) * 20.0f);
+			float base = 0.2f + 0.1f * u;
+			float *p = rgb + 3 * (y * w + x);
+			p[0] = blob + low + base;
+			p[1] = blob + 0.5f * low + base;
+			p[2] = 0.5f * blob + base * 2.0f;
+			if (y == h / 2 + 1 || x == 3)
+				p[0] = p[1] = p[2] = 0.0f;
+		}
+	return rgb;
+}
+
+static void test_env_orientation(void **state)
+{
+	Lit l;
+	assert_int_equal(scene_new("<test>", &l.s), AJAR_OK);
+	uint32_t w = 8, h = 4;
+	float *rgb = calloc(3 * w * h, sizeof(float));
+	/* Pixel (x, y) has red = x, green = y. */
+	for (uint32_t y = 0; y < h; y++)
+		for (uint32_t x = 0; x < w; x++) {
+			rgb[3 * (y * w + x)] = (float)x;
+			rgb[3 * (y * w + x) + 1] = (float)y;
+			rgb[3 * (y * w + x) + 2] = 1.0f;
+		}
+	assert_int_equal(scene_set_env_image(l.s, w, h, rgb, 2.0f), AJAR_OK);
+	lit_build(&l);
+	assert_int_equal(l.lt.nenv, ENV_FLOATS(w, h));
+	/* +Y is row 0, -Y the last row; strength applied once. */
+	V3 up = env_radiance(&l.sc, v3(0, 1, 0));
+	assert_float_equal(up.y, 0.0f, 0.0f);
+	assert_float_equal(up.z, 2.0f, 0.0f);
+	V3 down = env_radiance(&l.sc, v3(0, -1, 0));
+	assert_float_equal(down.y, 2.0f * (h - 1), 0.0f);
+	/* Image centre looks down -Z; +X is at u = 0.75, -X at 0.25. */
+	V3 fwd = env_radiance(&l.sc, v3_norm(v3(0, 0.1f, -1)));
+	assert_float_equal(fwd.x, 2.0f * (w / 2), 0.0f);
+	assert_float_equal(fwd.y, 2.0f * (h / 2 - 1), 0.0f);
+	assert_float_equal(env_radiance(&l.sc, v3(1, 0.01f, 0)).x, 2.0f * (3 * w / 4), 0.0f);
+	assert_float_equal(env_radiance(&l.sc, v3(-1, 0.01f, 0)).x, 2.0f * (w / 4), 0.0f);
+	/* env_dir is the inverse of the lookup at texel centres. */
+	for (uint32_t y = 0; y < h; y++)
+		for (uint32_t x = 0; x < w; x++) {
+			V3 d = env_dir((x + 0.5f) / w, (y + 0.5f) / h);
+			assert_float_equal(v3_len(d), 1.0f, 1e-5f);
+			V3 L = env_radiance(&l.sc, d);
+			assert_float_equal(L.x, 2.0f * x, 0.0f);
+			assert_float_equal(L.y, 2.0f * y, 0.0f);
+		}
+	lit_free(&l);
+}
+
+/* Histogram of env_sample over 16 x 8 cells in (u, v), expected counts
+ * from env_pdf_w integrated over each cell in solid angle. */
+static void test_env_sample_chi2(void **state)
+{
+	rng_state = 11;
+	Lit l;
+	assert_int_equal(scene_new("<test>", &l.s), AJAR_OK);
+	uint32_t w = 40, h = 20;
+	assert_int_equal(scene_set_env_image(l.s, w, h, synthetic_sky(w, h), 1.5f), AJAR_OK);
+	lit_build(&l);
+	assert_true(l.lt.env_power > 0.0f);
+	assert_float_equal(l.lt.env_pdf_select, 1.0f, 0.0f); /* no emitters */
+
+	enum { CU = 16, CV = 8, SUB = 20, N = 200000 };
+	static double obs[CU * CV], expct[CU * CV];
+	memset(obs, 0, sizeof(obs));
+	double total = 0.0;
+	for (int cv = 0; cv < CV; cv++)
+		for (int cu = 0; cu < CU; cu++) {
+			double sum = 0.0;
+			/* Midpoints of a sub-grid aligned with the texels (2.5 texels
+			 * per cell, 20 sub-steps): exact for a per-texel constant. */
+			for (int j = 0; j < SUB; j++)
+				for (int i = 0; i < SUB; i++) {
+					float u = (cu + (i + 0.5f) / SUB) / CU, v = (cv + (j + 0.5f) / SUB) / CV;
+					float st = sinf(AJAR_PI * v);
+					sum += env_pdf_w(&l.sc, env_dir(u, v)) * st;
+				}
+			double cell = sum * (2.0 * M_PI / (CU * SUB)) * (M_PI / (CV * SUB));
+			expct[cv * CU + cu] = cell * N;
+			total += cell;
+		}
+	assert_float_equal(total, 1.0, 1e-4); /* the density integrates to 1 */
+
+	int refused = 0;
+	for (int k = 0; k < N; k++) {
+		V3 d;
+		float pdf_w;
+		V3 L = env_sample(&l.sc, rnd(), rnd(), &d, &pdf_w);
+		if (!(pdf_w > 0.0f)) {
+			/* Rounded across a texel edge into a black texel (or onto
+			 * a pole): a refused sample, which must stay rare. */
+			refused++;
+			assert_true(v3_is_zero(L));
+			continue;
+		}
+		assert_float_equal(v3_len(d), 1.0f, 1e-5f);
+		/* The returned density and radiance are exactly those of d. */
+		V3 Le = env_radiance(&l.sc, d);
+		assert_true(env_pdf_w(&l.sc, d) == pdf_w);
+		assert_true(Le.x == L.x && Le.y == L.y && Le.z == L.z);
+		float u = 0.5f + atan2f(d.x, -d.z) / (2.0f * AJAR_PI);
+		float v = acosf(fminf(fmaxf(d.y, -1.0f), 1.0f)) / AJAR_PI;
+		int cu = (int)(u * CU), cv = (int)(v * CV);
+		cu = cu < 0 ? 0 : (cu >= CU ? CU - 1 : cu);
+		cv = cv < 0 ? 0 : (cv >= CV ? CV - 1 : cv);
+		obs[cv * CU + cu] += 1.0;
+	}
+	assert_true(refused < N / 10000);
+	double p = chi2_test(obs, expct, CU * CV, 5.0);
+	printf("  env_sample: p = %.3f (%d refused)\n", p, refused);
+	assert_true(p > ALPHA);
+
+	/* Densities follow luminance: bright texel centres are denser. */
+	float bright = env_pdf_w(&l.sc, env_dir(0.3f, 0.2f)), dim = env_pdf_w(&l.sc, env_dir(0.9f, 0.5f));
+	assert_true(bright > 10.0f * dim);
+	/* The black column and row are never sampled. */
+	assert_float_equal(env_pdf_w(&l.sc, env_dir(3.5f / w, 0.3f)), 0.0f, 0.0f);
+	assert_float_equal(env_pdf_w(&l.sc, env_dir(0.5f, (h / 2 + 1.5f) / h)), 0.0f, 0.0f);
+	lit_free(&l);
+}
+
+static void test_env_black_and_color(void **state)
+{
+	/* An all-black image: no power, never picked, tables still sane. */
+	Lit l;
+	assert_int_equal(scene_new("<test>", &l.s), AJAR_OK);
+	uint32_t mat = add_material(l.s, v3(1, 1, 1));
+	add_tri(l.s, v3(0, 0, 0), v3(1, 0, 0), v3(0, 1, 0), mat);
+	assert_int_equal(scene_set_env_image(l.s, 8, 4, calloc(3 * 8 * 4, sizeof(float)), 1.0f), AJAR_OK);
+	lit_build(&l);
+	assert_float_equal(l.lt.env_power, 0.0f, 0.0f);
+	assert_float_equal(l.lt.env_pdf_select, 0.0f, 0.0f);
+	for (size_t i = 0; i < l.lt.nenv; i++)
+		assert_true(isfinite(l.lt.env[i]));
+	V3 d;
+	float pdf_w;
+	env_sample(&l.sc, 0.3f, 0.6f, &d, &pdf_w);
+	assert_true(isfinite(pdf_w) && pdf_w > 0.0f);
+	assert_true(pdf_w == env_pdf_w(&l.sc, d));
+	lit_free(&l);
+
+	/* A constant colour: power pi R^2 pi L, uniform sphere sampling, and
+	 * a selection probability by power against the emitters. */
+	assert_int_equal(scene_new("<test>", &l.s), AJAR_OK);
+	mat = add_material(l.s, v3(2, 2, 2));
+	add_tri(l.s, v3(0, 0, 0), v3(1, 0, 0), v3(0, 1, 0), mat);
+	scene_set_env_color(l.s, v3(0.5f, 0.5f, 0.5f));
+	lit_build(&l);
+	double env_power = M_PI * 100.0 * M_PI * 0.5, em_power = 0.5 * M_PI * 2.0;
+	assert_float_equal(l.lt.env_power, env_power, 1e-3 * env_power);
+	assert_float_equal(l.lt.emitter_power, em_power, 1e-5 * em_power);
+	assert_float_equal(l.lt.env_pdf_select, env_power / (env_power + em_power), 1e-5);
+	assert_int_equal(l.lt.nenv, 0);
+	V3 L = env_sample(&l.sc, 0.2f, 0.7f, &d, &pdf_w);
+	assert_float_equal(pdf_w, 0.25 / M_PI, 1e-7);
+	assert_float_equal(env_pdf_w(&l.sc, v3(0, 0, 1)), 0.25 / M_PI, 1e-7);
+	assert_float_equal(L.x, 0.5f, 0.0f);
+	assert_float_equal(env_radiance(&l.sc, v3(1, 0, 0)).y, 0.5f, 0.0f);
+	lit_free(&l);
+
+	/* No environment at all. */
+	assert_int_equal(scene_new("<test>", &l.s), AJAR_OK);
+	mat = add_material(l.s, v3(1, 0, 0));
+	add_tri(l.s, v3(0, 0, 0), v3(1, 0, 0), v3(0, 1, 0), mat);
+	lit_build(&l);
+	assert_float_equal(l.lt.env_pdf_select, 0.0f, 0.0f);
+	assert_float_equal(env_pdf_w(&l.sc, v3(0, 1, 0)), 0.0f, 0.0f);
+	assert_true(v3_is_zero(env_radiance(&l.sc, v3(0, 1, 0))));
+	lit_free(&l);
+}
+
+/* Emissive triangles of different areas and emissions, one black, one
+ * with zero area: selection by power, uniform points, front normals. */
+static void test_emitter_sampling(void **state)
+{
+	rng_state = 12;
+	Lit l;
+	assert_int_equal(scene_new("<test>", &l.s), AJAR_OK);
+	uint32_t black = add_material(l.s, v3(0, 0, 0));
+	V3 em[4] = {v3(1, 1, 1), v3(10, 0, 0), v3(0, 0, 3), v3(0.5f, 2, 0.5f)};
+	uint32_t mats[4];
+	for (int i = 0; i < 4; i++)
+		mats[i] = add_material(l.s, em[i]);
+	add_tri(l.s, v3(0, 0, 0), v3(1, 0, 0), v3(0, 1, 0), black);
+	add_tri(l.s, v3(0, 0, 1), v3(2, 0, 1), v3(0, 3, 1), mats[0]);      /* area 3 */
+	add_tri(l.s, v3(5, 0, 0), v3(5, 0.5f, 0), v3(5, 0, 0.5f), mats[1]); /* 0.125 */
+	add_tri(l.s, v3(1, 1, 1), v3(2, 2, 2), v3(3, 3, 3), mats[2]);      /* area 0 */
+	add_tri(l.s, v3(-1, 2, 0), v3(-1, 2, 4), v3(3, 2, 0), mats[2]);    /* 8 */
+	add_tri(l.s, v3(0, -1, 0), v3(0, -1, 1), v3(1, -1, 0), mats[3]);   /* 0.5 */
+	lit_build(&l);
+	assert_int_equal(l.lt.nemitters, 4);
+	int expect_emitter[6] = {-1, 0, 1, -1, 2, 3};
+	double power[4];
+	double total = 0.0;
+	for (int i = 0; i < 6; i++) {
+		assert_int_equal(l.tris[i].emitter, expect_emitter[i]);
+		if (expect_emitter[i] < 0)
+			continue;
+		const Emitter *e = &l.lt.emitters[expect_emitter[i]];
+		assert_int_equal(e->tri, i);
+		const Tri *t = &l.tris[i];
+		double area = 0.5 * v3_len(v3_cross(v3_sub(t->p1, t->p0), v3_sub(t->p2, t->p0)));
+		assert_float_equal(e->area, area, 1e-6 * area);
+		V3 L = l.s->materials[t->material].emission;
+		power[expect_emitter[i]] = area * M_PI * (0.2126 * L.x + 0.7152 * L.y + 0.0722 * L.z);
+		total += power[expect_emitter[i]];
+	}
+	assert_float_equal(l.lt.emitter_power, total, 1e-5 * total);
+	assert_float_equal(l.lt.emitter_cdf[0], 0.0f, 0.0f);
+	assert_float_equal(l.lt.emitter_cdf[4], 1.0f, 0.0f);
+
+	enum { N = 100000, SUBD = 4, NCELL = SUBD * SUBD };
+	double obs[4] = {0}, expct[4];
+	for (int k = 0; k < 4; k++) {
+		expct[k] = N * power[k] / total;
+		assert_float_equal(l.lt.emitters[k].pdf_select, power[k] / total, 1e-6);
+	}
+	/* Points on the big emitter, binned into its 16 congruent
+	 * sub-triangles (equal areas, so equal expected counts). */
+	double pobs[NCELL] = {0}, pexp[NCELL];
+	int big = 4;
+	for (int k = 0; k < N; k++) {
+		V3 p, n;
+		float pdf_a;
+		int tri = emitter_sample(&l.sc, rnd(), rnd(), rnd(), &p, &n, &pdf_a);
+		assert_true(tri >= 0 && tri < 6 && l.tris[tri].emitter >= 0);
+		const Tri *t = &l.tris[tri];
+		obs[t->emitter] += 1.0;
+		assert_float_equal(pdf_a, emitter_pdf_a(&l.sc, tri), 0.0f);
+		assert_float_equal(pdf_a, power[t->emitter] / total / l.lt.emitters[t->emitter].area,
+				   1e-5 * pdf_a);
+		V3 ng = tri_normal(t);
+		assert_float_equal(v3_len(n), 1.0f, 1e-5f);
+		assert_float_equal(v3_dot(n, ng), v3_len(ng), 1e-4f * v3_len(ng));
+		/* Barycentrics of p by least squares on the edges. */
+		V3 e1 = v3_sub(t->p1, t->p0), e2 = v3_sub(t->p2, t->p0), q = v3_sub(p, t->p0);
+		float d11 = v3_dot(e1, e1), d12 = v3_dot(e1, e2), d22 = v3_dot(e2, e2);
+		float det = d11 * d22 - d12 * d12;
+		float b1 = (d22 * v3_dot(q, e1) - d12 * v3_dot(q, e2)) / det;
+		float b2 = (d11 * v3_dot(q, e2) - d12 * v3_dot(q, e1)) / det;
+		assert_true(b1 >= -1e-5f && b2 >= -1e-5f && b1 + b2 <= 1.0f + 1e-5f);
+		if (tri == big) {
+			float x = fminf(fmaxf(b1 * SUBD, 0.0f), SUBD - 1e-3f);
+			float y = fminf(fmaxf(b2 * SUBD, 0.0f), SUBD - 1e-3f);
+			int i = (int)x, j = (int)y;
+			if (i + j >= SUBD) /* rounding at the hypotenuse */
+				j = SUBD - 1 - i;
+			int upper = i + j < SUBD - 1 && (x - i) + (y - j) > 1.0f;
+			/* Row j holds 2 (SUBD - j) - 1 sub-triangles. */
+			int cell = 0;
+			for (int r = 0; r < j; r++)
+				cell += 2 * (SUBD - r) - 1;
+			cell += 2 * i + upper;
+			pobs[cell] += 1.0;
+		}
+	}
+	double p = chi2_test(obs, expct, 4, 5.0);
+	printf("  emitter selection: p = %.3f\n", p);
+	assert_true(p > ALPHA);
+	for (int c = 0; c < NCELL; c++)
+		pexp[c] = expct[2] / NCELL;
+	p = chi2_test(pobs, pexp, NCELL, 5.0);
+	printf("  emitter points: p = %.3f\n", p);
+	assert_true(p > ALPHA);
+
+	/* Radiance leaves the front face only; non-emitters give none. */
+	V3 front = tri_normal(&l.tris[1]);
+	assert_float_equal(emitter_radiance(&l.sc, 1, front).x, 1.0f, 0.0f);
+	assert_true(v3_is_zero(emitter_radiance(&l.sc, 1, v3_neg(front))));
+	assert_true(v3_is_zero(emitter_radiance(&l.sc, 0, tri_normal(&l.tris[0]))));
+	assert_float_equal(emitter_pdf_a(&l.sc, 0), 0.0f, 0.0f);
+	lit_free(&l);
+}
+
+static void test_portal_sampling(void **state)
+{
+	rng_state = 13;
+	Lit l;
+	assert_int_equal(scene_new("<test>", &l.s), AJAR_OK);
+	add_material(l.s, v3(0, 0, 0));
+	/* A 2 x 1 window (two triangles) and a small 0.5 x 0.5 one. */
+	float pos[] = {0, 0, 0, 2, 0, 0, 2, 1, 0, 0, 1, 0, 5, 0, 0, 5.5f, 0, 0, 5, 0.5f, 0};
+	uint32_t idx[] = {0, 1, 2, 0, 2, 3, 4, 5, 6};
+	assert_int_equal(scene_add_portal(l.s, "window", pos, 7, idx, 3), AJAR_OK);
+	lit_build(&l);
+	assert_int_equal(l.lt.nportals, 3);
+	double area[3] = {1.0, 1.0, 0.125}, total = 2.125;
+	enum { N = 50000 };
+	double obs[3] = {0}, expct[3];
+	for (int k = 0; k < 3; k++) {
+		expct[k] = N * area[k] / total;
+		assert_float_equal(l.s->portals[k].pdf_select, area[k] / total, 1e-6);
+		assert_float_equal(l.s->portals[k].area, area[k], 1e-6);
+	}
+	for (int k = 0; k < N; k++) {
+		V3 p, n;
+		float pdf_a;
+		int i = portal_sample(&l.sc, rnd(), rnd(), rnd(), &p, &n, &pdf_a);
+		assert_true(i >= 0 && i < 3);
+		obs[i] += 1.0;
+		assert_float_equal(pdf_a, 1.0 / total, 1e-5);
+		assert_float_equal(n.z, 1.0f, 1e-6f);
+		assert_float_equal(p.z, 0.0f, 0.0f);
+		assert_true(i == 2 ? p.x >= 5.0f && p.x <= 5.5f : p.x >= 0.0f && p.x <= 2.0f);
+	}
+	double p = chi2_test(obs, expct, 3, 5.0);
+	printf("  portal selection: p = %.3f\n", p);
+	assert_true(p > ALPHA);
+	lit_free(&l);
+
+	/* No portals: nothing to sample. */
+	assert_int_equal(scene_new("<test>", &l.s), AJAR_OK);
+	add_material(l.s, v3(0, 0, 0));
+	lit_build(&l);
+	V3 pp, nn;
+	float pdf_a;
+	assert_int_equal(portal_sample(&l.sc, 0.5f, 0.5f, 0.5f, &pp, &nn, &pdf_a), -1);
+	lit_free(&l);
+}
+
+/* Total solid-angle density of light_sample at x in direction wi: the
+ * environment's share plus every emitter the ray crosses (light sampling
+ * ignores occlusion, so overlapping emitters add up). */
+static double light_density(const Lit *l, V3 x, V3 wi)
+{
+	double pdf = light_pdf_w(&l->sc, x, wi, -1, AJAR_INF, 1.0f);
+	RayPre r = ray_pre(x, wi);
+	for (uint32_t k = 0; k < l->lt.nemitters; k++) {
+		int tri = l->lt.emitters[k].tri;
+		float t, u, v;
+		if (!tri_intersect(&r, &l->tris[tri], AJAR_INF, &t, &u, &v))
+			continue;
+		V3 n = v3_norm(tri_normal(&l->tris[tri]));
+		pdf += light_pdf_w(&l->sc, x, wi, tri, t, -v3_dot(n, wi));
+	}
+	return pdf;
+}
+
+/* Directions from x binned into equal-area cells (cos theta about +Y,
+ * phi), expected counts from light_pdf_w integrated over each cell; one
+ * more cell for samples light_sample refused (back-facing emitters). */
+static void check_light_sample(Lit *l, V3 x, const char *name)
+{
+	enum { CT = 24, CP = 48, SUB = 24, N = 300000, NC = CT * CP + 1 };
+	static double obs[NC], expct[NC];
+	memset(obs, 0, sizeof(obs));
+	double total = 0.0;
+	for (int ct = 0; ct < CT; ct++)
+		for (int cp = 0; cp < CP; cp++) {
+			double sum = 0.0;
+			for (int j = 0; j < SUB; j++)
+				for (int i = 0; i < SUB; i++) {
+					float c = 1.0f - 2.0f * (ct + (j + 0.5f) / SUB) / CT;
+					float phi = 2.0f * AJAR_PI * (cp + (i + 0.5f) / SUB) / CP;
+					float s = sqrtf(fmaxf(0.0f, 1.0f - c * c));
+					sum += light_density(l, x, v3(s * cosf(phi), c, s * sinf(phi)));
+				}
+			double cell = sum * (4.0 * M_PI / (CT * CP)) / (SUB * SUB);
+			expct[ct * CP + cp] = cell * N;
+			total += cell;
+		}
+	expct[NC - 1] = N * (1.0 - total);
+	int env_count = 0;
+	for (int k = 0; k < N; k++) {
+		LightSample ls;
+		if (!light_sample(&l->sc, x, rnd(), rnd(), rnd(), &ls)) {
+			obs[NC - 1] += 1.0;
+			continue;
+		}
+		env_count += ls.is_env;
+		assert_true(ls.pdf_w > 0.0f);
+		assert_float_equal(v3_len(ls.wi), 1.0f, 1e-5f);
+		/* light_pdf_w reproduces the sample's own density. */
+		if (ls.is_env) {
+			assert_true(ls.dist == AJAR_INF);
+			assert_true(light_pdf_w(&l->sc, x, ls.wi, -1, ls.dist, 1.0f) == ls.pdf_w);
+		} else {
+			assert_float_equal(ls.dist, v3_len(v3_sub(ls.p, x)), 1e-5f * ls.dist);
+			float cos_light = -v3_dot(ls.n, ls.wi);
+			RayPre r = ray_pre(x, ls.wi);
+			float t, u, v;
+			int tri = -1;
+			for (uint32_t e = 0; e < l->lt.nemitters && tri < 0; e++) {
+				int ti = l->lt.emitters[e].tri;
+				if (tri_intersect(&r, &l->tris[ti], ls.dist * 1.0001f, &t, &u, &v) &&
+				    fabsf(t - ls.dist) < 1e-4f * ls.dist)
+					tri = ti;
+			}
+			assert_true(tri >= 0);
+			assert_float_equal(light_pdf_w(&l->sc, x, ls.wi, tri, ls.dist, cos_light), ls.pdf_w,
+					   1e-4f * ls.pdf_w);
+			V3 Le = emitter_radiance(&l->sc, tri, v3_neg(ls.wi));
+			assert_true(Le.x == ls.Le.x && Le.y == ls.Le.y && Le.z == ls.Le.z);
+		}
+		float c = fminf(fmaxf(ls.wi.y, -1.0f), 1.0f);
+		float phi = atan2f(ls.wi.z, ls.wi.x);
+		if (phi < 0.0f)
+			phi += 2.0f * AJAR_PI;
+		int ct = (int)((1.0f - c) * 0.5f * CT), cp = (int)(phi / (2.0f * AJAR_PI) * CP);
+		ct = ct < 0 ? 0 : (ct >= CT ? CT - 1 : ct);
+		cp = cp < 0 ? 0 : (cp >= CP ? CP - 1 : cp);
+		obs[ct * CP + cp] += 1.0;
+	}
+	double expected_env = N * l->lt.env_pdf_select;
+	assert_true(fabs(env_count - expected_env) <= 5.0 * sqrt(expected_env + 1.0));
+	double p = chi2_test(obs, expct, NC, 5.0);
+	printf("  light_sample %-14s p = %.3f (env picked %.3f, refused %.3f)\n", name, p,
+	       (double)env_count / N, obs[NC - 1] / N);
+	assert_true(p > ALPHA);
+}
+
+/* Emitters around x = (0, 0, 0): a square above, a triangle in front with
+ * another behind it (overlapping as seen from x), one facing away, and a
+ * non-emissive occluder (light sampling ignores it). */
+static void build_light_scene(Lit *l)
+{
+	assert_int_equal(scene_new("<test>", &l->s), AJAR_OK);
+	Scene *s = l->s;
+	uint32_t grey = add_material(s, v3(0, 0, 0));
+	uint32_t white = add_material(s, v3(1, 1, 1));
+	uint32_t red = add_material(s, v3(4, 0.5f, 0.5f));
+	uint32_t blue = add_material(s, v3(0.2f, 0.2f, 3));
+	/* Square at y = 1.5 facing down (CCW seen from below). */
+	add_tri(s, v3(-1, 1.5f, -1), v3(1, 1.5f, -1), v3(1, 1.5f, 1), white);
+	add_tri(s, v3(-1, 1.5f, -1), v3(1, 1.5f, 1), v3(-1, 1.5f, 1), white);
+	/* Tilted triangle at z ~ -2 facing +z, and a larger one behind it. */
+	add_tri(s, v3(-0.5f, -0.5f, -2), v3(1, -0.5f, -2.5f), v3(0, 1, -2), red);
+	add_tri(s, v3(-2, -1, -4), v3(2, -1, -4), v3(0, 2, -4), blue);
+	/* At x = 2, facing +x: x sees its back. */
+	add_tri(s, v3(2, -1, -1), v3(2, 1, -1), v3(2, 0, 1), white);
+	/* Occluder below. */
+	add_tri(s, v3(-1, -1, -1), v3(1, -1, -1), v3(0, -1, 1), grey);
+}
+
+static void test_light_sample_emitters(void **state)
+{
+	rng_state = 14;
+	Lit l;
+	build_light_scene(&l);
+	lit_build(&l);
+	assert_int_equal(l.lt.nemitters, 5);
+	assert_float_equal(l.lt.env_pdf_select, 0.0f, 0.0f);
+	check_light_sample(&l, v3(0, 0, 0), "emitters");
+	lit_free(&l);
+}
+
+static void test_light_sample_env_color(void **state)
+{
+	rng_state = 15;
+	Lit l;
+	build_light_scene(&l);
+	scene_set_env_color(l.s, v3(0.02f, 0.03f, 0.05f));
+	lit_build(&l);
+	assert_true(l.lt.env_pdf_select > 0.2f && l.lt.env_pdf_select < 0.8f);
+	check_light_sample(&l, v3(0, 0, 0), "+ env colour");
+	lit_free(&l);
+}
+
+static void test_light_sample_env_image(void **state)
+{
+	rng_state = 16;
+	Lit l;
+	build_light_scene(&l);
+	assert_int_equal(scene_set_env_image(l.s, 40, 20, synthetic_sky(40, 20), 0.02f), AJAR_OK);
+	lit_build(&l);
+	assert_true(l.lt.env_pdf_select > 0.1f && l.lt.env_pdf_select < 0.9f);
+	check_light_sample(&l, v3(0.1f, 0.2f, 0.05f), "+ env image");
+	lit_free(&l);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_env_orientation),
+		cmocka_unit_test(test_env_sample_chi2),
+		cmocka_unit_test(test_env_black_and_color),
+		cmocka_unit_test(test_emitter_sampling),
+		cmocka_unit_test(test_portal_sampling),
+		cmocka_unit_test(test_light_sample_emitters),
+		cmocka_unit_test(test_light_sample_env_color),
+		cmocka_unit_test(test_light_sample_env_image),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
