@@ -38,11 +38,14 @@ DEPS_test_bvh := $(call obj,error scene bvh gltf exr)
 DEPS_test_lights := $(call obj,error scene lights)
 DEPS_test_scene := $(call obj,error scene scene_api gltf exr)
 DEPS_test_exr := $(call obj,error exr png)
+DEPS_test_bdpt := $(BUILD)/tests/kernel_host.o $(call obj,error scene scene_api gltf exr bvh lights prepare)
 # Tests that render need the whole library.
 DEPS_test_layout := $(BUILD)/libajar.a
 DEPS_test_render := $(BUILD)/libajar.a
 DEPS_test_api := $(BUILD)/libajar.a
+DEPS_test_cache := $(BUILD)/libajar.a
 DEPS_test_cli := $(BUILD)/libajar.a
+DEPS_test_multidevice := $(BUILD)/libajar.a
 
 .PHONY: all lib cli tests test test-unit asan demo bench install uninstall clean deps help
 all: lib cli
@@ -146,19 +149,26 @@ bench:
 	$(Q)$(MAKE) --no-print-directory all $(BUILD)/tests/bench
 	$(BUILD)/tests/bench
 
+# The shared library is installed under its full version with the soname
+# (libajar.so.0, as the link rule sets it) and the development name as links.
+AJAR_VERSION = $(shell sed -n 's/.*AJAR_VERSION_STRING "\(.*\)"/\1/p' include/ajar.h)
+INSTALL_LIB = $(DESTDIR)$(PREFIX)/lib
+
 install: all
-	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/lib/pkgconfig
-	install -m 755 build/ajar $(DESTDIR)$(PREFIX)/bin/ajar
-	install -m 644 $(BUILD)/libajar.a $(DESTDIR)$(PREFIX)/lib/libajar.a
-	install -m 755 $(BUILD)/libajar.so $(DESTDIR)$(PREFIX)/lib/libajar.so.0
-	ln -sf libajar.so.0 $(DESTDIR)$(PREFIX)/lib/libajar.so
-	install -m 644 include/ajar.h $(DESTDIR)$(PREFIX)/include/ajar.h
-	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(shell sed -n 's/.*AJAR_VERSION_STRING "\(.*\)"/\1/p' include/ajar.h)|' \
-		src/ajar.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/ajar.pc
+	@echo "  INSTALL $(DESTDIR)$(PREFIX)"
+	$(Q)install -d $(DESTDIR)$(PREFIX)/bin $(INSTALL_LIB)/pkgconfig $(DESTDIR)$(PREFIX)/include
+	$(Q)install -m 755 build/ajar $(DESTDIR)$(PREFIX)/bin/ajar
+	$(Q)install -m 644 $(BUILD)/libajar.a $(INSTALL_LIB)/libajar.a
+	$(Q)install -m 755 $(BUILD)/libajar.so $(INSTALL_LIB)/libajar.so.$(AJAR_VERSION)
+	$(Q)ln -sf libajar.so.$(AJAR_VERSION) $(INSTALL_LIB)/libajar.so.0
+	$(Q)ln -sf libajar.so.0 $(INSTALL_LIB)/libajar.so
+	$(Q)install -m 644 include/ajar.h $(DESTDIR)$(PREFIX)/include/ajar.h
+	$(Q)sed -e 's|@PREFIX@|$(PREFIX)|g' -e 's|@VERSION@|$(AJAR_VERSION)|g' src/ajar.pc.in \
+		> $(INSTALL_LIB)/pkgconfig/ajar.pc
 
 uninstall:
-	rm -f $(DESTDIR)$(PREFIX)/bin/ajar $(DESTDIR)$(PREFIX)/lib/libajar.* $(DESTDIR)$(PREFIX)/include/ajar.h \
-		$(DESTDIR)$(PREFIX)/lib/pkgconfig/ajar.pc
+	rm -f $(DESTDIR)$(PREFIX)/bin/ajar $(INSTALL_LIB)/libajar.a $(INSTALL_LIB)/libajar.so $(INSTALL_LIB)/libajar.so.0 \
+		$(INSTALL_LIB)/libajar.so.$(AJAR_VERSION) $(DESTDIR)$(PREFIX)/include/ajar.h $(INSTALL_LIB)/pkgconfig/ajar.pc
 
 clean:
 	rm -rf build out

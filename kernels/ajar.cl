@@ -2,6 +2,7 @@
  * which the host also compiles for its tests. */
 #include "film.h"
 #include "layout.h"
+#include "bdpt.h"
 #include "pt.h"
 
 #define AJAR_KERNEL_ARG(type, name) __global const type *name,
@@ -11,7 +12,9 @@
  * that pixel, added in fixed point to accum (3 longs per pixel; the pixel
  * is owned by this work-item, so no atomics). Light paths that reach the
  * camera (t = 1) land in other pixels: they go to `splat` with 64-bit
- * atomic adds. The host divides both by the samples per pixel. */
+ * atomic adds. The host divides both by the samples per pixel. When
+ * Params.strategy_len > 0, bdpt's per-strategy layers follow the splat
+ * image in the same buffer. */
 __kernel void render_pass(AJAR_SCENE_BUFFERS(AJAR_KERNEL_ARG) __global long *accum,
 			  __global long *splat, uint sample_first, uint sample_count)
 {
@@ -23,11 +26,19 @@ __kernel void render_pass(AJAR_SCENE_BUFFERS(AJAR_KERNEL_ARG) __global long *acc
 		return;
 	float x = (float)(pixel % (uint)cam->width), y = (float)(pixel / (uint)cam->width);
 	long sum[3] = {0, 0, 0};
+	PathVertex light[SUBPATH_MAX], eye[SUBPATH_MAX];
 	for (uint i = 0; i < sample_count; i++) {
 		Rng rng = rng_init(params->seed, pixel, sample_first + i, 0u);
 		float jx = rng_f(&rng), jy = rng_f(&rng);
-		V3 d = camera_ray_dir(cam, x + jx, y + jy);
-		V3 L = pt_radiance(&sc, cam->pos, d, &rng);
+		V3 L;
+		if (params->integrator == INTEGRATOR_BDPT) {
+			BdptFilm out = {splat, splat + 3 * (ulong)cam->width * cam->height, pixel,
+					v3(0.0f, 0.0f, 0.0f)};
+			bdpt_sample(&sc, x + jx, y + jy, light, eye, &out, &rng);
+			L = out.L;
+		} else {
+			L = pt_radiance(&sc, cam->pos, camera_ray_dir(cam, x + jx, y + jy), &rng);
+		}
 		sum[0] += film_fixed(L.x, rng_f(&rng));
 		sum[1] += film_fixed(L.y, rng_f(&rng));
 		sum[2] += film_fixed(L.z, rng_f(&rng));

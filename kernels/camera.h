@@ -22,13 +22,13 @@ INLINE V3 camera_ray_dir(GLOBAL const Camera *c, float px, float py)
 INLINE int camera_raster(GLOBAL const Camera *c, V3 d, float *px, float *py, float *cos_theta)
 {
 	float cz = v3_dot(d, c->forward);
+	*cos_theta = cz;
 	if (cz <= 0.0f)
 		return 0;
 	float h = c->tan_half_fov_y, a = h * c->aspect;
 	float sx = v3_dot(d, c->right) / cz, sy = v3_dot(d, c->up) / cz;
 	*px = (sx / a + 1.0f) * 0.5f * (float)c->width;
 	*py = (1.0f - sy / h) * 0.5f * (float)c->height;
-	*cos_theta = cz;
 	return *px >= 0.0f && *px < (float)c->width && *py >= 0.0f && *py < (float)c->height;
 }
 

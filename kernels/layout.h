@@ -7,7 +7,7 @@
 
 #define AJAR_LAYOUT_TYPES(X) \
 	X(BvhNode, 32) X(Tri, 48) X(TriShade, 64) X(Material, 64) X(Texture, 16) \
-	X(Emitter, 16) X(PortalTri, 48) X(Camera, 64) X(Params, 160)
+	X(Emitter, 16) X(PortalTri, 48) X(Camera, 64) X(Params, 176)
 
 #define AJAR_LAYOUT_FIELDS(X)                                                          \
 	X(BvhNode, bmin) X(BvhNode, index) X(BvhNode, bmax) X(BvhNode, count)          \
@@ -29,5 +29,6 @@
 	X(Params, env_color) X(Params, env_pdf_select) X(Params, scene_center)         \
 	X(Params, scene_radius) X(Params, max_depth) X(Params, rr_depth)               \
 	X(Params, integrator) X(Params, seed) X(Params, emitter_power)                 \
-	X(Params, env_power)
+	X(Params, env_power) X(Params, mis) X(Params, min_depth)                       \
+	X(Params, strategy_len) X(Params, strategy_unweighted)
 #endif

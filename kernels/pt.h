@@ -5,7 +5,10 @@
  * sampling by the power heuristic; Russian roulette after rr_depth segments
  * scales only the throughput, so it enters neither strategy's density and
  * the MIS weights stay consistent (design.md, Pitfalls). max_depth counts
- * path segments, camera segment included (Mitsuba's max_depth). */
+ * path segments, camera segment included (Mitsuba's max_depth); paths of
+ * fewer than min_depth segments are left out, so max_depth = min_depth = k
+ * gives the image of paths of exactly k segments, which each bidirectional
+ * strategy must reproduce. */
 #ifndef AJAR_PT_H
 #define AJAR_PT_H
 #include "bsdf.h"
@@ -30,14 +33,15 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 			if (!v3_is_zero(Le)) {
 				float w = prev_delta ? 1.0f
 						     : mis_power(prev_pdf_w, light_pdf_w(sc, prev_p, d, -1, AJAR_INF, 1.0f));
-				L = v3_add(L, v3_scale(v3_mul(beta, Le), w));
+				if (depth + 1 >= prm->min_depth)
+					L = v3_add(L, v3_scale(v3_mul(beta, Le), w));
 			}
 			break;
 		}
 		Surface s;
 		surface_from_hit(sc, &h, &s);
 		V3 wo = v3_neg(d);
-		if (sc->tris[s.tri].emitter >= 0) {
+		if (sc->tris[s.tri].emitter >= 0 && depth + 1 >= prm->min_depth) {
 			V3 Le = emitter_radiance(sc, s.tri, wo);
 			if (!v3_is_zero(Le)) {
 				float w = 1.0f;
@@ -53,7 +57,7 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 			break;
 		Bsdf bs;
 		bsdf_setup(&bs, &sc->materials[s.material], surface_base_color(sc, &s), s.ns, s.ng);
-		if (!bsdf_is_delta(&bs)) {
+		if (!bsdf_is_delta(&bs) && depth + 2 >= prm->min_depth) {
 			LightSample ls;
 			float u0 = rng_f(rng), u1 = rng_f(rng), u2 = rng_f(rng);
 			if (light_sample(sc, s.p, u0, u1, u2, &ls) && ls.pdf_w > 0.0f && !v3_is_zero(ls.Le)) {

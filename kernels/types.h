@@ -116,8 +116,12 @@ typedef struct {
 	uint seed;
 	float emitter_power;    /* 144, total power of emissive triangles */
 	float env_power;        /* power estimate of the environment */
+	int mis;                /* MIS_POWER or MIS_BALANCE (mis.h) */
+	int min_depth;          /* only paths of at least this many segments */
+	int strategy_len;       /* 160, bdpt: per-strategy layers up to this path length, 0 = none */
+	int strategy_unweighted;/* layers without MIS weights */
 	int pad0, pad1;
-} Params; /* 160 */
+} Params; /* 176 */
 
 /* Layout of the float array `env`: for an ENV_IMAGE of W x H,
  *   [0, 3WH)                    linear RGB radiance, row-major, row 0 = top

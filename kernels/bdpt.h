@@ -1,0 +1,407 @@
+/* bdpt.h — bidirectional path tracing (Veach 1997, ch. 10) in the
+ * notation of design.md: one light subpath and one eye subpath per pixel
+ * sample, every (s, t) strategy evaluated and weighted by mis_path_weight.
+ *
+ *   s = 0   the eye subpath hits an emitter or escapes to the environment;
+ *   s = 1   next-event estimation: a fresh light point (the same density as
+ *           the light subpath's first vertex) connected to eye vertex t-1;
+ *   t = 1   light vertex s-1 connected to the camera and splatted into the
+ *           pixel it lands in (light tracing);
+ *   others  light vertex s-1 connected to eye vertex t-1.
+ * For each strategy the path's MIS records are built from the subpaths, with
+ * the four densities next to the connection recomputed (bdpt_mis_path).
+ *
+ * Light subpaths leave an emitter by power, a uniform point on it and a
+ * cosine direction, or the environment by its importance, from a disk of
+ * the scene's bounding radius perpendicular to the direction. The camera
+ * direction density is that of a uniform point on the whole image (camera.h):
+ * with one light path per pixel sample, light tracing takes W H times as
+ * many samples per pixel as each eye strategy and has W H times smaller
+ * density per pixel, so n p agrees and the MIS counts are right. */
+#ifndef AJAR_BDPT_H
+#define AJAR_BDPT_H
+#include "camera.h"
+#include "film.h"
+#include "mis.h"
+#include "vertex.h"
+
+/* Emitted radiance and light-origin densities of a light vertex `l`
+ * (VERTEX_LIGHT on an emitter's front face, or VERTEX_ENV) toward w. */
+INLINE V3 bdpt_emitted(const SceneView *sc, const PathVertex *l, V3 w)
+{
+	if (l->type == VERTEX_ENV)
+		return env_radiance(sc, l->p);
+	return emitter_radiance(sc, l->tri, w);
+}
+
+/* Density of the light vertex as a light subpath's origin (pf_0). */
+INLINE float bdpt_origin_pdf(const SceneView *sc, const PathVertex *l)
+{
+	float ps = sc->params->env_pdf_select;
+	if (l->type == VERTEX_ENV)
+		return ps * env_pdf_w(sc, l->p);
+	return (1.0f - ps) * emitter_pdf_a(sc, l->tri);
+}
+
+/* Density with which the light vertex's emission sampling produces `to`
+ * (pf_1): cosine-weighted directions from emitters, a disk of radius R
+ * for the environment (parallel rays: per perpendicular area). */
+INLINE float bdpt_emission_pdf(const SceneView *sc, const PathVertex *l, const PathVertex *to)
+{
+	if (l->type == VERTEX_ENV) {
+		float r = sc->params->scene_radius;
+		return fabs(v3_dot(to->ng, l->p)) / (AJAR_PI * r * r);
+	}
+	V3 d = v3_sub(to->p, l->p);
+	float cos_l = v3_dot(l->ng, d) / v3_len(d);
+	if (!(cos_l > 0.0f))
+		return 0.0f;
+	return vertex_density_a(l, to, cos_l * AJAR_INV_PI);
+}
+
+/* Solid-angle density of `v`'s BSDF sampling `to`, given the vertex `from`
+ * on its other side (wo), for the mode of the subpath v belongs to. */
+INLINE float bdpt_bsdf_pdf_w(const SceneView *sc, const PathVertex *v, const PathVertex *from, const PathVertex *to,
+			     int mode)
+{
+	Bsdf bs;
+	float pdf_w, pdf_rev_w;
+	V3 wo = from->type == VERTEX_ENV ? from->p : v3_norm(v3_sub(from->p, v->p));
+	V3 wi = to->type == VERTEX_ENV ? to->p : v3_norm(v3_sub(to->p, v->p));
+	vertex_bsdf(sc, v, &bs);
+	bsdf_eval(&bs, wo, wi, mode, &pdf_w, &pdf_rev_w);
+	return pdf_w;
+}
+
+/* Densities of `to` sampled from `v` when the path's other neighbour of v
+ * is `from` (used on both sides of a connection). Camera and light origins
+ * are handled by the callers. */
+INLINE float bdpt_pdf_a(const SceneView *sc, const PathVertex *v, const PathVertex *from, const PathVertex *to,
+			int mode)
+{
+	return vertex_density_a(v, to, bdpt_bsdf_pdf_w(sc, v, from, to, mode));
+}
+
+/* The MIS records of the path made of light vertices l[0..s-1] and eye
+ * vertices e[t-1..0], with the densities next to the connection
+ * recomputed: pr of l[s-1] and l[s-2], pf of e[t-1] and e[t-2]. */
+INLINE int bdpt_mis_path(const SceneView *sc, const PathVertex *l, int s, const PathVertex *e, int t,
+			 MisVertex *mv)
+{
+	GLOBAL const Camera *cam = &sc->params->camera;
+	int k = s + t;
+	for (int i = 0; i < s; i++) {
+		mv[i].pf = l[i].pf;
+		mv[i].pr = l[i].pr;
+		mv[i].delta = l[i].delta;
+		mv[i].infinite = l[i].type == VERTEX_ENV;
+	}
+	for (int j = 0; j < t; j++) {
+		MisVertex *m = &mv[k - 1 - j];
+		m->pf = e[j].pf;
+		m->pr = e[j].pr;
+		m->delta = e[j].delta;
+		m->infinite = e[j].type == VERTEX_ENV;
+	}
+	/* The connection's ends scatter through non-delta lobes on this path,
+	 * whatever their subpaths sampled next (pbrt does the same). */
+	if (s > 0)
+		mv[s - 1].delta = 0;
+	mv[s].delta = 0;
+	if (s == 0) {
+		/* e[t-1] is the light: its origin density and emission density. */
+		const PathVertex *lt = &e[t - 1];
+		mv[0].pf = bdpt_origin_pdf(sc, lt);
+		if (t >= 3)
+			mv[1].pf = bdpt_emission_pdf(sc, lt, &e[t - 2]);
+		return k;
+	}
+	const PathVertex *ls = &l[s - 1], *es = &e[t - 1];
+	/* Eye side of the connection: pf of e[t-1], then of e[t-2]. */
+	if (t >= 2) {
+		if (s == 1)
+			mv[s].pf = bdpt_emission_pdf(sc, ls, es);
+		else
+			mv[s].pf = bdpt_pdf_a(sc, ls, &l[s - 2], es, BSDF_IMPORTANCE);
+		if (t >= 3)
+			mv[s + 1].pf = bdpt_pdf_a(sc, es, ls, &e[t - 2], BSDF_RADIANCE);
+	}
+	/* Light side: pr of l[s-1] (from the eye vertex or the camera), then of l[s-2]. */
+	if (t == 1) {
+		float px, py, cos_c;
+		V3 d = v3_sub(ls->p, cam->pos);
+		float d2 = v3_len2(d);
+		camera_raster(cam, v3_scale(d, 1.0f / sqrt(d2)), &px, &py, &cos_c);
+		mv[s - 1].pr = vertex_density_a(es, ls, camera_pdf_w(cam, cos_c));
+	} else {
+		mv[s - 1].pr = bdpt_pdf_a(sc, es, &e[t - 2], ls, BSDF_RADIANCE);
+	}
+	if (s >= 2)
+		mv[s - 2].pr = bdpt_pdf_a(sc, ls, es, &l[s - 2], BSDF_IMPORTANCE);
+	return k;
+}
+
+INLINE float bdpt_weight(const SceneView *sc, const PathVertex *l, int s, const PathVertex *e, int t)
+{
+	MisVertex mv[2 * SUBPATH_MAX];
+	int k = bdpt_mis_path(sc, l, s, e, t, mv);
+	return mis_path_weight(mv, k, s, sc->params->mis);
+}
+
+/* Unoccluded segment between two vertices (either may be the camera). */
+INLINE int bdpt_visible(const SceneView *sc, const PathVertex *a, const PathVertex *b)
+{
+	V3 d = v3_sub(b->p, a->p);
+	V3 o = a->type == VERTEX_CAMERA ? a->p : ray_offset(a->p, a->ng, d);
+	V3 q = b->type == VERTEX_CAMERA ? b->p : ray_offset(b->p, b->ng, v3_neg(d));
+	V3 od = v3_sub(q, o);
+	float len = v3_len(od);
+	if (!(len > 0.0f))
+		return 0;
+	return !bvh_occluded(sc, o, v3_scale(od, 1.0f / len), len * (1.0f - 1e-4f));
+}
+
+/* f (with the shading-normal correction on light subpaths) times the
+ * shading cosine toward `to`, at a surface vertex v whose subpath
+ * predecessor lies along v->wo. */
+INLINE V3 bdpt_scatter(const SceneView *sc, const PathVertex *v, V3 wi, int mode)
+{
+	Bsdf bs;
+	float pdf_w, pdf_rev_w;
+	vertex_bsdf(sc, v, &bs);
+	V3 f = bsdf_eval(&bs, v->wo, wi, mode, &pdf_w, &pdf_rev_w);
+	float k = fabs(v3_dot(v->ns, wi));
+	if (mode == BSDF_IMPORTANCE)
+		k *= vertex_shading_correction(v, v->wo, wi);
+	return v3_scale(f, k);
+}
+
+/* Traces the light subpath into l[]; returns its vertex count (0 if the
+ * scene has nothing to start from). */
+INLINE int bdpt_light_subpath(const SceneView *sc, PathVertex *l, int max_verts, Rng *rng)
+{
+	GLOBAL const Params *prm = sc->params;
+	float ps = prm->env_pdf_select;
+	float u_sel = rng_f(rng), u1 = rng_f(rng), u2 = rng_f(rng), u3 = rng_f(rng), u4 = rng_f(rng);
+	if (max_verts < 1)
+		return 0;
+	PathVertex *y = &l[0];
+	y->delta = 0;
+	y->pr = 0.0f;
+	y->base = v3(0.0f, 0.0f, 0.0f);
+	y->material = -1;
+	if (u_sel < ps) {
+		float pdf_w;
+		V3 dir;
+		V3 Le = env_sample(sc, u1, u2, &dir, &pdf_w);
+		if (!(pdf_w > 0.0f))
+			return 0;
+		float r = prm->scene_radius, dx, dy;
+		V3 t, b;
+		v3_basis(dir, &t, &b);
+		sample_concentric_disk(u3, u4, &dx, &dy);
+		V3 o = v3_add(v3_add(prm->scene_center, v3_scale(dir, r)),
+			      v3_add(v3_scale(t, dx * r), v3_scale(b, dy * r)));
+		y->type = VERTEX_ENV;
+		y->p = dir;
+		y->ng = y->ns = y->wo = v3_neg(dir);
+		y->tri = -1;
+		y->pf = ps * pdf_w;
+		float pdf_disk = 1.0f / (AJAR_PI * r * r);
+		y->beta = v3(1.0f / y->pf, 1.0f / y->pf, 1.0f / y->pf);
+		V3 beta = v3_scale(Le, 1.0f / (y->pf * pdf_disk));
+		return vertex_walk(sc, l, 1, max_verts, o, v3_neg(dir), beta, pdf_disk, 1, 1, 0, rng);
+	}
+	float u = fmin((u_sel - ps) / (1.0f - ps), 0.99999994f), pdf_a;
+	V3 p, n;
+	int tri = emitter_sample(sc, u, u1, u2, &p, &n, &pdf_a);
+	if (tri < 0 || !(pdf_a > 0.0f))
+		return 0;
+	y->type = VERTEX_LIGHT;
+	y->p = p;
+	y->ng = y->ns = y->wo = n;
+	y->tri = tri;
+	y->pf = (1.0f - ps) * pdf_a;
+	y->beta = v3(1.0f / y->pf, 1.0f / y->pf, 1.0f / y->pf);
+	V3 t, b;
+	v3_basis(n, &t, &b);
+	V3 lc = sample_cosine_hemisphere(u3, u4);
+	if (!(lc.z > 0.0f))
+		return 1;
+	V3 dir = v3_from_local(lc, t, b, n);
+	V3 Le = emitter_radiance(sc, tri, dir);
+	/* Le cos / (pf_0 cos / pi) */
+	V3 beta = v3_scale(Le, AJAR_PI / y->pf);
+	return vertex_walk(sc, l, 1, max_verts, ray_offset(p, n, dir), dir, beta, lc.z * AJAR_INV_PI, 0, 1, 0,
+			   rng);
+}
+
+/* Where a sample's contributions go: the pixel's own sum (eye strategies),
+ * the splat film (t = 1), and optionally one layer per strategy (s, t) for
+ * paths of up to strategy_len segments: layer (n - 1)(n + 2)/2 + s for
+ * n = s + t - 1 segments, each a width x height x 3 fixed-point image. */
+typedef struct {
+	GLOBAL long *splat;
+	GLOBAL long *layers; /* 0 when strategy_len is 0 */
+	uint pixel;
+	V3 L;                /* this pixel's eye-strategy sum */
+} BdptFilm;
+
+INLINE int bdpt_layer_count(int len) { return len * (len + 3) / 2; }
+
+INLINE void film_add(GLOBAL long *film, uint pixel, V3 c, Rng *rng)
+{
+	atom_add(&film[3 * pixel + 0], film_fixed(c.x, rng_f(rng)));
+	atom_add(&film[3 * pixel + 1], film_fixed(c.y, rng_f(rng)));
+	atom_add(&film[3 * pixel + 2], film_fixed(c.z, rng_f(rng)));
+}
+
+/* Records the unweighted contribution c of strategy (s, t) with MIS weight
+ * w, landing in `pixel` (this sample's pixel unless t = 1). */
+INLINE void bdpt_add(const SceneView *sc, BdptFilm *out, int s, int t, V3 c, float w, uint pixel, Rng *rng)
+{
+	GLOBAL const Params *prm = sc->params;
+	int n = s + t - 1;
+	if (n < prm->min_depth)
+		return;
+	V3 cw = v3_scale(c, w);
+	if (t == 1)
+		film_add(out->splat, pixel, cw, rng);
+	else
+		out->L = v3_add(out->L, cw);
+	if (n <= prm->strategy_len) {
+		uint npix = (uint)(prm->camera.width * prm->camera.height);
+		uint layer = (uint)((n - 1) * (n + 2) / 2 + s);
+		film_add(out->layers + 3 * (ulong)npix * layer, pixel, prm->strategy_unweighted ? c : cw, rng);
+	}
+}
+
+/* Connecting light vertex y (s >= 2) to eye vertex z (t >= 2), both on
+ * surfaces: f_y G f_z without the betas, or 0 if occluded or either BSDF
+ * is black toward the other. */
+INLINE V3 bdpt_connect(const SceneView *sc, const PathVertex *y, const PathVertex *z)
+{
+	V3 d = v3_sub(z->p, y->p);
+	float d2 = v3_len2(d);
+	if (!(d2 > 0.0f))
+		return v3(0.0f, 0.0f, 0.0f);
+	V3 w = v3_scale(d, 1.0f / sqrt(d2));
+	V3 fy = bdpt_scatter(sc, y, w, BSDF_IMPORTANCE);
+	if (v3_is_zero(fy))
+		return fy;
+	V3 fz = bdpt_scatter(sc, z, v3_neg(w), BSDF_RADIANCE);
+	if (v3_is_zero(fz) || !bdpt_visible(sc, y, z))
+		return v3(0.0f, 0.0f, 0.0f);
+	return v3_scale(v3_mul(fy, fz), 1.0f / d2);
+}
+
+/* Light vertex y (s >= 1) seen by the camera: splats its weighted
+ * contribution into the pixel it lands in. */
+INLINE void bdpt_light_to_camera(const SceneView *sc, PathVertex *l, int s, PathVertex *cam_v, BdptFilm *out,
+				 Rng *rng)
+{
+	GLOBAL const Camera *cam = &sc->params->camera;
+	const PathVertex *y = &l[s - 1];
+	V3 d = v3_sub(cam->pos, y->p);
+	float d2 = v3_len2(d), px, py, cos_c;
+	if (!(d2 > 0.0f) || y->type == VERTEX_ENV)
+		return;
+	V3 w = v3_scale(d, 1.0f / sqrt(d2));
+	if (!camera_raster(cam, v3_neg(w), &px, &py, &cos_c))
+		return;
+	V3 fy = s == 1 ? v3_scale(bdpt_emitted(sc, y, w), fabs(v3_dot(y->ng, w)))
+		       : bdpt_scatter(sc, y, w, BSDF_IMPORTANCE);
+	if (v3_is_zero(fy) || !bdpt_visible(sc, y, cam_v))
+		return;
+	/* We G = cos_c / (A cos_c^4) / d^2 for the pinhole (camera.h). */
+	float we = camera_pdf_w(cam, cos_c) / d2;
+	V3 c = v3_scale(v3_mul(y->beta, fy), we);
+	uint pixel = (uint)py * (uint)cam->width + (uint)px;
+	bdpt_add(sc, out, s, 1, c, bdpt_weight(sc, l, s, cam_v, 1), pixel, rng);
+}
+
+/* Traces the eye subpath through raster point (px, py) into e[]; e[0] is
+ * the camera. Returns its vertex count. */
+INLINE int bdpt_eye_subpath(const SceneView *sc, float px, float py, PathVertex *e, int max_verts, Rng *rng)
+{
+	GLOBAL const Camera *cam = &sc->params->camera;
+	PathVertex *z0 = &e[0];
+	z0->type = VERTEX_CAMERA;
+	z0->p = cam->pos;
+	z0->ng = z0->ns = z0->wo = cam->forward;
+	z0->beta = v3(1.0f, 1.0f, 1.0f);
+	z0->base = v3(0.0f, 0.0f, 0.0f);
+	z0->pf = 0.0f;
+	z0->pr = 1.0f;
+	z0->delta = 0;
+	z0->material = z0->tri = -1;
+	V3 dir = camera_ray_dir(cam, px, py);
+	float cos_c = v3_dot(dir, cam->forward);
+	return vertex_walk(sc, e, 1, max_verts, cam->pos, dir, z0->beta, camera_pdf_w(cam, cos_c), 0, 0, 1, rng);
+}
+
+/* One pixel sample at raster (px, py) of pixel out->pixel: adds the eye
+ * strategies to out->L and splats light tracing (t = 1). l and e hold
+ * SUBPATH_MAX vertices each. */
+INLINE void bdpt_sample(const SceneView *sc, float px, float py, PathVertex *l, PathVertex *e, BdptFilm *out,
+			Rng *rng)
+{
+	int depth = sc->params->max_depth;
+	V3 one = v3(1.0f, 1.0f, 1.0f);
+
+	int nl = bdpt_light_subpath(sc, l, depth, rng);
+	int ne = bdpt_eye_subpath(sc, px, py, e, depth + 1, rng);
+	PathVertex *z0 = &e[0];
+
+	/* t = 1: every light vertex to the camera. */
+	for (int s = 1; s <= nl && s <= depth; s++)
+		bdpt_light_to_camera(sc, l, s, z0, out, rng);
+
+	for (int t = 2; t <= ne; t++) {
+		PathVertex *z = &e[t - 1];
+		/* s = 0: the eye subpath found the light. */
+		if (z->type == VERTEX_ENV || sc->tris[z->tri].emitter >= 0) {
+			V3 Le = bdpt_emitted(sc, z, z->wo);
+			if (!v3_is_zero(Le))
+				bdpt_add(sc, out, 0, t, v3_mul(z->beta, Le), bdpt_weight(sc, l, 0, e, t), out->pixel, rng);
+		}
+		if (z->type == VERTEX_ENV)
+			break;
+		/* s = 1: next-event estimation with a fresh light sample. */
+		if (t <= depth) {
+			LightSample ls;
+			float u0 = rng_f(rng), u1 = rng_f(rng), u2 = rng_f(rng);
+			if (light_sample(sc, z->p, u0, u1, u2, &ls) && !v3_is_zero(ls.Le)) {
+				PathVertex y;
+				y.type = ls.is_env ? VERTEX_ENV : VERTEX_LIGHT;
+				y.p = ls.is_env ? ls.wi : ls.p;
+				y.ng = y.ns = y.wo = ls.n;
+				y.base = v3(0.0f, 0.0f, 0.0f);
+				y.delta = 0;
+				y.material = y.tri = -1;
+				/* pf_0: solid angle for the environment, area for emitters. */
+				y.pf = ls.is_env ? ls.pdf_w : ls.pdf_w * fabs(v3_dot(ls.n, ls.wi)) / (ls.dist * ls.dist);
+				y.pr = 0.0f;
+				y.beta = one;
+				V3 f = bdpt_scatter(sc, z, ls.wi, BSDF_RADIANCE);
+				if (!v3_is_zero(f)) {
+					V3 o = ray_offset(z->p, z->ng, ls.wi);
+					int vis = ls.is_env ? !bvh_occluded(sc, o, ls.wi, AJAR_INF) : bdpt_visible(sc, z, &y);
+					if (vis) {
+						V3 c = v3_scale(v3_mul(v3_mul(z->beta, f), ls.Le), 1.0f / ls.pdf_w);
+						bdpt_add(sc, out, 1, t, c, bdpt_weight(sc, &y, 1, e, t), out->pixel, rng);
+					}
+				}
+			}
+		}
+		/* s >= 2: light vertex s-1 to eye vertex t-1. */
+		for (int s = 2; s <= nl && s + t - 1 <= depth; s++) {
+			V3 c = bdpt_connect(sc, &l[s - 1], z);
+			if (v3_is_zero(c))
+				continue;
+			bdpt_add(sc, out, s, t, v3_mul(v3_mul(l[s - 1].beta, c), z->beta), bdpt_weight(sc, l, s, e, t),
+				 out->pixel, rng);
+		}
+	}
+}
+#endif

@@ -1,0 +1,157 @@
+/* vertex.h — subpath vertices and the random walk that extends a subpath
+ * (eye, light, and later the two halves of an intermediate subpath).
+ *
+ * Each vertex stores pf and pr in the global sense of design.md: pf is the
+ * density of the vertex sampled from the light side, pr from the eye side,
+ * both in area measure, except for a vertex at infinity (the environment),
+ * whose density is the solid-angle density of its direction. A walk fills
+ * one of them (the direction it walks in) and, when it samples the next
+ * vertex, the other one of the vertex before it (pbrt's pdfRev). Densities
+ * that involve a delta lobe are stored as 0 (see mis.h). */
+#ifndef AJAR_VERTEX_H
+#define AJAR_VERTEX_H
+#include "bsdf.h"
+#include "bvh.h"
+#include "lights.h"
+#include "rng.h"
+#include "surface.h"
+
+#define VERTEX_CAMERA 0
+#define VERTEX_LIGHT 1   /* the point where a light subpath starts on an emitter */
+#define VERTEX_ENV 2     /* the environment: p holds the unit direction to the sky */
+#define VERTEX_SURFACE 3
+
+/* Maximum vertices of one subpath; bdpt needs max_depth + 1 eye vertices. */
+#define SUBPATH_MAX 33
+
+typedef struct {
+	V3 p;     /* position, or direction to the sky for VERTEX_ENV */
+	V3 ng;    /* unit geometric normal (front face); light: emitter normal */
+	V3 ns;    /* unit shading normal */
+	V3 wo;    /* unit direction to the previous vertex of this subpath */
+	V3 beta;  /* subpath throughput up to and including this vertex's sampling */
+	V3 base;  /* textured base colour, for rebuilding the BSDF */
+	float pf, pr;
+	int type;
+	int delta;    /* scattered by a delta lobe */
+	int material; /* -1 for camera, env */
+	int tri;      /* hit triangle, -1 for camera, env */
+} PathVertex;
+
+INLINE void vertex_bsdf(const SceneView *sc, const PathVertex *v, Bsdf *bs)
+{
+	bsdf_setup(bs, &sc->materials[v->material], v->base, v->ns, v->ng);
+}
+
+/* Area density at `to` of a direction sampled at `from` with solid-angle
+ * density pdf_w; unchanged (solid angle) when `to` is at infinity. */
+INLINE float vertex_density_a(const PathVertex *from, const PathVertex *to, float pdf_w)
+{
+	if (to->type == VERTEX_ENV)
+		return pdf_w;
+	V3 d = v3_sub(to->p, from->p);
+	float d2 = v3_len2(d);
+	if (!(d2 > 0.0f))
+		return 0.0f;
+	return pdf_w * fabs(v3_dot(to->ng, d)) / (d2 * sqrt(d2));
+}
+
+/* pbrt's correction for shading normals in light transport (Veach 1997,
+ * sec. 5.3): scattering toward wi at a light-subpath vertex whose previous
+ * vertex lies along wo. */
+INLINE float vertex_shading_correction(const PathVertex *v, V3 wo, V3 wi)
+{
+	float den = fabs(v3_dot(wo, v->ng)) * fabs(v3_dot(wi, v->ns));
+	if (!(den > 0.0f))
+		return 0.0f;
+	return fabs(v3_dot(wo, v->ns)) * fabs(v3_dot(wi, v->ng)) / den;
+}
+
+/* Continues a subpath whose last vertex is path[n - 1] along the ray (o, d)
+ * with throughput beta. `pdf_w` is the solid-angle density of d at
+ * path[n - 1]; `parallel` says the ray is one of a parallel family (leaving
+ * the environment's disk): then pdf_w is a density per unit perpendicular
+ * area and no 1/d^2 applies. `light_side` says which density the walk fills
+ * (pf for light subpaths and the portal's <- half). `escape_env` adds an
+ * environment vertex when the ray escapes (eye side). Stops at max_verts
+ * vertices, when the BSDF gives no sample, or by Russian roulette after
+ * rr_depth vertices of this subpath. Returns the new vertex count. */
+INLINE int vertex_walk(const SceneView *sc, PathVertex *path, int n, int max_verts, V3 o, V3 d, V3 beta,
+		       float pdf_w, int parallel, int light_side, int escape_env, Rng *rng)
+{
+	GLOBAL const Params *prm = sc->params;
+	int mode = light_side ? BSDF_IMPORTANCE : BSDF_RADIANCE;
+	float beta_ref = fmax(v3_maxc(beta), 1e-30f);
+	while (n < max_verts) {
+		PathVertex *prev = &path[n - 1], *v = &path[n];
+		Hit h;
+		if (!bvh_intersect(sc, o, d, AJAR_INF, &h)) {
+			if (!escape_env || prm->env_type == ENV_NONE)
+				break;
+			v->type = VERTEX_ENV;
+			v->p = d;
+			v->ng = v->ns = v3_neg(d);
+			v->wo = v3_neg(d);
+			v->beta = beta;
+			v->base = v3(0.0f, 0.0f, 0.0f);
+			v->material = v->tri = -1;
+			v->delta = 0;
+			v->pf = 0.0f;
+			v->pr = pdf_w;
+			return n + 1;
+		}
+		Surface s;
+		surface_from_hit(sc, &h, &s);
+		v->type = VERTEX_SURFACE;
+		v->p = s.p;
+		v->ng = s.ng;
+		v->ns = s.ns;
+		v->wo = v3_neg(d);
+		v->beta = beta;
+		v->base = surface_base_color(sc, &s);
+		v->material = s.material;
+		v->tri = s.tri;
+		v->delta = 0;
+		float pa = parallel ? pdf_w * fabs(v3_dot(s.ng, d)) : vertex_density_a(prev, v, pdf_w);
+		parallel = 0;
+		if (light_side) {
+			v->pf = pa;
+			v->pr = 0.0f;
+		} else {
+			v->pr = pa;
+			v->pf = 0.0f;
+		}
+		n++;
+		if (n >= max_verts)
+			break;
+		Bsdf bs;
+		BsdfSample bsm;
+		vertex_bsdf(sc, v, &bs);
+		float u0 = rng_f(rng), u1 = rng_f(rng), u2 = rng_f(rng);
+		if (!bsdf_sample(&bs, v->wo, u0, u1, u2, mode, &bsm) || !(bsm.pdf_w > 0.0f))
+			break;
+		float k = fabs(v3_dot(v->ns, bsm.wi)) / bsm.pdf_w;
+		if (light_side)
+			k *= vertex_shading_correction(v, v->wo, bsm.wi);
+		beta = v3_mul(beta, v3_scale(bsm.f, k));
+		v->delta = bsm.delta;
+		pdf_w = bsm.delta ? 0.0f : bsm.pdf_w;
+		float rev_a = bsm.delta ? 0.0f : vertex_density_a(v, prev, bsm.pdf_rev_w);
+		if (light_side)
+			prev->pr = rev_a;
+		else
+			prev->pf = rev_a;
+		if (n >= prm->rr_depth) {
+			float q = fmin(v3_maxc(beta) / beta_ref, 0.95f);
+			if (!(rng_f(rng) < q))
+				break;
+			beta = v3_scale(beta, 1.0f / q);
+		}
+		if (v3_is_zero(beta))
+			break;
+		o = ray_offset(s.p, s.ng, bsm.wi);
+		d = bsm.wi;
+	}
+	return n;
+}
+#endif

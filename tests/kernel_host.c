@@ -1,0 +1,70 @@
+/* kernel_host.c — see kernel_host.h. */
+#include "kernel_host.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "testutil.h"
+
+void host_scene_open(HostScene *h, const char *path, Scene *built, uint32_t w, uint32_t hgt, int integrator,
+		     int max_depth)
+{
+	memset(h, 0, sizeof *h);
+	if (path) {
+		if (ajar_scene_load(path, &h->scene) != AJAR_OK)
+			fail_msg("%s", ajar_last_error());
+	} else {
+		h->scene = built;
+	}
+	PrepareOptions po = {w, hgt, integrator, (uint32_t)max_depth, 1};
+	if (prepare_scene(h->scene, &po, &h->data) != AJAR_OK)
+		fail_msg("%s", ajar_last_error());
+#define HOST_VIEW(type, name) h->view.name = h->data.name;
+	AJAR_SCENE_BUFFERS(HOST_VIEW)
+#undef HOST_VIEW
+}
+
+void host_scene_close(HostScene *h)
+{
+	prepare_free(&h->data);
+	ajar_scene_destroy(&h->scene);
+}
+
+void host_render(HostScene *h, uint32_t spp, uint32_t seed, double *rgb, double *layers)
+{
+	Params *prm = h->data.params;
+	GLOBAL const Camera *cam = &prm->camera;
+	uint32_t npix = (uint32_t)(cam->width * cam->height);
+	int nlayers = bdpt_layer_count(prm->strategy_len);
+	long *film = calloc((size_t)3 * npix * (1 + (size_t)nlayers), sizeof *film);
+	double *eye = calloc((size_t)3 * npix, sizeof *eye);
+	PathVertex *lv = malloc(sizeof *lv * SUBPATH_MAX), *ev = malloc(sizeof *ev * SUBPATH_MAX);
+	prm->seed = seed;
+	for (uint32_t px = 0; px < npix; px++) {
+		for (uint32_t i = 0; i < spp; i++) {
+			Rng rng = rng_init(seed, px, i, 0u);
+			float x = (float)(px % (uint32_t)cam->width) + rng_f(&rng);
+			float y = (float)(px / (uint32_t)cam->width) + rng_f(&rng);
+			V3 L;
+			if (prm->integrator == INTEGRATOR_BDPT) {
+				BdptFilm out = {film, film + 3 * (size_t)npix, px, v3(0, 0, 0)};
+				bdpt_sample(&h->view, x, y, lv, ev, &out, &rng);
+				L = out.L;
+			} else {
+				L = pt_radiance(&h->view, cam->pos, camera_ray_dir(cam, x, y), &rng);
+			}
+			eye[3 * px] += L.x;
+			eye[3 * px + 1] += L.y;
+			eye[3 * px + 2] += L.z;
+		}
+	}
+	for (size_t i = 0; i < (size_t)3 * npix; i++)
+		rgb[i] = (eye[i] + film[i] / (double)FILM_SCALE) / spp;
+	if (layers)
+		for (size_t i = 0; i < (size_t)3 * npix * nlayers; i++)
+			layers[i] = film[3 * (size_t)npix + i] / (double)FILM_SCALE / spp;
+	free(film);
+	free(eye);
+	free(lv);
+	free(ev);
+}

@@ -1,0 +1,27 @@
+/* kernel_host.h — runs the kernels' integrators on the host, one thread,
+ * for tests that need to look inside a sample (MIS records, strategy
+ * images) or must not depend on an OpenCL device. The same headers are
+ * what the device compiles. */
+#ifndef AJAR_KERNEL_HOST_H
+#define AJAR_KERNEL_HOST_H
+#include "../kernels/bdpt.h"
+#include "../kernels/pt.h"
+#include "prepare.h"
+
+typedef struct {
+	Scene *scene;
+	SceneData data;
+	SceneView view;
+} HostScene;
+
+/* Loads `path` (or takes `built` if path is NULL) and prepares it for a
+ * width x height image; integrator settings go into the Params. */
+void host_scene_open(HostScene *h, const char *path, Scene *built, uint32_t w, uint32_t hgt, int integrator,
+		     int max_depth);
+void host_scene_close(HostScene *h);
+
+/* Renders spp samples per pixel: rgb gets the mean (3 floats per pixel);
+ * layers (if not NULL) the per-strategy means for paths up to
+ * params->strategy_len segments, 3 doubles per pixel per layer. */
+void host_render(HostScene *h, uint32_t spp, uint32_t seed, double *rgb, double *layers);
+#endif

@@ -1,0 +1,424 @@
+/* test_bdpt.c — bidirectional path tracing, checked on the host with the
+ * kernels' own code (tests/kernel_host.h):
+ *   - MIS records: for random paths in the shipped scenes and a scene with
+ *     glass, mirrors, an emitter and the sky, the densities bdpt_mis_path
+ *     builds for a strategy equal those an independent oracle computes from
+ *     the path's geometry, and the weights of all strategies that can
+ *     produce the path sum to 1, for the power and the balance heuristic;
+ *   - each strategy alone, unweighted, converges to the path tracer's image
+ *     of paths of exactly its length; light tracing alone (t = 1) too;
+ *   - the weighted strategy layers sum to the image;
+ *   - bdpt and pt agree.
+ * Statistics: image means from B independent batches (different seeds);
+ * the batch spread gives the standard error, and a difference must stay
+ * within Z standard errors (Student t with B - 1 degrees of freedom). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "kernel_host.h"
+#include "testutil.h"
+
+/* ---- The oracle: every vertex's pf and pr from the path alone ---------- */
+
+static float oracle_convert(const PathVertex *from, const PathVertex *to, float pdf_w)
+{
+	if (to->type == VERTEX_ENV)
+		return pdf_w;
+	double dx = to->p.x - from->p.x, dy = to->p.y - from->p.y, dz = to->p.z - from->p.z;
+	double d2 = dx * dx + dy * dy + dz * dz, d = sqrt(d2);
+	double c = fabs(to->ng.x * dx + to->ng.y * dy + to->ng.z * dz) / d;
+	return (float)(pdf_w * c / d2);
+}
+
+static V3 oracle_dir(const PathVertex *from, const PathVertex *to)
+{
+	return to->type == VERTEX_ENV ? to->p : v3_norm(v3_sub(to->p, from->p));
+}
+
+/* Solid-angle density that v's BSDF samples toward `to` given `from`. */
+static float oracle_bsdf(const SceneView *sc, const PathVertex *v, const PathVertex *from, const PathVertex *to)
+{
+	Bsdf bs;
+	float pdf, rev;
+	bsdf_setup(&bs, &sc->materials[v->material], v->base, v->ns, v->ng);
+	bsdf_eval(&bs, oracle_dir(v, from), oracle_dir(v, to), BSDF_RADIANCE, &pdf, &rev);
+	return pdf;
+}
+
+/* x[0] light (emitter point or environment), x[k-1] camera; delta[i] says
+ * x[i] scattered through a delta lobe on this path. */
+static void oracle(const SceneView *sc, const PathVertex *x, const int *delta, int k, MisVertex *mv)
+{
+	GLOBAL const Params *prm = sc->params;
+	float ps = prm->env_pdf_select;
+	for (int i = 0; i < k; i++) {
+		mv[i].delta = delta[i];
+		mv[i].infinite = x[i].type == VERTEX_ENV;
+		/* pf */
+		if (i == k - 1)
+			mv[i].pf = 0;
+		else if (i == 0)
+			mv[i].pf = x[0].type == VERTEX_ENV ? ps * env_pdf_w(sc, x[0].p)
+							   : (1 - ps) * emitter_pdf_a(sc, x[0].tri);
+		else if (i == 1 && x[0].type == VERTEX_ENV)
+			mv[i].pf = fabs(v3_dot(x[1].ng, x[0].p)) /
+				   (AJAR_PI * prm->scene_radius * prm->scene_radius);
+		else if (i == 1) {
+			V3 d = v3_norm(v3_sub(x[1].p, x[0].p));
+			float c = v3_dot(v3_norm(tri_normal(&sc->tris[x[0].tri])), d);
+			mv[i].pf = c > 0 ? oracle_convert(&x[0], &x[1], c / AJAR_PI) : 0;
+		} else
+			mv[i].pf = delta[i - 1] ? 0 : oracle_convert(&x[i - 1], &x[i], oracle_bsdf(sc, &x[i - 1], &x[i - 2], &x[i]));
+		/* pr */
+		if (i == k - 1)
+			mv[i].pr = 1;
+		else if (i == k - 2) {
+			GLOBAL const Camera *cam = &prm->camera;
+			V3 d = oracle_dir(&x[k - 1], &x[i]);
+			mv[i].pr = oracle_convert(&x[k - 1], &x[i], camera_pdf_w(cam, v3_dot(d, cam->forward)));
+		} else
+			mv[i].pr = delta[i + 1] ? 0 : oracle_convert(&x[i + 1], &x[i], oracle_bsdf(sc, &x[i + 1], &x[i + 2], &x[i]));
+	}
+}
+
+/* Whether an edge that the densities of vertex i depend on is shorter
+ * than 1% of the scene radius: there the ray offset (a few hundred ulps),
+ * seen at a grazing angle, is a sizeable fraction of the edge. */
+static int near_contact(const PathVertex *x, int k, int i, float radius)
+{
+	for (int j = i - 2; j < i + 2; j++) {
+		if (j < 0 || j + 1 >= k || x[j].type == VERTEX_ENV || x[j + 1].type == VERTEX_ENV)
+			continue;
+		if (v3_len(v3_sub(x[j + 1].p, x[j].p)) < 1e-2f * radius)
+			return 1;
+	}
+	return 0;
+}
+
+static int strategy_valid(const MisVertex *v, int k, int s)
+{
+	if (s == 0)
+		return 1;
+	if (v[s - 1].delta || v[s].delta)
+		return 0;
+	return !(v[s - 1].infinite && s == k - 1);
+}
+
+/* Relative difference of two densities. The walk converts the density of
+ * the direction it sampled; the oracle that of the direction between the
+ * vertices, which differs by the ray origin's offset: at grazing angles or
+ * for vertices a few ulps-offsets apart (corners) that reaches percents.
+ * A wrong conversion, vertex or BSDF mode is off on most paths, so the
+ * test allows 1% of records beyond 1% and none beyond 10%. */
+static double rel_diff(float a, float b)
+{
+	if (a == b)
+		return 0;
+	return fabs(a - b) / fmax(fabs(a), fabs(b));
+}
+
+/* Random paths of every strategy in one scene: records against the
+ * oracle, and the sum of weights. Returns how many paths were checked. */
+static int check_mis(HostScene *h, int nsamples)
+{
+	SceneView *sc = &h->view;
+	Params *prm = h->data.params;
+	PathVertex l[SUBPATH_MAX], e[SUBPATH_MAX], x[2 * SUBPATH_MAX];
+	int dl[2 * SUBPATH_MAX];
+	MisVertex rec[2 * SUBPATH_MAX], orc[2 * SUBPATH_MAX];
+	int checked = 0, with_delta = 0, with_env = 0, records = 0, off = 0;
+	int depth = prm->max_depth;
+	for (int n = 0; n < nsamples; n++) {
+		Rng rng = rng_init(99, (uint)n, 0, 7);
+		float px = rng_f(&rng) * prm->camera.width, py = rng_f(&rng) * prm->camera.height;
+		int nl = bdpt_light_subpath(sc, l, depth, &rng);
+		int ne = bdpt_eye_subpath(sc, px, py, e, depth + 1, &rng);
+		for (int s = 0; s <= nl; s++) {
+			for (int t = 1; t <= ne; t++) {
+				int k = s + t;
+				if (k - 1 > depth || (s == 0 && t < 2))
+					continue;
+				if (s == 0) {
+					const PathVertex *z = &e[t - 1];
+					if (!(z->type == VERTEX_ENV || (z->tri >= 0 && sc->tris[z->tri].emitter >= 0)))
+						continue;
+					if (v3_is_zero(bdpt_emitted(sc, z, z->wo)))
+						continue;
+				} else {
+					if (l[s - 1].type == VERTEX_ENV && t == 1)
+						continue;
+					if (e[t - 1].type == VERTEX_ENV)
+						continue;
+					/* Both ends must scatter toward each other. */
+					if (s >= 2) {
+						V3 w = v3_norm(v3_sub(e[t - 1].p, l[s - 1].p));
+						if (v3_is_zero(bdpt_scatter(sc, &l[s - 1], w, BSDF_IMPORTANCE)))
+							continue;
+					}
+					if (t >= 2 && v3_is_zero(bdpt_scatter(sc, &e[t - 1], oracle_dir(&e[t - 1], &l[s - 1]),
+									   BSDF_RADIANCE)))
+						continue;
+				}
+				/* The path and its delta flags. */
+				for (int i = 0; i < s; i++) {
+					x[i] = l[i];
+					dl[i] = l[i].delta;
+				}
+				for (int j = 0; j < t; j++) {
+					x[k - 1 - j] = e[j];
+					dl[k - 1 - j] = e[j].delta;
+				}
+				if (s > 0)
+					dl[s - 1] = 0;
+				dl[s] = 0;
+				dl[0] = 0;
+				if (s == 0 && x[0].type != VERTEX_ENV)
+					x[0].type = VERTEX_LIGHT;
+				bdpt_mis_path(sc, l, s, e, t, rec);
+				oracle(sc, x, dl, k, orc);
+				for (int i = 0; i < k; i++) {
+					if (i == k - 1 || (i == 0 && t == k))
+						continue; /* camera's pf, and pr of ... never used */
+					double diff = fmax(rel_diff(rec[i].pf, orc[i].pf), rel_diff(rec[i].pr, orc[i].pr));
+					records++;
+					off += diff > 1e-2;
+					if ((diff > 0.1 && !near_contact(x, k, i, prm->scene_radius)) ||
+					    rec[i].delta != orc[i].delta)
+						fail_msg("strategy (s=%d, t=%d), vertex %d of %d: kernel pf %g pr %g delta %d, "
+							 "oracle pf %g pr %g delta %d",
+							 s, t, i, k, rec[i].pf, rec[i].pr, rec[i].delta, orc[i].pf, orc[i].pr,
+							 orc[i].delta);
+				}
+				for (int heur = 0; heur < 2; heur++) {
+					double sum = 0;
+					for (int s2 = 0; s2 < k; s2++)
+						if (strategy_valid(orc, k, s2))
+							sum += mis_path_weight(orc, k, s2, heur);
+					if (fabs(sum - 1) > 1e-4)
+						fail_msg("strategy (%d,%d): weights sum to %.7f (heuristic %d)", s, t, sum, heur);
+				}
+				checked++;
+				for (int i = 0; i < k; i++)
+					with_delta += orc[i].delta;
+				with_env += x[0].type == VERTEX_ENV;
+			}
+		}
+	}
+	print_message("%d paths checked, %d delta vertices, %d from the environment; %d of %d records "
+		      "beyond 1%%\n", checked, with_delta, with_env, off, records);
+	assert_true(off <= records / 100);
+	return checked;
+}
+
+static void test_mis_cornell(void **state)
+{
+	HostScene h;
+	host_scene_open(&h, SCENE("cornell/cornell.gltf"), NULL, 32, 32, INTEGRATOR_BDPT, 8);
+	assert_true(check_mis(&h, 300) > 1000);
+	host_scene_close(&h);
+}
+
+static void test_mis_window_room(void **state)
+{
+	HostScene h;
+	host_scene_open(&h, SCENE("window-room/window-room.gltf"), NULL, 32, 32, INTEGRATOR_BDPT, 8);
+	assert_true(check_mis(&h, 300) > 300);
+	host_scene_close(&h);
+}
+
+/* Glass, a mirror, a glossy metal, an emitter and the sky. */
+static Scene *glossy_scene(void)
+{
+	ajar_scene *s;
+	ajar_material m;
+	uint32_t diffuse, glass, mirror, metal, light;
+	const float sky[3] = {0.4f, 0.5f, 0.7f};
+	assert_int_equal(ajar_scene_create(&s), AJAR_OK);
+	ajar_material_default(&m);
+	assert_int_equal(ajar_scene_add_material(s, &m, &diffuse), AJAR_OK);
+	m.transmission = 1;
+	m.roughness = 0;
+	m.specular = 1;
+	assert_int_equal(ajar_scene_add_material(s, &m, &glass), AJAR_OK);
+	ajar_material_default(&m);
+	m.metallic = 1;
+	m.roughness = 0;
+	assert_int_equal(ajar_scene_add_material(s, &m, &mirror), AJAR_OK);
+	m.roughness = 0.4f;
+	assert_int_equal(ajar_scene_add_material(s, &m, &metal), AJAR_OK);
+	ajar_material_default(&m);
+	m.emission[0] = m.emission[1] = m.emission[2] = 5;
+	assert_int_equal(ajar_scene_add_material(s, &m, &light), AJAR_OK);
+	/* floor, two walls, a glass slab, a light facing down */
+	static const float floor_p[] = {-2, 0, -2, 2, 0, -2, 2, 0, 2, -2, 0, 2};
+	static const float wall_p[] = {-2, 0, -2, -2, 2, -2, 2, 2, -2, 2, 0, -2};
+	static const float side_p[] = {2, 0, -2, 2, 2, -2, 2, 2, 2, 2, 0, 2};
+	static const float slab_p[] = {-1, 0.2f, 0, 0, 0.2f, 0, 0, 1.2f, 0, -1, 1.2f, 0};
+	static const float light_p[] = {-0.5f, 1.9f, -1, -0.5f, 1.9f, 0, 0.5f, 1.9f, 0, 0.5f, 1.9f, -1};
+	static const uint32_t quad[] = {0, 2, 1, 0, 3, 2}, quad_ccw[] = {0, 1, 2, 0, 2, 3};
+	ajar_mesh mesh = {floor_p, NULL, NULL, 4, quad, 2, diffuse, NULL};
+	assert_int_equal(ajar_scene_add_mesh(s, &mesh), AJAR_OK);
+	mesh.positions = wall_p;
+	mesh.material = mirror;
+	assert_int_equal(ajar_scene_add_mesh(s, &mesh), AJAR_OK);
+	mesh.positions = side_p;
+	mesh.material = metal;
+	assert_int_equal(ajar_scene_add_mesh(s, &mesh), AJAR_OK);
+	mesh.positions = slab_p;
+	mesh.material = glass;
+	assert_int_equal(ajar_scene_add_mesh(s, &mesh), AJAR_OK);
+	mesh.positions = light_p;
+	mesh.indices = quad_ccw;
+	mesh.material = light;
+	assert_int_equal(ajar_scene_add_mesh(s, &mesh), AJAR_OK);
+	assert_int_equal(ajar_scene_set_environment_color(s, sky), AJAR_OK);
+	ajar_camera cam = {{0.5f, 1.0f, 3.5f}, {0, 0.7f, 0}, {0, 1, 0}, 1.0f, 0};
+	assert_int_equal(ajar_scene_set_camera(s, &cam), AJAR_OK);
+	return s;
+}
+
+static void test_mis_glossy_glass_sky(void **state)
+{
+	HostScene h;
+	host_scene_open(&h, NULL, glossy_scene(), 32, 32, INTEGRATOR_BDPT, 8);
+	assert_true(check_mis(&h, 800) > 1000);
+	host_scene_close(&h);
+}
+
+static void test_mis_living_room(void **state)
+{
+	HostScene h;
+	host_scene_open(&h, SCENE("living-room/living-room.gltf"), NULL, 32, 18, INTEGRATOR_BDPT, 8);
+	assert_true(check_mis(&h, 600) > 300);
+	host_scene_close(&h);
+}
+
+/* ---- Convergence ------------------------------------------------------- */
+
+#define BATCHES 32
+
+typedef struct {
+	double mean[3], se[3];
+} Estimate;
+
+/* Image mean per channel over BATCHES renders with different seeds. */
+static void batch_estimate(HostScene *h, uint32_t spp, int layer, Estimate *est)
+{
+	Params *prm = h->data.params;
+	uint32_t npix = (uint32_t)(prm->camera.width * prm->camera.height);
+	int nlayers = bdpt_layer_count(prm->strategy_len);
+	double *rgb = malloc(sizeof(double) * 3 * npix);
+	double *lay = nlayers ? malloc(sizeof(double) * 3 * npix * nlayers) : NULL;
+	double s1[3] = {0}, s2[3] = {0};
+	for (int b = 0; b < BATCHES; b++) {
+		host_render(h, spp, 1000 + b, rgb, lay);
+		const double *img = layer >= 0 ? lay + (size_t)3 * npix * layer : rgb;
+		for (int c = 0; c < 3; c++) {
+			double m = 0;
+			for (uint32_t i = 0; i < npix; i++)
+				m += img[3 * i + c];
+			m /= npix;
+			s1[c] += m;
+			s2[c] += m * m;
+		}
+	}
+	for (int c = 0; c < 3; c++) {
+		est->mean[c] = s1[c] / BATCHES;
+		double var = (s2[c] - s1[c] * s1[c] / BATCHES) / (BATCHES - 1);
+		est->se[c] = sqrt(fmax(var, 0) / BATCHES);
+	}
+	free(rgb);
+	free(lay);
+}
+
+/* |a - b| within z combined standard errors, per channel. */
+static void assert_agree(const char *what, const Estimate *a, const Estimate *b, double z)
+{
+	for (int c = 0; c < 3; c++) {
+		double se = sqrt(a->se[c] * a->se[c] + b->se[c] * b->se[c]);
+		double d = a->mean[c] - b->mean[c];
+		print_message("%s, channel %d: %.5f +- %.5f vs %.5f +- %.5f (%.1f se)\n", what, c, a->mean[c], a->se[c],
+			      b->mean[c], b->se[c], se > 0 ? d / se : 0.0);
+		if (fabs(d) > z * se + 1e-7)
+			fail_msg("%s, channel %d: %.6f vs %.6f differ by %.1f standard errors", what, c, a->mean[c],
+				 b->mean[c], d / se);
+	}
+}
+
+/* Every strategy of paths of 1..3 segments, unweighted, against the path
+ * tracer's image of exactly that many segments. 9 layers x 3 channels:
+ * at 5 standard errors with 31 degrees of freedom a false alarm is ~1e-3
+ * for the whole test. */
+static void test_strategies_unbiased(void **state)
+{
+	HostScene hb, hp;
+	const int len = 3;
+	host_scene_open(&hb, SCENE("cornell/cornell.gltf"), NULL, 12, 12, INTEGRATOR_BDPT, len);
+	host_scene_open(&hp, SCENE("cornell/cornell.gltf"), NULL, 12, 12, INTEGRATOR_PT, len);
+	hb.data.params->strategy_len = len;
+	hb.data.params->strategy_unweighted = 1;
+	for (int n = 1; n <= len; n++) {
+		Estimate pt;
+		char what[64];
+		hp.data.params->min_depth = hp.data.params->max_depth = n;
+		batch_estimate(&hp, 16, -1, &pt);
+		for (int s = 0; s <= n; s++) {
+			Estimate st;
+			batch_estimate(&hb, 16, (n - 1) * (n + 2) / 2 + s, &st);
+			snprintf(what, sizeof what, "length %d, strategy (s=%d, t=%d)", n, s, n + 1 - s);
+			assert_agree(what, &st, &pt, 5.0);
+		}
+	}
+	host_scene_close(&hb);
+	host_scene_close(&hp);
+}
+
+/* The weighted layers add up to the image, exactly (fixed-point sums). */
+static void test_layers_sum_to_image(void **state)
+{
+	HostScene h;
+	const int len = 4;
+	host_scene_open(&h, SCENE("cornell/cornell.gltf"), NULL, 10, 10, INTEGRATOR_BDPT, len);
+	h.data.params->strategy_len = len;
+	int nl = bdpt_layer_count(len);
+	double rgb[300], *lay = malloc(sizeof(double) * 300 * nl);
+	host_render(&h, 8, 5, rgb, lay);
+	for (int i = 0; i < 300; i++) {
+		double sum = 0;
+		for (int j = 0; j < nl; j++)
+			sum += lay[300 * j + i];
+		assert_true(fabs(sum - rgb[i]) <= 1e-5 * fabs(rgb[i]) + 1e-5);
+	}
+	free(lay);
+	host_scene_close(&h);
+}
+
+/* bdpt against pt on the full image, with glass, mirror, metal and sky. */
+static void test_bdpt_matches_pt_glossy(void **state)
+{
+	HostScene hb, hp;
+	Estimate b, p;
+	host_scene_open(&hb, NULL, glossy_scene(), 12, 12, INTEGRATOR_BDPT, 6);
+	host_scene_open(&hp, NULL, glossy_scene(), 12, 12, INTEGRATOR_PT, 6);
+	batch_estimate(&hb, 8, -1, &b);
+	batch_estimate(&hp, 16, -1, &p);
+	assert_agree("glossy scene bdpt vs pt", &b, &p, 5.0);
+	host_scene_close(&hb);
+	host_scene_close(&hp);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_mis_cornell),
+		cmocka_unit_test(test_mis_window_room),
+		cmocka_unit_test(test_mis_glossy_glass_sky),
+		cmocka_unit_test(test_mis_living_room),
+		cmocka_unit_test(test_layers_sum_to_image),
+		cmocka_unit_test(test_strategies_unbiased),
+		cmocka_unit_test(test_bdpt_matches_pt_glossy),
+	};
+	return cmocka_run_group_tests_name("bdpt", tests, NULL, NULL);
+}
