@@ -9,7 +9,7 @@ Q := $(if $(filter 1,$(V)),,@)
 
 CC ?= cc
 CXX ?= c++
-PKGS := OpenEXR OpenCL tinygltf stb
+PKGS := OpenEXR OpenCL tinygltf
 PKG_CFLAGS = $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 PKG_LIBS = $(shell pkg-config --libs OpenEXR OpenCL tinygltf 2>/dev/null)
 WARN := -Wall -Wextra -Werror -Wno-unused-parameter

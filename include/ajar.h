@@ -131,7 +131,9 @@ typedef struct {
 	ajar_integrator integrator;
 	uint32_t max_depth;      /* maximum path segments */
 	uint32_t seed;
-	const char *device;      /* selector ("0:0", "cpu", "gpu", name substring) or NULL */
+	const char *device;      /* selector ("0:0", "cpu", "gpu", name substring), a comma-
+				  * separated list of them or "all" (render on several
+				  * devices at once), or NULL for the first CPU device */
 } ajar_options;
 void ajar_options_default(ajar_options *o);
 
@@ -153,17 +155,36 @@ typedef struct ajar_renderer ajar_renderer;
 ajar_status ajar_renderer_create(const ajar_scene *scene, const ajar_options *o, ajar_renderer **out);
 void ajar_renderer_destroy(ajar_renderer **r);
 /* Renders until spp or time_limit, or until cancelled (AJAR_ERROR_CANCELLED,
- * with a valid image of the samples done). */
+ * with a valid image of the samples done). With several devices, each takes
+ * sample ranges in proportion to its speed; a device that fails is dropped
+ * with a warning (log callback) and the others finish the image. If none is
+ * left: AJAR_ERROR_DEVICE, and the image holds the samples rendered before. */
 ajar_status ajar_renderer_render(ajar_renderer *r, ajar_progress_fn fn, void *user);
 /* Safe from a signal handler or another thread. */
 void ajar_renderer_cancel(ajar_renderer *r);
 uint32_t ajar_renderer_spp(const ajar_renderer *r);
-/* The current estimate: width * height RGBA floats, row-major, top row first. */
+/* The current estimate: width * height RGBA floats, row-major, top row first.
+ * Not while ajar_renderer_render runs (call it before or after). */
 ajar_status ajar_renderer_image(ajar_renderer *r, float *rgba, uint32_t *width, uint32_t *height);
 ajar_status ajar_renderer_write_exr(ajar_renderer *r, const char *path);
 ajar_status ajar_renderer_write_png(ajar_renderer *r, const char *path);
 /* The device(s) used, for reports. */
 const char *ajar_renderer_device_name(const ajar_renderer *r);
+
+/* Per-device figures of a renderer with several devices (ajar_options.device
+ * "all" or a comma-separated list), for progress reports. Safe to call during
+ * a render, from the progress callback too. */
+typedef struct {
+	char name[128];
+	char selector[32];         /* as ajar_device_info.selector */
+	uint64_t samples;          /* pixel samples of this device in the image */
+	double samples_per_second; /* pixel samples per second while it rendered */
+	double share;              /* samples / all devices' samples, 0..1 */
+	int failed;                /* 1: dropped after an error, the others went on */
+} ajar_device_stats;
+/* Devices the renderer opened (including any dropped later). */
+uint32_t ajar_renderer_device_count(const ajar_renderer *r);
+ajar_status ajar_renderer_device_stats(const ajar_renderer *r, uint32_t index, ajar_device_stats *out);
 
 /* ---- Images ------------------------------------------------------------ */
 

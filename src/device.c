@@ -3,7 +3,10 @@
  * Program binaries are cached per device and per hash of (source, options,
  * device name, driver and platform version), so the second run of the same
  * build skips the OpenCL C front end. Cache files are written to a temporary
- * name and renamed, so concurrent renders never read a half-written binary. */
+ * name and renamed, so concurrent renders never read a half-written binary.
+ * A file starts with a magic and a hash of the binary that follows: some
+ * drivers (PoCL 3.1) crash on a damaged binary instead of rejecting it, so
+ * a file that fails the check is never handed to the driver. */
 #include "device.h"
 
 #include <errno.h>
@@ -122,12 +125,32 @@ static int contains_ci(const char *hay, const char *needle)
 	return 0;
 }
 
+/* Does device i (of the enumeration) match one selector item? */
+static int item_matches(const char *item, int i, cl_device_id id, const int *pidx, const int *didx)
+{
+	cl_device_type t = 0;
+	char name[256] = "";
+	int p, d;
+	char end;
+	clGetDeviceInfo(id, CL_DEVICE_TYPE, sizeof t, &t, NULL);
+	clGetDeviceInfo(id, CL_DEVICE_NAME, sizeof name - 1, name, NULL);
+	if (sscanf(item, "%d:%d%c", &p, &d, &end) == 2)
+		return p == pidx[i] && d == didx[i];
+	if (sscanf(item, "%d%c", &p, &end) == 1)
+		return p == i;
+	if (!strcmp(item, "cpu"))
+		return (t & CL_DEVICE_TYPE_CPU) != 0;
+	if (!strcmp(item, "gpu"))
+		return (t & CL_DEVICE_TYPE_GPU) != 0;
+	return contains_ci(name, item);
+}
+
 ajar_status device_select(const char *sel, cl_platform_id *platforms, cl_device_id *out, uint32_t cap,
 			  uint32_t *count)
 {
 	cl_platform_id plats[MAX_DEVICES];
 	cl_device_id ids[MAX_DEVICES];
-	int pidx[MAX_DEVICES], didx[MAX_DEVICES];
+	int pidx[MAX_DEVICES], didx[MAX_DEVICES], taken[MAX_DEVICES] = {0};
 	int n = enumerate(plats, ids, pidx, didx, MAX_DEVICES);
 	uint32_t k = 0;
 	*count = 0;
@@ -135,43 +158,68 @@ ajar_status device_select(const char *sel, cl_platform_id *platforms, cl_device_
 		return err_set(AJAR_ERROR_DEVICE,
 			       "no OpenCL device found: is an ICD installed (e.g. pocl-opencl-icd) and "
 			       "/etc/OpenCL/vendors readable?");
-	int want_default = !sel || !sel[0];
-	int p, d;
-	char end;
-	for (int i = 0; i < n && k < cap; i++) {
-		cl_device_type t = 0;
-		char name[256] = "";
-		int match;
-		clGetDeviceInfo(ids[i], CL_DEVICE_TYPE, sizeof t, &t, NULL);
-		clGetDeviceInfo(ids[i], CL_DEVICE_NAME, sizeof name - 1, name, NULL);
-		if (want_default)
-			match = (t & CL_DEVICE_TYPE_CPU) != 0;
-		else if (sscanf(sel, "%d:%d%c", &p, &d, &end) == 2)
-			match = p == pidx[i] && d == didx[i];
-		else if (sscanf(sel, "%d%c", &p, &end) == 1)
-			match = p == i;
-		else if (!strcmp(sel, "all"))
-			match = 1;
-		else if (!strcmp(sel, "cpu"))
-			match = (t & CL_DEVICE_TYPE_CPU) != 0;
-		else if (!strcmp(sel, "gpu"))
-			match = (t & CL_DEVICE_TYPE_GPU) != 0;
-		else
-			match = contains_ci(name, sel);
-		if (match) {
+	if (!sel || !sel[0]) { /* the first CPU device, else the first of any kind */
+		int pick = 0;
+		for (int i = n - 1; i >= 0; i--)
+			pick = item_matches("cpu", i, ids[i], pidx, didx) ? i : pick;
+		platforms[0] = plats[pick];
+		out[0] = ids[pick];
+		*count = 1;
+		return AJAR_OK;
+	}
+	/* A comma-separated list: each item takes its first match not taken
+	 * by an earlier item ("cpu,cpu" is two CPU devices), "all" takes every
+	 * device not taken yet. */
+	for (const char *p = sel; *p && k < cap;) {
+		char item[128];
+		size_t len = strcspn(p, ",");
+		const char *next = p[len] ? p + len + 1 : p + len;
+		while (len > 0 && (*p == ' ' || *p == '\t')) {
+			p++;
+			len--;
+		}
+		while (len > 0 && (p[len - 1] == ' ' || p[len - 1] == '\t'))
+			len--;
+		if (len == 0 || len >= sizeof item)
+			return err_set(AJAR_ERROR_INVALID_ARGUMENT,
+				       "device list '%s': empty or overlong item (see `ajar devices`)", sel);
+		memcpy(item, p, len);
+		item[len] = '\0';
+		int all = !strcmp(item, "all"), found = 0, twice = 0;
+		for (int i = 0; i < n && k < cap; i++) {
+			if (!(all || item_matches(item, i, ids[i], pidx, didx)))
+				continue;
+			twice |= taken[i];
+			if (taken[i])
+				continue;
+			taken[i] = found = 1;
 			platforms[k] = plats[i];
 			out[k++] = ids[i];
+			if (!all)
+				break;
 		}
+		if (!found && !all && twice)
+			return err_set(AJAR_ERROR_DEVICE, "device list '%s': '%s' is listed twice", sel, item);
+		if (!found && !all)
+			return err_set(AJAR_ERROR_DEVICE, "no OpenCL device matches '%s'%s%s%s (see `ajar devices`)", item,
+				       strchr(sel, ',') ? " in the list '" : "", strchr(sel, ',') ? sel : "",
+				       strchr(sel, ',') ? "'" : "");
+		p = next;
 	}
-	if (k == 0 && want_default) { /* no CPU device: take the first of any kind */
-		platforms[0] = plats[0];
-		out[0] = ids[0];
-		k = 1;
-	}
-	if (k == 0)
-		return err_set(AJAR_ERROR_DEVICE, "no OpenCL device matches '%s' (see `ajar devices`)", sel);
 	*count = k;
 	return AJAR_OK;
+}
+
+void device_selector_of(cl_device_id id, char *buf, size_t cap)
+{
+	cl_platform_id plats[MAX_DEVICES];
+	cl_device_id ids[MAX_DEVICES];
+	int pidx[MAX_DEVICES], didx[MAX_DEVICES];
+	int n = enumerate(plats, ids, pidx, didx, MAX_DEVICES);
+	snprintf(buf, cap, "?");
+	for (int i = 0; i < n; i++)
+		if (ids[i] == id)
+			snprintf(buf, cap, "%d:%d", pidx[i], didx[i]);
 }
 
 ajar_status device_open(Device *d, cl_platform_id platform, cl_device_id id)
@@ -184,6 +232,7 @@ ajar_status device_open(Device *d, cl_platform_id platform, cl_device_id id)
 	clGetDeviceInfo(id, CL_DEVICE_NAME, sizeof d->name - 1, d->name, NULL);
 	clGetDeviceInfo(id, CL_DEVICE_TYPE, sizeof t, &t, NULL);
 	d->is_cpu = (t & CL_DEVICE_TYPE_CPU) != 0;
+	device_selector_of(id, d->selector, sizeof d->selector);
 	cl_context_properties props[] = {CL_CONTEXT_PLATFORM, (cl_context_properties)platform, 0};
 	d->ctx = clCreateContext(props, 1, &id, NULL, NULL, &err);
 	if (!d->ctx)
@@ -223,11 +272,25 @@ const char *device_cache_dir(char *buf, size_t cap)
 	return buf;
 }
 
+#define FNV_BASIS 14695981039346656037ull
+#define FNV_PRIME 1099511628211ull
+/* Cache file header: CACHE_MAGIC, then the FNV-1a hash of the binary. */
+#define CACHE_MAGIC "AJARBIN1"
+#define CACHE_HEADER 16
+
 static uint64_t fnv1a(uint64_t h, const char *s)
 {
 	for (; *s; s++)
-		h = (h ^ (unsigned char)*s) * 1099511628211ull;
-	return (h ^ 0xff) * 1099511628211ull; /* separator: "ab"+"c" != "a"+"bc" */
+		h = (h ^ (unsigned char)*s) * FNV_PRIME;
+	return (h ^ 0xff) * FNV_PRIME; /* separator: "ab"+"c" != "a"+"bc" */
+}
+
+static uint64_t fnv1a_bytes(const unsigned char *p, size_t n)
+{
+	uint64_t h = FNV_BASIS;
+	for (size_t i = 0; i < n; i++)
+		h = (h ^ p[i]) * FNV_PRIME;
+	return h;
 }
 
 static void cache_path(const Device *d, const char *source, const char *options, char *path, size_t cap)
@@ -235,7 +298,7 @@ static void cache_path(const Device *d, const char *source, const char *options,
 	char dir[1024], drv[256] = "", pver[256] = "";
 	clGetDeviceInfo(d->id, CL_DRIVER_VERSION, sizeof drv - 1, drv, NULL);
 	clGetPlatformInfo(d->platform, CL_PLATFORM_VERSION, sizeof pver - 1, pver, NULL);
-	uint64_t h = 14695981039346656037ull;
+	uint64_t h = FNV_BASIS;
 	h = fnv1a(h, source);
 	h = fnv1a(h, options);
 	h = fnv1a(h, d->name);
@@ -267,9 +330,19 @@ static unsigned char *read_file(const char *path, size_t *n)
 	return buf;
 }
 
+/* Is this a whole cache file as cache_store wrote it? */
+static int cache_valid(const unsigned char *file, size_t n)
+{
+	uint64_t h;
+	if (n <= CACHE_HEADER || memcmp(file, CACHE_MAGIC, 8) != 0)
+		return 0;
+	memcpy(&h, file + 8, sizeof h);
+	return h == fnv1a_bytes(file + CACHE_HEADER, n - CACHE_HEADER);
+}
+
 static void mkdirs(const char *path)
 {
-	char tmp[1024];
+	char tmp[1200];
 	snprintf(tmp, sizeof tmp, "%s", path);
 	for (char *p = tmp + 1; *p; p++) {
 		if (*p == '/') {
@@ -286,7 +359,7 @@ static void cache_store(const Device *d, const char *path)
 {
 	size_t size = 0;
 	unsigned char *bin;
-	char dir[1024], tmp[1100];
+	char dir[1200], tmp[1232]; /* path: char[1200] in device_build */
 	if (clGetProgramInfo(d->program, CL_PROGRAM_BINARY_SIZES, sizeof size, &size, NULL) != CL_SUCCESS ||
 	    size == 0 || !(bin = malloc(size)))
 		return;
@@ -297,7 +370,9 @@ static void cache_store(const Device *d, const char *path)
 		snprintf(tmp, sizeof tmp, "%s.%ld.tmp", path, (long)getpid());
 		FILE *f = fopen(tmp, "wb");
 		if (f) {
-			int ok = fwrite(bin, 1, size, f) == size;
+			uint64_t h = fnv1a_bytes(bin, size);
+			int ok = fwrite(CACHE_MAGIC, 1, 8, f) == 8 && fwrite(&h, sizeof h, 1, f) == 1;
+			ok &= fwrite(bin, 1, size, f) == size;
 			ok &= fclose(f) == 0;
 			if (!ok || rename(tmp, path) != 0)
 				remove(tmp);
@@ -340,8 +415,13 @@ ajar_status device_build(Device *d, const char *source, const char *options)
 	double t0 = now_seconds();
 	cache_path(d, source, options, path, sizeof path);
 	bin = path[0] ? read_file(path, &nbin) : NULL;
+	if (bin && !cache_valid(bin, nbin)) {
+		free(bin);
+		bin = NULL;
+	}
 	if (bin) {
-		const unsigned char *b = bin;
+		const unsigned char *b = bin + CACHE_HEADER;
+		nbin -= CACHE_HEADER;
 		d->program = clCreateProgramWithBinary(d->ctx, 1, &d->id, &nbin, &b, &st, &err);
 		free(bin);
 		if (d->program && err == CL_SUCCESS && st == CL_SUCCESS &&
@@ -350,7 +430,8 @@ ajar_status device_build(Device *d, const char *source, const char *options)
 			d->build_seconds = now_seconds() - t0;
 			return AJAR_OK;
 		}
-		/* A stale or foreign binary: rebuild from source and overwrite it. */
+		/* A binary the driver refuses (e.g. after a driver update):
+		 * rebuild from source and overwrite it. */
 		if (d->program)
 			clReleaseProgram(d->program);
 		d->program = NULL;

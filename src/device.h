@@ -26,12 +26,15 @@ typedef struct Device {
 
 /* Every device of every platform, in selector order ("P:D"). */
 ajar_status device_list(ajar_device_info *out, uint32_t capacity, uint32_t *count);
-/* Resolves a selector: NULL/"" (first CPU device, else first device),
- * "P:D", "N" (flat index), "cpu", "gpu", "all" or a name substring. Up to
- * `cap` matches go to platforms/ids; "all" and "cpu"/"gpu" may give several
- * but callers that want one take the first. */
+/* Resolves a selector list: NULL/"" (the first CPU device, else the first
+ * device), or comma-separated items, each "P:D", "N" (flat index), "cpu",
+ * "gpu", a name substring (the first matching device not already chosen)
+ * or "all" (every device not already chosen). Up to `cap` devices go to
+ * platforms/ids in list order; an item that matches nothing is an error. */
 ajar_status device_select(const char *selector, cl_platform_id *platforms, cl_device_id *ids,
 			  uint32_t cap, uint32_t *count);
+/* The "P:D" selector of a device ("?" if it is not enumerated). */
+void device_selector_of(cl_device_id id, char *buf, size_t cap);
 
 ajar_status device_open(Device *d, cl_platform_id platform, cl_device_id id);
 void device_close(Device *d);

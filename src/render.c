@@ -1,14 +1,28 @@
 /* render.c — the renderer behind ajar_renderer_*: prepares the scene,
- * compiles the kernels on the chosen device, runs passes until the sample
- * count, the time limit or a cancel, and reduces the fixed-point film into
- * the image.
+ * compiles the kernels on every chosen device, deals sample ranges to the
+ * devices until the sample count, the time limit or a cancel, and reduces
+ * their fixed-point films into the image.
  *
- * A pass renders samples [first, first + count) of every pixel. Its size
- * adapts so a pass takes about PASS_SECONDS: progress stays smooth and a
- * stop loses at most one pass. Because samples have their own random
- * streams and the film is fixed point (kernels/film.h), the image does not
- * depend on how the samples were split into passes. */
+ * A pass renders samples [first, first + count) of every pixel on one
+ * device. Each device has its own context, queue, buffers, program and host
+ * thread; a scheduler under one lock hands each idle device the next range,
+ * sized so the pass takes about PASS_SECONDS at that device's measured speed
+ * (the first pass is one sample: it also pays PoCL's work-group compile).
+ * Near the end of a fixed-count render the rest is split in proportion to
+ * the devices' speeds, so no device holds the render back by more than one
+ * pass. Because every sample index has its own random stream and the film
+ * is 64-bit fixed point (kernels/film.h), integer sums do not depend on
+ * which device rendered a sample nor on how the ranges were split: on
+ * identical devices the image is bit-identical to a one-device render.
+ *
+ * A device whose pass fails is dropped; its range goes back to the pool. If
+ * the failure came before its kernel could run (argument or launch error),
+ * its film still holds exactly its completed ranges and is read back into
+ * `salvage`; otherwise the film is untrusted and its completed ranges are
+ * re-rendered by the others. Every range covers all pixels, so the image is
+ * always the exact mean of the sample indices it holds. */
 #include <math.h>
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -24,24 +38,71 @@
 
 #define PASS_SECONDS 0.25
 #define DEFAULT_WIDTH 512
+#define MAX_RENDER_DEVICES 16
 
 extern const char ajar_kernel_source[];
 
-struct ajar_renderer {
-	SceneData data;
+typedef struct {
+	uint32_t first, count;
+} Range;
+
+typedef struct {
+	Range *r;
+	size_t n, cap;
+} RangeList;
+
+/* Test hook: AJAR_TEST_FAIL_DEVICE=<index>:<pass>[:lost] makes pass number
+ * <pass> (from 1) of the renderer's device <index> (from 0, in selection
+ * order) fail: by default as if the kernel launch returned an error (the
+ * film stays readable); with ":lost" after the kernel ran, as if the device
+ * was lost mid-pass (the film is untrusted). Read once per renderer. */
+enum { FAIL_NONE, FAIL_LAUNCH, FAIL_LOST };
+
+typedef struct RenderDevice {
+	struct ajar_renderer *r;
 	Device dev;
 	cl_kernel k_render;
 	SceneBuffers bufs;
 	cl_uint arg_first; /* index of the render kernel's first non-scene argument */
 	cl_mem accum, splat; /* fixed-point films: own pixel, and atomic splats */
+	size_t local;        /* work-group size of render_pass */
+	pthread_t thread;
+	int started;              /* thread is running this render */
+	int fail_pass, fail_mode; /* the test hook */
+	uint32_t attempts;        /* passes started, for the test hook */
+	/* Under the renderer's lock: */
+	int alive, reported;
+	RangeList done;      /* ranges its film holds */
+	uint64_t spp_kept;   /* sample indices of this device in the image */
+	double busy_seconds; /* time in completed passes */
+	double per_spp;      /* seconds per sample index, last pass; 0 unknown */
+	char error[1024];    /* why it was dropped */
+} RenderDevice;
+
+struct ajar_renderer {
+	SceneData data;
+	RenderDevice *devs;
+	uint32_t ndev;
 	uint32_t width, height;
-	uint32_t spp_done, spp_target;
 	double time_limit, elapsed;
 	ajar_integrator integrator;
 	uint32_t seed, max_depth;
 	char scene_name[256];
+	char device_names[1024];
 	atomic_int cancel;
-	long *film, *film_splat; /* host copies */
+	long *film, *film_splat;       /* host reduction */
+	long *salvage, *salvage_splat; /* films read back from dropped devices, or NULL */
+	pthread_mutex_t lock;
+	pthread_cond_t cond;
+	/* Under the lock: */
+	uint32_t spp_done, spp_target;
+	uint32_t next_first; /* first sample index never handed out */
+	RangeList holes;     /* ranges below next_first to render again */
+	uint32_t in_flight, running;
+	uint64_t events; /* passes ended, for the main thread's wake-ups */
+	int out_of_memory;
+	RenderDevice *last_dropped;
+	double t0;
 };
 
 static double seconds(void)
@@ -49,6 +110,25 @@ static double seconds(void)
 	struct timespec ts;
 	clock_gettime(CLOCK_MONOTONIC, &ts);
 	return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+/* Appends g, merging with the last range when they touch; 0 if out of memory. */
+static int ranges_push(RangeList *l, Range g)
+{
+	if (l->n && l->r[l->n - 1].first + l->r[l->n - 1].count == g.first) {
+		l->r[l->n - 1].count += g.count;
+		return 1;
+	}
+	if (l->n == l->cap) {
+		size_t cap = l->cap ? 2 * l->cap : 16;
+		Range *p = realloc(l->r, cap * sizeof *p);
+		if (!p)
+			return 0;
+		l->r = p;
+		l->cap = cap;
+	}
+	l->r[l->n++] = g;
+	return 1;
 }
 
 void ajar_options_default(ajar_options *o)
@@ -92,23 +172,112 @@ static void image_size(const Scene *s, const ajar_options *o, uint32_t *w, uint3
 	}
 }
 
-static ajar_status upload(ajar_renderer *r)
+static size_t film_bytes(const ajar_renderer *r)
 {
-	Device *d = &r->dev;
+	return sizeof(cl_long) * 3 * (size_t)r->width * r->height;
+}
+
+/* Context, program, scene and films on one device. */
+static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_id plat, cl_device_id id)
+{
+	Device *d = &rd->dev;
 	ajar_status st;
-	if ((st = upload_scene(d, &r->data, &r->bufs)) != AJAR_OK ||
-	    (st = upload_bind(d, r->k_render, &r->bufs, &r->arg_first)) != AJAR_OK)
-		return st;
-	size_t film_bytes = sizeof(cl_long) * 3 * (size_t)r->width * r->height;
 	cl_long zero = 0;
-	if ((st = device_buffer(d, CL_MEM_READ_WRITE, film_bytes, NULL, &r->accum)) != AJAR_OK ||
-	    (st = device_buffer(d, CL_MEM_READ_WRITE, film_bytes, NULL, &r->splat)) != AJAR_OK)
+	size_t bytes = film_bytes(r);
+	if ((st = device_open(d, plat, id)) != AJAR_OK ||
+	    (st = device_build(d, ajar_kernel_source, "-cl-std=CL1.2")) != AJAR_OK ||
+	    (st = device_kernel(d, "render_pass", &rd->k_render)) != AJAR_OK ||
+	    (st = upload_scene(d, &r->data, &rd->bufs)) != AJAR_OK ||
+	    (st = upload_bind(d, rd->k_render, &rd->bufs, &rd->arg_first)) != AJAR_OK ||
+	    (st = device_buffer(d, CL_MEM_READ_WRITE, bytes, NULL, &rd->accum)) != AJAR_OK ||
+	    (st = device_buffer(d, CL_MEM_READ_WRITE, bytes, NULL, &rd->splat)) != AJAR_OK)
 		return st;
-	CL_TRY(d, clEnqueueFillBuffer(d->queue, r->accum, &zero, sizeof zero, 0, film_bytes, 0, NULL, NULL));
-	CL_TRY(d, clEnqueueFillBuffer(d->queue, r->splat, &zero, sizeof zero, 0, film_bytes, 0, NULL, NULL));
-	CL_TRY(d, clSetKernelArg(r->k_render, r->arg_first, sizeof(cl_mem), &r->accum));
-	CL_TRY(d, clSetKernelArg(r->k_render, r->arg_first + 1, sizeof(cl_mem), &r->splat));
+	CL_TRY(d, clEnqueueFillBuffer(d->queue, rd->accum, &zero, sizeof zero, 0, bytes, 0, NULL, NULL));
+	CL_TRY(d, clEnqueueFillBuffer(d->queue, rd->splat, &zero, sizeof zero, 0, bytes, 0, NULL, NULL));
+	CL_TRY(d, clSetKernelArg(rd->k_render, rd->arg_first, sizeof(cl_mem), &rd->accum));
+	CL_TRY(d, clSetKernelArg(rd->k_render, rd->arg_first + 1, sizeof(cl_mem), &rd->splat));
 	CL_TRY(d, clFinish(d->queue));
+	/* An explicit work-group size, measured on PoCL 3.1's CPU device (2
+	 * cores, 128x128 path tracing, first pass = PoCL's cold work-group
+	 * compile + 1 spp; Msamples/s over 16 spp; two runs each):
+	 *   local    cornell: first pass, speed    bathroom: first pass, speed
+	 *   1        0.63/0.61 s, 1.69/1.77        0.71/0.74 s, 0.35/0.25
+	 *   8        0.61/0.68 s, 1.74/1.57        0.73/0.70 s, 0.34/0.38
+	 *   64       0.63/0.68 s, 1.69/1.56        0.81/0.69 s, 0.33/0.38
+	 *   NULL     crashes (SIGSEGV in PoCL's work-group function) at 128x128
+	 *            and 256x256: PoCL picks 4096 work-items per group.
+	 * On the CPU the choice is within noise; 64 is a multiple of every GPU's
+	 * SIMD width, capped by what the compiled kernel allows. */
+	size_t max_local = 0;
+	CL_TRY(d, clGetKernelWorkGroupInfo(rd->k_render, d->id, CL_KERNEL_WORK_GROUP_SIZE, sizeof max_local,
+					   &max_local, NULL));
+	for (rd->local = 64; rd->local > 1 && rd->local > max_local; rd->local /= 2)
+		;
+	log_msg(AJAR_LOG_INFO, "device %s (%s): kernels %s in %.2f s", d->name, d->selector,
+		d->from_cache ? "loaded from cache" : "compiled", d->build_seconds);
+	return AJAR_OK;
+}
+
+static void device_teardown(RenderDevice *rd)
+{
+	upload_free(&rd->bufs);
+	if (rd->accum)
+		clReleaseMemObject(rd->accum);
+	if (rd->splat)
+		clReleaseMemObject(rd->splat);
+	if (rd->k_render)
+		clReleaseKernel(rd->k_render);
+	device_close(&rd->dev);
+	free(rd->done.r);
+	memset(rd, 0, sizeof *rd);
+}
+
+static void parse_fail_hook(RenderDevice *rd, uint32_t index)
+{
+	const char *env = getenv("AJAR_TEST_FAIL_DEVICE");
+	unsigned i, pass;
+	char mode[8] = "";
+	if (!env || sscanf(env, "%u:%u:%7s", &i, &pass, mode) < 2 || i != index)
+		return;
+	rd->fail_pass = (int)pass;
+	rd->fail_mode = strcmp(mode, "lost") ? FAIL_LAUNCH : FAIL_LOST;
+}
+
+/* Opens every selected device. With several, one that cannot be set up is
+ * dropped with a warning; with none left, the last error stands. */
+static ajar_status open_devices(ajar_renderer *r, const char *selector)
+{
+	cl_platform_id plats[MAX_RENDER_DEVICES];
+	cl_device_id ids[MAX_RENDER_DEVICES];
+	uint32_t n;
+	ajar_status st;
+	if ((st = device_select(selector, plats, ids, MAX_RENDER_DEVICES, &n)) != AJAR_OK)
+		return st;
+	r->devs = calloc(n, sizeof *r->devs);
+	if (!r->devs)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory");
+	for (uint32_t i = 0; i < n; i++) {
+		RenderDevice *rd = &r->devs[r->ndev];
+		if ((st = device_setup(r, rd, plats[i], ids[i])) != AJAR_OK) {
+			if (n > 1)
+				log_msg(AJAR_LOG_WARNING, "device %s left out: %s", rd->dev.name[0] ? rd->dev.name : "?",
+					ajar_last_error());
+			device_teardown(rd);
+			continue;
+		}
+		rd->r = r;
+		rd->alive = 1;
+		parse_fail_hook(rd, r->ndev);
+		size_t len = strlen(r->device_names);
+		if (n == 1)
+			snprintf(r->device_names, sizeof r->device_names, "%s", rd->dev.name);
+		else
+			snprintf(r->device_names + len, sizeof r->device_names - len, "%s%s (%s)",
+				 r->ndev ? " + " : "", rd->dev.name, rd->dev.selector);
+		r->ndev++;
+	}
+	if (r->ndev == 0)
+		return st; /* the last device's error, already set */
 	return AJAR_OK;
 }
 
@@ -130,6 +299,8 @@ ajar_status ajar_renderer_create(const ajar_scene *scene, const ajar_options *op
 	ajar_renderer *r = calloc(1, sizeof *r);
 	if (!r)
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory");
+	pthread_mutex_init(&r->lock, NULL);
+	pthread_cond_init(&r->cond, NULL);
 	image_size(scene, opt, &r->width, &r->height);
 	r->spp_target = opt->spp;
 	r->time_limit = opt->time_limit;
@@ -140,19 +311,7 @@ ajar_status ajar_renderer_create(const ajar_scene *scene, const ajar_options *op
 	PrepareOptions po = {r->width, r->height, (int)opt->integrator, opt->max_depth, opt->seed};
 	if ((st = prepare_scene(scene, &po, &r->data)) != AJAR_OK)
 		goto fail;
-
-	cl_platform_id plat;
-	cl_device_id id;
-	uint32_t ndev;
-	if ((st = device_select(opt->device, &plat, &id, 1, &ndev)) != AJAR_OK)
-		goto fail;
-	if ((st = device_open(&r->dev, plat, id)) != AJAR_OK)
-		goto fail;
-	if ((st = device_build(&r->dev, ajar_kernel_source, "-cl-std=CL1.2")) != AJAR_OK)
-		goto fail;
-	if ((st = device_kernel(&r->dev, "render_pass", &r->k_render)) != AJAR_OK)
-		goto fail;
-	if ((st = upload(r)) != AJAR_OK)
+	if ((st = open_devices(r, opt->device)) != AJAR_OK)
 		goto fail;
 	r->film = calloc(3 * (size_t)r->width * r->height, sizeof *r->film);
 	r->film_splat = calloc(3 * (size_t)r->width * r->height, sizeof *r->film_splat);
@@ -160,8 +319,6 @@ ajar_status ajar_renderer_create(const ajar_scene *scene, const ajar_options *op
 		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory for a %ux%u image", r->width, r->height);
 		goto fail;
 	}
-	log_msg(AJAR_LOG_INFO, "device %s: kernels %s in %.2f s", r->dev.name,
-		r->dev.from_cache ? "loaded from cache" : "compiled", r->dev.build_seconds);
 	*out = r;
 	return AJAR_OK;
 fail:
@@ -174,17 +331,17 @@ void ajar_renderer_destroy(ajar_renderer **rp)
 	ajar_renderer *r = rp ? *rp : NULL;
 	if (!r)
 		return;
-	upload_free(&r->bufs);
-	if (r->accum)
-		clReleaseMemObject(r->accum);
-	if (r->splat)
-		clReleaseMemObject(r->splat);
-	if (r->k_render)
-		clReleaseKernel(r->k_render);
-	device_close(&r->dev);
+	for (uint32_t i = 0; i < r->ndev; i++)
+		device_teardown(&r->devs[i]);
+	free(r->devs);
 	prepare_free(&r->data);
 	free(r->film);
 	free(r->film_splat);
+	free(r->salvage);
+	free(r->salvage_splat);
+	free(r->holes.r);
+	pthread_cond_destroy(&r->cond);
+	pthread_mutex_destroy(&r->lock);
 	free(r);
 	*rp = NULL;
 }
@@ -195,72 +352,373 @@ void ajar_renderer_cancel(ajar_renderer *r)
 		atomic_store(&r->cancel, 1);
 }
 
-uint32_t ajar_renderer_spp(const ajar_renderer *r) { return r ? r->spp_done : 0; }
-
-const char *ajar_renderer_device_name(const ajar_renderer *r) { return r ? r->dev.name : ""; }
-
-static ajar_status run_pass(ajar_renderer *r, uint32_t count)
+uint32_t ajar_renderer_spp(const ajar_renderer *r)
 {
-	Device *d = &r->dev;
-	cl_uint first = r->spp_done, n = count;
-	CL_TRY(d, clSetKernelArg(r->k_render, r->arg_first + 2, sizeof first, &first));
-	CL_TRY(d, clSetKernelArg(r->k_render, r->arg_first + 3, sizeof n, &n));
-	size_t global = (size_t)r->width * r->height;
-	CL_TRY(d, clEnqueueNDRangeKernel(d->queue, r->k_render, 1, NULL, &global, NULL, 0, NULL, NULL));
-	CL_TRY(d, clFinish(d->queue));
-	r->spp_done += count;
+	if (!r)
+		return 0;
+	pthread_mutex_lock((pthread_mutex_t *)&r->lock);
+	uint32_t spp = r->spp_done;
+	pthread_mutex_unlock((pthread_mutex_t *)&r->lock);
+	return spp;
+}
+
+const char *ajar_renderer_device_name(const ajar_renderer *r) { return r ? r->device_names : ""; }
+
+uint32_t ajar_renderer_device_count(const ajar_renderer *r) { return r ? r->ndev : 0; }
+
+ajar_status ajar_renderer_device_stats(const ajar_renderer *r, uint32_t index, ajar_device_stats *out)
+{
+	if (!r || !out || index >= r->ndev)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_device_stats: device %u of %u", index,
+			       r ? r->ndev : 0);
+	const RenderDevice *rd = &r->devs[index];
+	memset(out, 0, sizeof *out);
+	snprintf(out->name, sizeof out->name, "%.127s", rd->dev.name);
+	snprintf(out->selector, sizeof out->selector, "%.31s", rd->dev.selector);
+	pthread_mutex_lock((pthread_mutex_t *)&r->lock);
+	out->samples = rd->spp_kept * r->width * r->height;
+	out->samples_per_second = rd->busy_seconds > 0 ? out->samples / rd->busy_seconds : 0.0;
+	out->share = r->spp_done ? (double)rd->spp_kept / r->spp_done : 0.0;
+	out->failed = !rd->alive;
+	pthread_mutex_unlock((pthread_mutex_t *)&r->lock);
 	return AJAR_OK;
+}
+
+/* ---- Scheduling (all under r->lock) ---------------------------------------- */
+
+static double time_left(const ajar_renderer *r)
+{
+	return r->time_limit > 0 ? r->time_limit - (seconds() - r->t0) : 1e30;
+}
+
+/* Sample indices not yet handed out (UINT64_MAX: no sample target). */
+static uint64_t work_left(const ajar_renderer *r)
+{
+	uint64_t n = r->spp_target ? r->spp_target - r->next_first : UINT64_MAX;
+	for (size_t i = 0; i < r->holes.n && n != UINT64_MAX; i++)
+		n += r->holes.r[i].count;
+	return n;
+}
+
+/* The stop conditions other than running out of work. */
+static int stopping(const ajar_renderer *r)
+{
+	return atomic_load(&r->cancel) || r->out_of_memory || time_left(r) <= 0;
+}
+
+/* The next range for device rd, or 0 if there is none now. */
+static int take_range(ajar_renderer *r, RenderDevice *rd, Range *g)
+{
+	uint64_t left = work_left(r);
+	if (left == 0 || stopping(r))
+		return 0;
+	uint32_t count = 1;
+	if (rd->per_spp > 0) {
+		count = (uint32_t)fmax(1.0, fmin(fmin(PASS_SECONDS, time_left(r)) / rd->per_spp, 1e6));
+		if (left != UINT64_MAX) {
+			/* Near the end, split the rest by speed; a device not
+			 * measured yet counts as fast as this one. */
+			double rates = 0;
+			for (uint32_t i = 0; i < r->ndev; i++)
+				if (r->devs[i].alive)
+					rates += 1.0 / (r->devs[i].per_spp > 0 ? r->devs[i].per_spp : rd->per_spp);
+			double share = ceil((double)left / (rd->per_spp * rates));
+			if (share < count)
+				count = (uint32_t)share;
+		}
+	}
+	if (r->holes.n) {
+		Range *h = &r->holes.r[r->holes.n - 1];
+		g->first = h->first;
+		g->count = count < h->count ? count : h->count;
+		h->first += g->count;
+		h->count -= g->count;
+		if (h->count == 0)
+			r->holes.n--;
+		return 1;
+	}
+	if (left < count)
+		count = (uint32_t)left;
+	if (count > UINT32_MAX - r->next_first)
+		return 0; /* the sample index space is exhausted */
+	g->first = r->next_first;
+	g->count = count;
+	r->next_first += count;
+	return 1;
+}
+
+/* ---- Device threads ------------------------------------------------------- */
+
+/* The message of a failed call, kept on the device (not err_set: that is
+ * per thread and would log an error for what may only be a warning). */
+static int pass_failed(RenderDevice *rd, const char *what, cl_int err)
+{
+	snprintf(rd->error, sizeof rd->error, "%s failed: %s (%d)", what, cl_error_name(err), (int)err);
+	return 0;
+}
+
+/* Renders range g on rd; on failure sets *film_ok to whether the film
+ * still holds exactly the completed ranges (the kernel never started). */
+static int run_pass(RenderDevice *rd, Range g, int *film_ok)
+{
+	ajar_renderer *r = rd->r;
+	Device *d = &rd->dev;
+	cl_uint first = g.first, n = g.count;
+	cl_int err;
+	int inject = rd->fail_pass > 0 && ++rd->attempts == (uint32_t)rd->fail_pass;
+	*film_ok = 1;
+	if ((err = clSetKernelArg(rd->k_render, rd->arg_first + 2, sizeof first, &first)) != CL_SUCCESS ||
+	    (err = clSetKernelArg(rd->k_render, rd->arg_first + 3, sizeof n, &n)) != CL_SUCCESS)
+		return pass_failed(rd, "clSetKernelArg", err);
+	size_t npix = (size_t)r->width * r->height;
+	size_t global = (npix + rd->local - 1) / rd->local * rd->local; /* the kernel skips the excess */
+	if (inject && rd->fail_mode == FAIL_LAUNCH)
+		return pass_failed(rd, "clEnqueueNDRangeKernel (test hook AJAR_TEST_FAIL_DEVICE)", CL_OUT_OF_RESOURCES);
+	if ((err = clEnqueueNDRangeKernel(d->queue, rd->k_render, 1, NULL, &global, &rd->local, 0, NULL, NULL)) !=
+	    CL_SUCCESS)
+		return pass_failed(rd, "clEnqueueNDRangeKernel", err);
+	err = clFinish(d->queue);
+	if (err == CL_SUCCESS && inject)
+		err = CL_DEVICE_NOT_AVAILABLE;
+	if (err != CL_SUCCESS) {
+		*film_ok = 0;
+		return pass_failed(rd, inject ? "clFinish (test hook AJAR_TEST_FAIL_DEVICE)" : "clFinish", err);
+	}
+	return 1;
+}
+
+/* Reads a device's films into fresh host arrays; 0 if it cannot. */
+static int read_films(RenderDevice *rd, long **accum, long **splat)
+{
+	size_t bytes = film_bytes(rd->r);
+	*accum = malloc(bytes);
+	*splat = malloc(bytes);
+	if (*accum && *splat &&
+	    clEnqueueReadBuffer(rd->dev.queue, rd->accum, CL_TRUE, 0, bytes, *accum, 0, NULL, NULL) == CL_SUCCESS &&
+	    clEnqueueReadBuffer(rd->dev.queue, rd->splat, CL_TRUE, 0, bytes, *splat, 0, NULL, NULL) == CL_SUCCESS)
+		return 1;
+	free(*accum);
+	free(*splat);
+	*accum = *splat = NULL;
+	return 0;
+}
+
+/* Adds a dropped device's films to the salvage (under the lock); 0 if out of memory. */
+static int salvage_add(ajar_renderer *r, const long *accum, const long *splat)
+{
+	size_t n = 3 * (size_t)r->width * r->height;
+	if (!r->salvage) {
+		r->salvage = calloc(n, sizeof *r->salvage);
+		r->salvage_splat = calloc(n, sizeof *r->salvage_splat);
+		if (!r->salvage || !r->salvage_splat) {
+			free(r->salvage);
+			free(r->salvage_splat);
+			r->salvage = r->salvage_splat = NULL;
+			return 0;
+		}
+	}
+	for (size_t i = 0; i < n; i++) {
+		r->salvage[i] += accum[i];
+		r->salvage_splat[i] += splat[i];
+	}
+	return 1;
+}
+
+/* Drops rd after its pass g failed (under the lock): g goes back to the
+ * pool, and so do its completed ranges unless its film was read back. */
+static void drop_device(ajar_renderer *r, RenderDevice *rd, Range g, const long *accum, const long *splat)
+{
+	int kept = accum && salvage_add(r, accum, splat);
+	rd->alive = 0;
+	r->last_dropped = rd;
+	if (!ranges_push(&r->holes, g))
+		r->out_of_memory = 1;
+	if (!kept) {
+		for (size_t i = 0; i < rd->done.n; i++)
+			if (!ranges_push(&r->holes, rd->done.r[i]))
+				r->out_of_memory = 1;
+		r->spp_done -= (uint32_t)rd->spp_kept;
+		rd->spp_kept = 0;
+		rd->done.n = 0;
+	}
+}
+
+static void *device_thread(void *arg)
+{
+	RenderDevice *rd = arg;
+	ajar_renderer *r = rd->r;
+	pthread_mutex_lock(&r->lock);
+	for (;;) {
+		Range g;
+		if (!take_range(r, rd, &g)) {
+			/* A pass in flight elsewhere may still fail and return its range. */
+			if (r->in_flight == 0 || stopping(r))
+				break;
+			pthread_cond_wait(&r->cond, &r->lock);
+			continue;
+		}
+		r->in_flight++;
+		pthread_mutex_unlock(&r->lock);
+		double tp = seconds();
+		int film_ok;
+		int ok = run_pass(rd, g, &film_ok);
+		double dt = seconds() - tp;
+		long *accum = NULL, *splat = NULL;
+		if (!ok && film_ok)
+			read_films(rd, &accum, &splat);
+		pthread_mutex_lock(&r->lock);
+		r->in_flight--;
+		r->events++;
+		if (ok) {
+			if (!ranges_push(&rd->done, g))
+				r->out_of_memory = 1;
+			rd->spp_kept += g.count;
+			rd->busy_seconds += dt;
+			rd->per_spp = dt / g.count;
+			r->spp_done += g.count;
+		} else {
+			drop_device(r, rd, g, accum, splat);
+		}
+		free(accum);
+		free(splat);
+		pthread_cond_broadcast(&r->cond);
+		if (!ok)
+			break;
+	}
+	r->running--;
+	pthread_cond_broadcast(&r->cond);
+	pthread_mutex_unlock(&r->lock);
+	return NULL;
+}
+
+/* "name (P:D): 52.1% 0.71 Msamples/s; ..." for the EXR header. */
+static void device_shares(const ajar_renderer *r, char *buf, size_t cap)
+{
+	size_t len = 0;
+	buf[0] = '\0';
+	for (uint32_t i = 0; i < r->ndev && len < cap; i++) {
+		ajar_device_stats s;
+		ajar_renderer_device_stats(r, i, &s);
+		len += (size_t)snprintf(buf + len, cap - len, "%s%s (%s): %.1f%% %.3g Msamples/s%s", i ? "; " : "",
+					s.name, s.selector, 100 * s.share, s.samples_per_second * 1e-6,
+					s.failed ? " (failed)" : "");
+	}
+}
+
+/* ---- The render loop (main thread) ---------------------------------------- */
+
+static void fill_progress(const ajar_renderer *r, ajar_progress *p)
+{
+	double elapsed = seconds() - r->t0, rate = 0; /* sample indices per second */
+	memset(p, 0, sizeof *p);
+	for (uint32_t i = 0; i < r->ndev; i++)
+		if (r->devs[i].alive && r->devs[i].per_spp > 0)
+			rate += 1.0 / r->devs[i].per_spp;
+	p->spp_done = r->spp_done;
+	p->spp_target = r->spp_target;
+	p->samples_done = (uint64_t)r->spp_done * r->width * r->height;
+	p->elapsed = elapsed;
+	p->samples_per_second = elapsed > 0 ? p->samples_done / elapsed : 0;
+	if (r->spp_target) {
+		p->fraction = (double)r->spp_done / r->spp_target;
+		p->eta = rate > 0 ? (r->spp_target - r->spp_done) / rate : -1.0;
+	} else {
+		p->fraction = fmin(1.0, elapsed / r->time_limit);
+		p->eta = fmax(0.0, r->time_limit - elapsed);
+	}
+	if (r->time_limit > 0 && r->spp_target)
+		p->eta = p->eta < 0 ? fmax(0.0, r->time_limit - elapsed) : fmin(p->eta, fmax(0.0, r->time_limit - elapsed));
+}
+
+/* Logs a warning for every device dropped since the last call (unlocked). */
+static void report_drops(ajar_renderer *r)
+{
+	for (uint32_t i = 0; i < r->ndev; i++) {
+		RenderDevice *rd = &r->devs[i];
+		pthread_mutex_lock(&r->lock);
+		int fresh = !rd->alive && !rd->reported;
+		uint32_t left = 0;
+		for (uint32_t j = 0; j < r->ndev; j++)
+			left += r->devs[j].alive;
+		rd->reported |= fresh;
+		pthread_mutex_unlock(&r->lock);
+		if (fresh && left)
+			log_msg(AJAR_LOG_WARNING,
+				"device %s (%s) dropped: %s; its unfinished samples go to the %u other device%s",
+				rd->dev.name, rd->dev.selector, rd->error, left, left == 1 ? "" : "s");
+	}
 }
 
 ajar_status ajar_renderer_render(ajar_renderer *r, ajar_progress_fn fn, void *user)
 {
-	ajar_status st;
 	if (!r)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_render: renderer is NULL");
-	double t0 = seconds() - r->elapsed, per_spp = 0.0;
-	uint32_t count = 1;
-	for (;;) {
-		uint32_t left = r->spp_target ? r->spp_target - r->spp_done : UINT32_MAX;
-		double time_left = r->time_limit > 0 ? r->time_limit - (seconds() - t0) : 1e30;
-		if (left == 0 || time_left <= 0)
-			break;
-		if (atomic_load(&r->cancel))
-			return err_set(AJAR_ERROR_CANCELLED, "render cancelled after %u samples per pixel",
-				       r->spp_done);
-		if (per_spp > 0) {
-			double want = fmin(PASS_SECONDS, time_left) / per_spp;
-			count = (uint32_t)fmax(1.0, fmin(want, 1e6));
-		}
-		if (count > left)
-			count = left;
-		double tp = seconds();
-		if ((st = run_pass(r, count)) != AJAR_OK)
-			return st;
-		per_spp = (seconds() - tp) / count;
-		r->elapsed = seconds() - t0;
-		if (fn) {
-			ajar_progress p;
-			memset(&p, 0, sizeof p);
-			p.spp_done = r->spp_done;
-			p.spp_target = r->spp_target;
-			p.samples_done = (uint64_t)r->spp_done * r->width * r->height;
-			p.elapsed = r->elapsed;
-			p.samples_per_second = r->elapsed > 0 ? p.samples_done / r->elapsed : 0;
-			if (r->spp_target) {
-				p.fraction = (double)r->spp_done / r->spp_target;
-				p.eta = per_spp * (r->spp_target - r->spp_done);
-			} else {
-				p.fraction = fmin(1.0, r->elapsed / r->time_limit);
-				p.eta = fmax(0.0, r->time_limit - r->elapsed);
-			}
-			if (r->time_limit > 0 && r->spp_target)
-				p.eta = fmin(p.eta, fmax(0.0, r->time_limit - r->elapsed));
-			if (fn(&p, user))
-				ajar_renderer_cancel(r);
-		}
+	pthread_mutex_lock(&r->lock);
+	r->t0 = seconds() - r->elapsed;
+	r->running = 0;
+	for (uint32_t i = 0; i < r->ndev; i++) {
+		RenderDevice *rd = &r->devs[i];
+		rd->started = rd->alive && pthread_create(&rd->thread, NULL, device_thread, rd) == 0;
+		r->running += (uint32_t)rd->started;
 	}
+	if (r->running == 0 && r->last_dropped != NULL) {
+		pthread_mutex_unlock(&r->lock);
+		return err_set(AJAR_ERROR_DEVICE, "no OpenCL device left (the last failed: %s)", r->last_dropped->error);
+	}
+	if (r->running == 0 && work_left(r) > 0 && !atomic_load(&r->cancel)) {
+		pthread_mutex_unlock(&r->lock);
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "cannot start a render thread");
+	}
+	uint64_t seen = r->events;
+	int callbacks = fn != NULL;
+	while (r->running > 0) {
+		while (r->events == seen && r->running > 0)
+			pthread_cond_wait(&r->cond, &r->lock);
+		if (r->events == seen)
+			break; /* the devices stopped without another pass */
+		seen = r->events;
+		ajar_progress p;
+		fill_progress(r, &p);
+		pthread_mutex_unlock(&r->lock);
+		report_drops(r);
+		if (callbacks && !atomic_load(&r->cancel) && fn(&p, user))
+			ajar_renderer_cancel(r);
+		pthread_mutex_lock(&r->lock);
+		pthread_cond_broadcast(&r->cond); /* wakes idle devices after a cancel */
+	}
+	pthread_mutex_unlock(&r->lock);
+	for (uint32_t i = 0; i < r->ndev; i++)
+		if (r->devs[i].started) {
+			pthread_join(r->devs[i].thread, NULL);
+			r->devs[i].started = 0;
+		}
+	r->elapsed = seconds() - r->t0;
+	report_drops(r);
+	if (r->ndev > 1) {
+		char shares[2048];
+		device_shares(r, shares, sizeof shares);
+		log_msg(AJAR_LOG_INFO, "devices: %s", shares);
+	}
+
+	uint32_t alive = 0;
+	for (uint32_t i = 0; i < r->ndev; i++)
+		alive += (uint32_t)r->devs[i].alive;
+	uint64_t left = work_left(r);
+	if (r->out_of_memory)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory while scheduling passes");
+	if (alive == 0 && left > 0) {
+		const RenderDevice *rd = r->last_dropped;
+		return err_set(AJAR_ERROR_DEVICE,
+			       "OpenCL device %s (%s): %s; no device left: the image holds the %u samples per pixel "
+			       "rendered before",
+			       rd->dev.name, rd->dev.selector, rd->error, r->spp_done);
+	}
+	if (left > 0 && time_left(r) > 0 && atomic_load(&r->cancel))
+		return err_set(AJAR_ERROR_CANCELLED, "render cancelled after %u samples per pixel", r->spp_done);
 	return AJAR_OK;
 }
+
+/* ---- Reduction and output --------------------------------------------------- */
 
 ajar_status ajar_renderer_image(ajar_renderer *r, float *rgba, uint32_t *width, uint32_t *height)
 {
@@ -272,15 +730,35 @@ ajar_status ajar_renderer_image(ajar_renderer *r, float *rgba, uint32_t *width, 
 		*height = r->height;
 	if (!rgba)
 		return AJAR_OK;
-	size_t npix = (size_t)r->width * r->height;
-	CL_TRY(&r->dev, clEnqueueReadBuffer(r->dev.queue, r->accum, CL_TRUE, 0, sizeof(cl_long) * 3 * npix,
-					    r->film, 0, NULL, NULL));
-	CL_TRY(&r->dev, clEnqueueReadBuffer(r->dev.queue, r->splat, CL_TRUE, 0, sizeof(cl_long) * 3 * npix,
-					    r->film_splat, 0, NULL, NULL));
+	size_t n = 3 * (size_t)r->width * r->height;
+	long *sum = r->film, *sum_splat = r->film_splat;
+	if (r->salvage) {
+		memcpy(sum, r->salvage, n * sizeof *sum);
+		memcpy(sum_splat, r->salvage_splat, n * sizeof *sum_splat);
+	} else {
+		memset(sum, 0, n * sizeof *sum);
+		memset(sum_splat, 0, n * sizeof *sum_splat);
+	}
+	/* Integer sums first, scaled once: the same bits whatever the device count. */
+	for (uint32_t k = 0; k < r->ndev; k++) {
+		RenderDevice *rd = &r->devs[k];
+		long *a, *s;
+		if (!rd->alive)
+			continue;
+		if (!read_films(rd, &a, &s))
+			return err_set(AJAR_ERROR_DEVICE, "OpenCL device %s: reading the film back failed",
+				       rd->dev.name);
+		for (size_t i = 0; i < n; i++) {
+			sum[i] += a[i];
+			sum_splat[i] += s[i];
+		}
+		free(a);
+		free(s);
+	}
 	double scale = r->spp_done ? 1.0 / ((double)FILM_SCALE * r->spp_done) : 0.0;
-	for (size_t i = 0; i < npix; i++) {
+	for (size_t i = 0; i < n / 3; i++) {
 		for (int c = 0; c < 3; c++)
-			rgba[4 * i + c] = (float)((double)(r->film[3 * i + c] + r->film_splat[3 * i + c]) * scale);
+			rgba[4 * i + c] = (float)((double)(sum[3 * i + c] + sum_splat[3 * i + c]) * scale);
 		rgba[4 * i + 3] = 1.0f;
 	}
 	return AJAR_OK;
@@ -306,7 +784,7 @@ ajar_status ajar_renderer_write_exr(ajar_renderer *r, const char *path)
 {
 	float *rgba;
 	ajar_status st;
-	char spp[32], seed[32], depth[32], secs[32];
+	char spp[32], seed[32], depth[32], secs[32], shares[2048];
 	if (!r || !path)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_write_exr: NULL argument");
 	if ((st = read_image(r, &rgba)) != AJAR_OK)
@@ -315,10 +793,11 @@ ajar_status ajar_renderer_write_exr(ajar_renderer *r, const char *path)
 	snprintf(seed, sizeof seed, "%u", r->seed);
 	snprintf(depth, sizeof depth, "%u", r->max_depth);
 	snprintf(secs, sizeof secs, "%.3f", r->elapsed);
+	device_shares(r, shares, sizeof shares);
 	const char *attrs[] = {"ajar:spp", spp, "ajar:integrator", integrator_name(r->integrator),
 			       "ajar:seed", seed, "ajar:max_depth", depth, "ajar:render_seconds", secs,
-			       "ajar:device", r->dev.name, "ajar:scene", r->scene_name,
-			       "ajar:version", AJAR_VERSION_STRING};
+			       "ajar:device", r->device_names, "ajar:devices", shares,
+			       "ajar:scene", r->scene_name, "ajar:version", AJAR_VERSION_STRING};
 	st = ajar_write_exr(path, rgba, r->width, r->height, attrs, sizeof attrs / sizeof attrs[0] / 2);
 	free(rgba);
 	return st;

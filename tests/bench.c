@@ -134,6 +134,51 @@ static void bench_scene(const char *path, uint32_t spp)
 	ajar_scene_destroy(&s);
 }
 
+/* Path-tracing samples per second on one device and on all devices at
+ * once, with each device's share. Without other devices PoCL's pthread
+ * device is exposed twice; those two share the machine's cores, so the
+ * figure shows the scheduler's overhead and balance, not a speed-up. Runs
+ * before anything else starts OpenCL (PoCL reads POCL_DEVICES then). */
+static void bench_devices(void)
+{
+	int set = !getenv("POCL_DEVICES");
+	ajar_scene *s;
+	uint32_t ndev = 0;
+	if (set)
+		setenv("POCL_DEVICES", "pthread pthread", 1);
+	check(ajar_devices(NULL, 0, &ndev));
+	check(ajar_scene_load("scenes/cornell/cornell.gltf", &s));
+	const char *sel[] = {"0:0", "all"};
+	for (int k = 0; k < (ndev > 1 ? 2 : 1); k++) {
+		ajar_options o;
+		ajar_renderer *r;
+		ajar_options_default(&o);
+		o.width = o.height = 256;
+		o.device = sel[k];
+		o.spp = 2; /* warm-up: PoCL's work-group compile */
+		check(ajar_renderer_create(s, &o, &r));
+		check(ajar_renderer_render(r, NULL, NULL));
+		ajar_renderer_destroy(&r);
+		o.spp = 32;
+		check(ajar_renderer_create(s, &o, &r));
+		double t0 = now();
+		check(ajar_renderer_render(r, NULL, NULL));
+		double t = now() - t0;
+		printf("cornell 256x256 32 spp on %-3s: %6.3f Msamples/s", sel[k], 256.0 * 256 * 32 / t * 1e-6);
+		for (uint32_t i = 0; i < ajar_renderer_device_count(r); i++) {
+			ajar_device_stats st;
+			check(ajar_renderer_device_stats(r, i, &st));
+			printf("%s %s %.1f%% %.3g Msamples/s", i ? ";" : " ", st.selector, 100 * st.share,
+			       st.samples_per_second * 1e-6);
+		}
+		printf("\n");
+		ajar_renderer_destroy(&r);
+	}
+	ajar_scene_destroy(&s);
+	if (set)
+		unsetenv("POCL_DEVICES");
+}
+
 /* Wall time of a tiny CLI render; `cold` empties both kernel caches. */
 static double startup(const char *cache, int cold)
 {
@@ -156,6 +201,7 @@ int main(int argc, char **argv)
 	if (!mkdtemp(dir))
 		return 1;
 	printf("Ajar %s bench (device: first CPU device; one run, compare figures within it)\n", ajar_version());
+	bench_devices();
 	double cold = startup(dir, 1);
 	startup(dir, 0); /* fills PoCL's cache */
 	double warm = startup(dir, 0);
