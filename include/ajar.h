@@ -123,14 +123,22 @@ ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info);
 /* ---- Rendering --------------------------------------------------------- */
 
 typedef enum { AJAR_INTEGRATOR_PT = 0, AJAR_INTEGRATOR_BDPT = 1, AJAR_INTEGRATOR_PORTAL = 2 } ajar_integrator;
+typedef enum { AJAR_MIS_POWER = 0, AJAR_MIS_BALANCE = 1 } ajar_mis;
+/* Longest path (segments) the bidirectional integrators take. */
+#define AJAR_BIDIR_MAX_DEPTH 32
 
 typedef struct {
 	uint32_t width, height;  /* 0: scene's suggestion, else 512 x 512/aspect */
 	uint32_t spp;            /* samples per pixel; 0 = until time_limit */
 	double time_limit;       /* seconds; 0 = none */
 	ajar_integrator integrator;
-	uint32_t max_depth;      /* maximum path segments */
+	uint32_t max_depth;      /* maximum path segments (camera segment included) */
+	uint32_t min_depth;      /* paths of fewer segments are left out (0: none) */
 	uint32_t seed;
+	ajar_mis mis;            /* bidirectional integrators' MIS heuristic */
+	uint32_t strategy_len;   /* bdpt: keep one image per strategy (s, t) for paths
+				  * of up to this many segments (1..8), 0 = none */
+	int strategy_unweighted; /* those images without MIS weights */
 	const char *device;      /* selector ("0:0", "cpu", "gpu", name substring), a comma-
 				  * separated list of them or "all" (render on several
 				  * devices at once), or NULL for the first CPU device */
@@ -168,6 +176,9 @@ uint32_t ajar_renderer_spp(const ajar_renderer *r);
 ajar_status ajar_renderer_image(ajar_renderer *r, float *rgba, uint32_t *width, uint32_t *height);
 ajar_status ajar_renderer_write_exr(ajar_renderer *r, const char *path);
 ajar_status ajar_renderer_write_png(ajar_renderer *r, const char *path);
+/* The image plus one RGB layer per bdpt strategy (channels
+ * "len<n>.s<s>t<t>.R" etc.), when options.strategy_len > 0. */
+ajar_status ajar_renderer_write_strategies(ajar_renderer *r, const char *path);
 /* The device(s) used, for reports. */
 const char *ajar_renderer_device_name(const ajar_renderer *r);
 

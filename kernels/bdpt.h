@@ -23,6 +23,7 @@
 #include "camera.h"
 #include "film.h"
 #include "mis.h"
+#include "strategies.h"
 #include "vertex.h"
 
 /* Emitted radiance and light-origin densities of a light vertex `l`
@@ -247,8 +248,6 @@ typedef struct {
 	V3 L;                /* this pixel's eye-strategy sum */
 } BdptFilm;
 
-INLINE int bdpt_layer_count(int len) { return len * (len + 3) / 2; }
-
 INLINE void film_add(GLOBAL long *film, uint pixel, V3 c, Rng *rng)
 {
 	atom_add(&film[3 * pixel + 0], film_fixed(c.x, rng_f(rng)));
@@ -271,7 +270,7 @@ INLINE void bdpt_add(const SceneView *sc, BdptFilm *out, int s, int t, V3 c, flo
 		out->L = v3_add(out->L, cw);
 	if (n <= prm->strategy_len) {
 		uint npix = (uint)(prm->camera.width * prm->camera.height);
-		uint layer = (uint)((n - 1) * (n + 2) / 2 + s);
+		uint layer = (uint)bdpt_layer(n, s);
 		film_add(out->layers + 3 * (ulong)npix * layer, pixel, prm->strategy_unweighted ? c : cw, rng);
 	}
 }

@@ -153,8 +153,10 @@ static int64_t exr_stream_write(exr_const_context_t ctxt, void *user, const void
 
 static const char *const rgba_names[4] = {"R", "G", "B", "A"};
 
-/* Encodes every scanline chunk of part 0 from interleaved float RGBA. */
-static exr_result_t exr_write_pixels(exr_context_t ctxt, const float *rgba, uint32_t width, uint32_t height)
+/* Encodes every scanline chunk of part 0 from interleaved float pixels of
+ * nch channels named `names`. */
+static exr_result_t exr_write_pixels(exr_context_t ctxt, const float *px, int nch, const char *const *names,
+				     uint32_t width, uint32_t height)
 {
 	int32_t lines;
 	exr_result_t rv = exr_get_scanlines_per_chunk(ctxt, 0, &lines);
@@ -174,13 +176,13 @@ static exr_result_t exr_write_pixels(exr_context_t ctxt, const float *rgba, uint
 		for (int c = 0; c < enc.channel_count; c++) {
 			exr_coding_channel_info_t *ch = &enc.channels[c];
 			int k = 0;
-			while (k < 4 && strcmp(ch->channel_name, rgba_names[k]) != 0)
+			while (k < nch - 1 && strcmp(ch->channel_name, names[k]) != 0)
 				k++;
-			ch->user_pixel_stride = 4 * sizeof(float);
-			ch->user_line_stride = (int32_t)(width * 4 * sizeof(float));
+			ch->user_pixel_stride = nch * (int32_t)sizeof(float);
+			ch->user_line_stride = (int32_t)(width * nch * sizeof(float));
 			ch->user_bytes_per_element = sizeof(float);
 			ch->user_data_type = EXR_PIXEL_FLOAT;
-			ch->encode_from_ptr = (const uint8_t *)(rgba + (size_t)y * width * 4 + k);
+			ch->encode_from_ptr = (const uint8_t *)(px + (size_t)y * width * nch + k);
 		}
 		rv = exr_encoding_choose_default_routines(ctxt, 0, &enc);
 		if (rv == EXR_ERR_SUCCESS)
@@ -194,7 +196,14 @@ static exr_result_t exr_write_pixels(exr_context_t ctxt, const float *rgba, uint
 ajar_status ajar_write_exr(const char *path, const float *rgba, uint32_t width, uint32_t height,
 			   const char *const *attrs, uint32_t nattrs)
 {
-	if (!path || !rgba || width == 0 || height == 0 || (nattrs > 0 && !attrs))
+	return exr_write_channels(path, rgba, 4, rgba_names, width, height, attrs, nattrs);
+}
+
+ajar_status exr_write_channels(const char *path, const float *px, int nch, const char *const *names, uint32_t width,
+			       uint32_t height, const char *const *attrs, uint32_t nattrs)
+{
+	const float *rgba = px;
+	if (!path || !rgba || width == 0 || height == 0 || (nattrs > 0 && !attrs) || nch < 1)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_write_exr: %s: no path, pixels or size",
 			       path ? path : "(null)");
 	if (width > INT_MAX / 16 || height > INT_MAX)
@@ -227,8 +236,8 @@ ajar_status ajar_write_exr(const char *path, const float *rgba, uint32_t width, 
 	if (rv == EXR_ERR_SUCCESS)
 		rv = exr_initialize_required_attr_simple(ctxt, 0, (int32_t)width, (int32_t)height,
 							 EXR_COMPRESSION_ZIP);
-	for (int k = 0; k < 4 && rv == EXR_ERR_SUCCESS; k++)
-		rv = exr_add_channel(ctxt, 0, rgba_names[k], EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
+	for (int k = 0; k < nch && rv == EXR_ERR_SUCCESS; k++)
+		rv = exr_add_channel(ctxt, 0, names[k], EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
 	for (uint32_t i = 0; i < nattrs && rv == EXR_ERR_SUCCESS; i++) {
 		step = "set attribute";
 		rv = exr_attr_set_string(ctxt, 0, attrs[2 * i], attrs[2 * i + 1]);
@@ -239,7 +248,7 @@ ajar_status ajar_write_exr(const char *path, const float *rgba, uint32_t width, 
 	}
 	if (rv == EXR_ERR_SUCCESS) {
 		step = "write pixels";
-		rv = exr_write_pixels(ctxt, rgba, width, height);
+		rv = exr_write_pixels(ctxt, rgba, nch, names, width, height);
 	}
 	/* finish writes the chunk offset table; it can fail too. */
 	if (ctxt) {

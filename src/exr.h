@@ -3,6 +3,7 @@
 #ifndef AJAR_EXR_H
 #define AJAR_EXR_H
 #include <stddef.h>
+#include <stdint.h>
 
 #include "ajar.h"
 
@@ -15,6 +16,11 @@ extern "C" {
  * one of another type is AJAR_ERROR_BAD_INPUT; a value longer than the
  * buffer is AJAR_ERROR_INVALID_ARGUMENT. */
 ajar_status exr_read_attr(const char *path, const char *name, char *value, size_t cap);
+
+/* Writes nch float channels named names[0..nch-1], interleaved per pixel
+ * in `px` (top row first), with string attributes as in ajar_write_exr. */
+ajar_status exr_write_channels(const char *path, const float *px, int nch, const char *const *names, uint32_t width,
+			       uint32_t height, const char *const *attrs, uint32_t nattrs);
 
 /* Atomic output, shared by the EXR and PNG writers: image_tmp_open creates
  * a new file next to `path` (*tmp_path is malloc'd); image_tmp_finish

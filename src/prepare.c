@@ -118,6 +118,10 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	p->rr_depth = 3;
 	p->integrator = o->integrator;
 	p->seed = o->seed;
+	p->mis = o->mis;
+	p->min_depth = (int)o->min_depth;
+	p->strategy_len = (int)o->strategy_len;
+	p->strategy_unweighted = o->strategy_unweighted;
 	p->emitter_power = d->lights.emitter_power;
 	p->env_power = d->lights.env_power;
 	if (p->num_emitters == 0 && p->env_type == ENV_NONE)

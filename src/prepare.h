@@ -21,6 +21,10 @@ typedef struct {
 	int integrator;
 	uint32_t max_depth;
 	uint32_t seed;
+	int mis;
+	uint32_t min_depth;
+	uint32_t strategy_len;
+	int strategy_unweighted;
 } PrepareOptions;
 
 ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *out);

@@ -31,10 +31,13 @@
 
 #include "device.h"
 #include "error.h"
+#include "exr.h"
 #include "prepare.h"
 #include "scene.h"
 #include "upload.h"
+#include "../kernels/compat.h"
 #include "../kernels/film.h"
+#include "../kernels/strategies.h"
 
 #define PASS_SECONDS 0.25
 #define DEFAULT_WIDTH 512
@@ -90,6 +93,8 @@ struct ajar_renderer {
 	char scene_name[256];
 	char device_names[1024];
 	atomic_int cancel;
+	int nlayers;                   /* per-strategy images after the splat film */
+	int strategy_unweighted;
 	long *film, *film_splat;       /* host reduction */
 	long *salvage, *salvage_splat; /* films read back from dropped devices, or NULL */
 	pthread_mutex_t lock;
@@ -136,20 +141,38 @@ void ajar_options_default(ajar_options *o)
 	memset(o, 0, sizeof *o);
 	o->spp = 64;
 	o->integrator = AJAR_INTEGRATOR_PT;
-	o->max_depth = 64;
+	o->max_depth = 0; /* the integrator's default */
 	o->seed = 1;
 }
 
-static ajar_status check_options(const ajar_options *o)
+/* Validates o into *out, with defaults resolved: max_depth 0 means 64 for
+ * pt and AJAR_BIDIR_MAX_DEPTH for the bidirectional integrators. */
+static ajar_status check_options(const ajar_options *in, ajar_options *out)
 {
+	*out = *in;
+	ajar_options *o = out;
+	if (o->max_depth == 0)
+		o->max_depth = o->integrator == AJAR_INTEGRATOR_PT ? 64 : AJAR_BIDIR_MAX_DEPTH;
 	if (o->width > 16384 || o->height > 16384 || (o->width == 0) != (o->height == 0))
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "image size %ux%u: both must be in 1..16384",
 			       o->width, o->height);
-	if (o->integrator != AJAR_INTEGRATOR_PT)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT,
-			       "integrator %d is not available in this version (only pt)", (int)o->integrator);
+	if (o->integrator != AJAR_INTEGRATOR_PT && o->integrator != AJAR_INTEGRATOR_BDPT)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "integrator %d is not available in this version",
+			       (int)o->integrator);
 	if (o->max_depth < 1 || o->max_depth > 1024)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "max depth %u: must be in 1..1024", o->max_depth);
+	/* Bidirectional subpaths live in fixed-size private arrays (kernels/vertex.h). */
+	if (o->integrator != AJAR_INTEGRATOR_PT && o->max_depth > AJAR_BIDIR_MAX_DEPTH)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "max depth %u: bdpt and portal allow at most %d",
+			       o->max_depth, AJAR_BIDIR_MAX_DEPTH);
+	if (o->mis != AJAR_MIS_POWER && o->mis != AJAR_MIS_BALANCE)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "unknown MIS heuristic %d", (int)o->mis);
+	if (o->min_depth > o->max_depth)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "min depth %u exceeds max depth %u", o->min_depth,
+			       o->max_depth);
+	if (o->strategy_len && (o->integrator == AJAR_INTEGRATOR_PT || o->strategy_len > 8))
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT,
+			       "strategy images need a bidirectional integrator and a length of 1..8");
 	if (o->spp == 0 && !(o->time_limit > 0))
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "set a sample count or a time limit");
 	if (o->time_limit < 0 || o->time_limit != o->time_limit)
@@ -177,23 +200,26 @@ static size_t film_bytes(const ajar_renderer *r)
 	return sizeof(cl_long) * 3 * (size_t)r->width * r->height;
 }
 
+/* The splat film, followed by bdpt's per-strategy layers if asked for. */
+static size_t splat_bytes(const ajar_renderer *r) { return film_bytes(r) * (1 + (size_t)r->nlayers); }
+
 /* Context, program, scene and films on one device. */
 static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_id plat, cl_device_id id)
 {
 	Device *d = &rd->dev;
 	ajar_status st;
 	cl_long zero = 0;
-	size_t bytes = film_bytes(r);
+	size_t bytes = film_bytes(r), sbytes = splat_bytes(r);
 	if ((st = device_open(d, plat, id)) != AJAR_OK ||
 	    (st = device_build(d, ajar_kernel_source, "-cl-std=CL1.2")) != AJAR_OK ||
 	    (st = device_kernel(d, "render_pass", &rd->k_render)) != AJAR_OK ||
 	    (st = upload_scene(d, &r->data, &rd->bufs)) != AJAR_OK ||
 	    (st = upload_bind(d, rd->k_render, &rd->bufs, &rd->arg_first)) != AJAR_OK ||
 	    (st = device_buffer(d, CL_MEM_READ_WRITE, bytes, NULL, &rd->accum)) != AJAR_OK ||
-	    (st = device_buffer(d, CL_MEM_READ_WRITE, bytes, NULL, &rd->splat)) != AJAR_OK)
+	    (st = device_buffer(d, CL_MEM_READ_WRITE, sbytes, NULL, &rd->splat)) != AJAR_OK)
 		return st;
 	CL_TRY(d, clEnqueueFillBuffer(d->queue, rd->accum, &zero, sizeof zero, 0, bytes, 0, NULL, NULL));
-	CL_TRY(d, clEnqueueFillBuffer(d->queue, rd->splat, &zero, sizeof zero, 0, bytes, 0, NULL, NULL));
+	CL_TRY(d, clEnqueueFillBuffer(d->queue, rd->splat, &zero, sizeof zero, 0, sbytes, 0, NULL, NULL));
 	CL_TRY(d, clSetKernelArg(rd->k_render, rd->arg_first, sizeof(cl_mem), &rd->accum));
 	CL_TRY(d, clSetKernelArg(rd->k_render, rd->arg_first + 1, sizeof(cl_mem), &rd->splat));
 	CL_TRY(d, clFinish(d->queue));
@@ -284,7 +310,7 @@ static ajar_status open_devices(ajar_renderer *r, const char *selector)
 ajar_status ajar_renderer_create(const ajar_scene *scene, const ajar_options *opt, ajar_renderer **out)
 {
 	ajar_status st;
-	ajar_options defaults;
+	ajar_options defaults, resolved;
 	if (!out)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_create: out is NULL");
 	*out = NULL;
@@ -294,8 +320,9 @@ ajar_status ajar_renderer_create(const ajar_scene *scene, const ajar_options *op
 		ajar_options_default(&defaults);
 		opt = &defaults;
 	}
-	if ((st = check_options(opt)) != AJAR_OK)
+	if ((st = check_options(opt, &resolved)) != AJAR_OK)
 		return st;
+	opt = &resolved;
 	ajar_renderer *r = calloc(1, sizeof *r);
 	if (!r)
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory");
@@ -307,14 +334,17 @@ ajar_status ajar_renderer_create(const ajar_scene *scene, const ajar_options *op
 	r->integrator = opt->integrator;
 	r->seed = opt->seed;
 	r->max_depth = opt->max_depth;
+	r->nlayers = opt->strategy_len ? bdpt_layer_count((int)opt->strategy_len) : 0;
+	r->strategy_unweighted = opt->strategy_unweighted;
 	snprintf(r->scene_name, sizeof r->scene_name, "%s", scene->source ? scene->source : "");
-	PrepareOptions po = {r->width, r->height, (int)opt->integrator, opt->max_depth, opt->seed};
+	PrepareOptions po = {r->width, r->height, (int)opt->integrator, opt->max_depth, opt->seed,
+			     (int)opt->mis, opt->min_depth, opt->strategy_len, opt->strategy_unweighted};
 	if ((st = prepare_scene(scene, &po, &r->data)) != AJAR_OK)
 		goto fail;
 	if ((st = open_devices(r, opt->device)) != AJAR_OK)
 		goto fail;
 	r->film = calloc(3 * (size_t)r->width * r->height, sizeof *r->film);
-	r->film_splat = calloc(3 * (size_t)r->width * r->height, sizeof *r->film_splat);
+	r->film_splat = calloc(3 * (size_t)r->width * r->height * (1 + (size_t)r->nlayers), sizeof *r->film_splat);
 	if (!r->film || !r->film_splat) {
 		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory for a %ux%u image", r->width, r->height);
 		goto fail;
@@ -490,12 +520,12 @@ static int run_pass(RenderDevice *rd, Range g, int *film_ok)
 /* Reads a device's films into fresh host arrays; 0 if it cannot. */
 static int read_films(RenderDevice *rd, long **accum, long **splat)
 {
-	size_t bytes = film_bytes(rd->r);
+	size_t bytes = film_bytes(rd->r), sbytes = splat_bytes(rd->r);
 	*accum = malloc(bytes);
-	*splat = malloc(bytes);
+	*splat = malloc(sbytes);
 	if (*accum && *splat &&
 	    clEnqueueReadBuffer(rd->dev.queue, rd->accum, CL_TRUE, 0, bytes, *accum, 0, NULL, NULL) == CL_SUCCESS &&
-	    clEnqueueReadBuffer(rd->dev.queue, rd->splat, CL_TRUE, 0, bytes, *splat, 0, NULL, NULL) == CL_SUCCESS)
+	    clEnqueueReadBuffer(rd->dev.queue, rd->splat, CL_TRUE, 0, sbytes, *splat, 0, NULL, NULL) == CL_SUCCESS)
 		return 1;
 	free(*accum);
 	free(*splat);
@@ -506,10 +536,10 @@ static int read_films(RenderDevice *rd, long **accum, long **splat)
 /* Adds a dropped device's films to the salvage (under the lock); 0 if out of memory. */
 static int salvage_add(ajar_renderer *r, const long *accum, const long *splat)
 {
-	size_t n = 3 * (size_t)r->width * r->height;
+	size_t n = 3 * (size_t)r->width * r->height, ns = n * (1 + (size_t)r->nlayers);
 	if (!r->salvage) {
 		r->salvage = calloc(n, sizeof *r->salvage);
-		r->salvage_splat = calloc(n, sizeof *r->salvage_splat);
+		r->salvage_splat = calloc(ns, sizeof *r->salvage_splat);
 		if (!r->salvage || !r->salvage_splat) {
 			free(r->salvage);
 			free(r->salvage_splat);
@@ -517,10 +547,10 @@ static int salvage_add(ajar_renderer *r, const long *accum, const long *splat)
 			return 0;
 		}
 	}
-	for (size_t i = 0; i < n; i++) {
+	for (size_t i = 0; i < n; i++)
 		r->salvage[i] += accum[i];
+	for (size_t i = 0; i < ns; i++)
 		r->salvage_splat[i] += splat[i];
-	}
 	return 1;
 }
 
@@ -730,14 +760,14 @@ ajar_status ajar_renderer_image(ajar_renderer *r, float *rgba, uint32_t *width, 
 		*height = r->height;
 	if (!rgba)
 		return AJAR_OK;
-	size_t n = 3 * (size_t)r->width * r->height;
+	size_t n = 3 * (size_t)r->width * r->height, ns = n * (1 + (size_t)r->nlayers);
 	long *sum = r->film, *sum_splat = r->film_splat;
 	if (r->salvage) {
 		memcpy(sum, r->salvage, n * sizeof *sum);
-		memcpy(sum_splat, r->salvage_splat, n * sizeof *sum_splat);
+		memcpy(sum_splat, r->salvage_splat, ns * sizeof *sum_splat);
 	} else {
 		memset(sum, 0, n * sizeof *sum);
-		memset(sum_splat, 0, n * sizeof *sum_splat);
+		memset(sum_splat, 0, ns * sizeof *sum_splat);
 	}
 	/* Integer sums first, scaled once: the same bits whatever the device count. */
 	for (uint32_t k = 0; k < r->ndev; k++) {
@@ -748,10 +778,10 @@ ajar_status ajar_renderer_image(ajar_renderer *r, float *rgba, uint32_t *width, 
 		if (!read_films(rd, &a, &s))
 			return err_set(AJAR_ERROR_DEVICE, "OpenCL device %s: reading the film back failed",
 				       rd->dev.name);
-		for (size_t i = 0; i < n; i++) {
+		for (size_t i = 0; i < n; i++)
 			sum[i] += a[i];
+		for (size_t i = 0; i < ns; i++)
 			sum_splat[i] += s[i];
-		}
 		free(a);
 		free(s);
 	}
@@ -780,25 +810,94 @@ static ajar_status read_image(ajar_renderer *r, float **rgba)
 	return st;
 }
 
+/* The header attributes every output of this renderer carries. */
+typedef struct {
+	char spp[32], seed[32], depth[32], secs[32], shares[2048];
+	const char *kv[20];
+} Header;
+
+static uint32_t header_fill(ajar_renderer *r, Header *h)
+{
+	snprintf(h->spp, sizeof h->spp, "%u", r->spp_done);
+	snprintf(h->seed, sizeof h->seed, "%u", r->seed);
+	snprintf(h->depth, sizeof h->depth, "%u", r->max_depth);
+	snprintf(h->secs, sizeof h->secs, "%.3f", r->elapsed);
+	device_shares(r, h->shares, sizeof h->shares);
+	const char *kv[] = {"ajar:spp", h->spp, "ajar:integrator", integrator_name(r->integrator),
+			    "ajar:seed", h->seed, "ajar:max_depth", h->depth, "ajar:render_seconds", h->secs,
+			    "ajar:device", r->device_names, "ajar:devices", h->shares,
+			    "ajar:scene", r->scene_name, "ajar:version", AJAR_VERSION_STRING};
+	memcpy(h->kv, kv, sizeof kv);
+	return sizeof kv / sizeof kv[0] / 2;
+}
+
 ajar_status ajar_renderer_write_exr(ajar_renderer *r, const char *path)
 {
 	float *rgba;
 	ajar_status st;
-	char spp[32], seed[32], depth[32], secs[32], shares[2048];
+	Header h;
 	if (!r || !path)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_write_exr: NULL argument");
 	if ((st = read_image(r, &rgba)) != AJAR_OK)
 		return st;
-	snprintf(spp, sizeof spp, "%u", r->spp_done);
-	snprintf(seed, sizeof seed, "%u", r->seed);
-	snprintf(depth, sizeof depth, "%u", r->max_depth);
-	snprintf(secs, sizeof secs, "%.3f", r->elapsed);
-	device_shares(r, shares, sizeof shares);
-	const char *attrs[] = {"ajar:spp", spp, "ajar:integrator", integrator_name(r->integrator),
-			       "ajar:seed", seed, "ajar:max_depth", depth, "ajar:render_seconds", secs,
-			       "ajar:device", r->device_names, "ajar:devices", shares,
-			       "ajar:scene", r->scene_name, "ajar:version", AJAR_VERSION_STRING};
-	st = ajar_write_exr(path, rgba, r->width, r->height, attrs, sizeof attrs / sizeof attrs[0] / 2);
+	uint32_t n = header_fill(r, &h);
+	st = ajar_write_exr(path, rgba, r->width, r->height, h.kv, n);
+	free(rgba);
+	return st;
+}
+
+ajar_status ajar_renderer_write_strategies(ajar_renderer *r, const char *path)
+{
+	float *rgba;
+	ajar_status st;
+	Header h;
+	if (!r || !path)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_write_strategies: NULL argument");
+	if (r->nlayers == 0)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT,
+			       "%s: the renderer keeps no strategy images (set ajar_options.strategy_len)", path);
+	if ((st = read_image(r, &rgba)) != AJAR_OK) /* also reduces the layers into film_splat */
+		return st;
+	size_t npix = (size_t)r->width * r->height;
+	int nch = 4 + 3 * r->nlayers;
+	float *px = malloc(sizeof(float) * nch * npix);
+	char(*names)[48] = malloc(sizeof *names * nch);
+	const char **np = malloc(sizeof *np * nch);
+	if (!px || !names || !np) {
+		free(px);
+		free(names);
+		free(np);
+		free(rgba);
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory for strategy images", path);
+	}
+	static const char rgb[] = "RGB";
+	for (int c = 0; c < 4; c++)
+		snprintf(names[c], sizeof names[c], "%c", "RGBA"[c]);
+	int len = 0;
+	while (bdpt_layer_count(len) < r->nlayers)
+		len++;
+	for (int n = 1; n <= len; n++)
+		for (int s = 0; s <= n; s++)
+			for (int c = 0; c < 3; c++)
+				snprintf(names[4 + 3 * bdpt_layer(n, s) + c], sizeof names[0], "len%d.s%dt%d.%c", n, s,
+					 n + 1 - s, rgb[c]);
+	for (int c = 0; c < nch; c++)
+		np[c] = names[c];
+	double scale = r->spp_done ? 1.0 / ((double)FILM_SCALE * r->spp_done) : 0.0;
+	for (size_t i = 0; i < npix; i++) {
+		memcpy(&px[nch * i], &rgba[4 * i], 4 * sizeof(float));
+		for (int l = 0; l < r->nlayers; l++)
+			for (int c = 0; c < 3; c++)
+				px[nch * i + 4 + 3 * l + c] =
+					(float)(r->film_splat[3 * npix * (1 + (size_t)l) + 3 * i + c] * scale);
+	}
+	uint32_t n = header_fill(r, &h);
+	h.kv[2 * n] = "ajar:strategies";
+	h.kv[2 * n + 1] = r->strategy_unweighted ? "unweighted" : "weighted (the layers sum to the image)";
+	st = exr_write_channels(path, px, nch, np, r->width, r->height, h.kv, n + 1);
+	free(px);
+	free(names);
+	free(np);
 	free(rgba);
 	return st;
 }

@@ -96,6 +96,7 @@ int args_parse_render(int argc, char **argv, RenderArgs *a)
 	memset(a, 0, sizeof *a);
 	ajar_options_default(&a->opt);
 	int spp_given = 0, time_given = 0;
+	uint32_t strategy_len = 0;
 	for (int i = 0; i < argc; i++) {
 		const char *arg = argv[i];
 		if (arg[0] != '-' || arg[1] == '\0') { /* "-" alone is a (strange) file name */
@@ -118,6 +119,10 @@ int args_parse_render(int argc, char **argv, RenderArgs *a)
 			a->quiet = 1;
 			continue;
 		}
+		if (!strcmp(arg, "--unweighted")) {
+			a->opt.strategy_unweighted = 1;
+			continue;
+		}
 		/* Every other option takes a value: "--opt value" or "--opt=value". */
 		char name[32];
 		const char *val, *eq = strchr(arg, '=');
@@ -133,7 +138,8 @@ int args_parse_render(int argc, char **argv, RenderArgs *a)
 			val = NULL;
 		}
 		static const char *const known[] = {"-o", "--output", "--spp", "--time", "--size", "--integrator",
-						    "--max-depth", "--seed", "--device", "--png"};
+						    "--max-depth", "--seed", "--device", "--png", "--min-depth",
+						    "--mis", "--strategies", "--strategy-len"};
 		size_t k = 0;
 		while (k < sizeof known / sizeof known[0] && strcmp(name, known[k]) != 0)
 			k++;
@@ -165,6 +171,20 @@ int args_parse_render(int argc, char **argv, RenderArgs *a)
 			rc = parse_integrator(name, val, &a->opt.integrator);
 		else if (!strcmp(name, "--max-depth"))
 			rc = parse_u32(name, val, 1, 1024, &a->opt.max_depth);
+		else if (!strcmp(name, "--min-depth"))
+			rc = parse_u32(name, val, 0, 1024, &a->opt.min_depth);
+		else if (!strcmp(name, "--strategy-len"))
+			rc = parse_u32(name, val, 1, 8, &strategy_len);
+		else if (!strcmp(name, "--strategies"))
+			a->strategies = val;
+		else if (!strcmp(name, "--mis")) {
+			if (!strcmp(val, "power"))
+				a->opt.mis = AJAR_MIS_POWER;
+			else if (!strcmp(val, "balance"))
+				a->opt.mis = AJAR_MIS_BALANCE;
+			else
+				rc = args_usage_error("--mis: '%s' is not power or balance", val);
+		}
 		else /* --seed */
 			rc = parse_u32(name, val, 0, UINT32_MAX, &a->opt.seed);
 		if (rc != EXIT_OK)
@@ -176,6 +196,14 @@ int args_parse_render(int argc, char **argv, RenderArgs *a)
 		return args_usage_error("no output given (-o OUT.exr)");
 	if (a->png && strcmp(a->png, a->exr) == 0)
 		return args_usage_error("--png: '%s' is also the EXR output", a->png);
+	if (a->strategies) {
+		a->opt.strategy_len = strategy_len ? strategy_len : 4;
+		if (!strcmp(a->strategies, a->exr) || (a->png && !strcmp(a->strategies, a->png)))
+			return args_usage_error("--strategies: '%s' is also another output", a->strategies);
+	} else if (strategy_len || a->opt.strategy_unweighted) {
+		return args_usage_error("%s needs --strategies OUT.exr",
+					strategy_len ? "--strategy-len" : "--unweighted");
+	}
 	/* 64 samples unless only a time limit was asked for. */
 	if (!spp_given)
 		a->opt.spp = time_given ? 0 : 64;

@@ -22,6 +22,7 @@ typedef struct {
 	const char *scene;
 	const char *exr;   /* -o */
 	const char *png;   /* --png, or NULL */
+	const char *strategies; /* --strategies, or NULL */
 	ajar_options opt;  /* spp, time_limit, size, integrator, depth, seed, device */
 	int quiet;
 	int help;          /* --help was given: print render help, nothing else */

@@ -57,11 +57,22 @@ static const char usage_render[] =
 	"  --time SECONDS         render until this time has passed (with --spp: whichever\n"
 	"                         comes first)\n"
 	"  --size WxH             image size (default: the scene's suggestion, else 512 wide)\n"
-	"  --integrator NAME      pt (default), bdpt or portal\n"
-	"  --max-depth N          maximum path segments\n"
+	"  --integrator NAME      pt (default): path tracing; bdpt: bidirectional path\n"
+	"                         tracing; portal: bdpt plus intermediate subpaths\n"
+	"                         through the scene's portals\n"
+	"  --max-depth N          maximum path segments, camera segment included\n"
+	"                         (default 64 for pt, 32 for bdpt and portal, their limit)\n"
+	"  --min-depth N          leave out paths of fewer segments\n"
+	"  --mis NAME             power (default) or balance heuristic (bdpt, portal)\n"
+	"  --strategies OUT.exr   bdpt: also write one RGB layer per strategy (s, t) of\n"
+	"                         paths of up to --strategy-len N segments (default 4),\n"
+	"                         channels len<n>.s<s>t<t>.R/G/B; weighted, they sum\n"
+	"                         to the image\n"
+	"  --unweighted           the strategy layers without MIS weights\n"
 	"  --seed N               random seed (same seed, device and options: same image)\n"
-	"  --device SELECTOR      platform:device index (e.g. 0:1), cpu, gpu, or a part of\n"
-	"                         the device name; see 'ajar devices'\n"
+	"  --device SELECTOR      platform:device index (e.g. 0:1), cpu, gpu, a part of the\n"
+	"                         device name, a comma-separated list of these, or all:\n"
+	"                         several devices render at once; see 'ajar devices'\n"
 	"  --png OUT.png          also write a tone-mapped 8-bit sRGB preview\n"
 	"  -q, --quiet            print nothing but errors\n"
 	"  -h, --help             this text\n"
@@ -202,6 +213,13 @@ static int write_outputs(ajar_renderer *r, const RenderArgs *a)
 		report(st, a->exr);
 		return exit_code(st) == EXIT_BAD_INPUT ? EXIT_IO : exit_code(st);
 	}
+	if (a->strategies) {
+		st = ajar_renderer_write_strategies(r, a->strategies);
+		if (st != AJAR_OK) {
+			report(st, a->strategies);
+			return exit_code(st) == EXIT_BAD_INPUT ? EXIT_IO : exit_code(st);
+		}
+	}
 	if (a->png) {
 		st = ajar_renderer_write_png(r, a->png);
 		if (st != AJAR_OK) {
@@ -210,6 +228,19 @@ static int write_outputs(ajar_renderer *r, const RenderArgs *a)
 		}
 	}
 	return EXIT_OK;
+}
+
+/* One line per device when several rendered: who did which share. */
+static void print_device_shares(const ajar_renderer *r)
+{
+	uint32_t n = ajar_renderer_device_count(r);
+	for (uint32_t i = 0; n > 1 && i < n; i++) {
+		ajar_device_stats ds;
+		if (ajar_renderer_device_stats(r, i, &ds) == AJAR_OK)
+			fprintf(stderr, "ajar:   %s (%s): %.1f%% of the samples, %.3g Msamples/s%s\n", ds.name,
+				ds.selector, 100.0 * ds.share, ds.samples_per_second * 1e-6,
+				ds.failed ? ", dropped after a failure" : "");
+	}
 }
 
 static int cmd_render(int argc, char **argv)
@@ -222,7 +253,8 @@ static int cmd_render(int argc, char **argv)
 		fputs(usage_render, stdout);
 		return EXIT_OK;
 	}
-	if ((rc = check_output("-o", a.exr)) != EXIT_OK || (a.png && (rc = check_output("--png", a.png)) != EXIT_OK))
+	if ((rc = check_output("-o", a.exr)) != EXIT_OK || (a.png && (rc = check_output("--png", a.png)) != EXIT_OK) ||
+	    (a.strategies && (rc = check_output("--strategies", a.strategies)) != EXIT_OK))
 		return rc;
 
 	Progress progress;
@@ -285,6 +317,7 @@ static int cmd_render(int argc, char **argv)
 	} else if (!a.quiet) {
 		fprintf(stderr, "ajar: done: %u spp in %s (%.3g Msamples/s); wrote %s%s%s\n", spp, elapsed,
 			last->samples_per_second * 1e-6, a.exr, a.png ? " and " : "", a.png ? a.png : "");
+		print_device_shares(r);
 	}
 done:
 	atomic_store(&g_renderer, NULL);
