@@ -46,6 +46,7 @@ DEPS_test_api := $(BUILD)/libajar.a
 DEPS_test_cache := $(BUILD)/libajar.a
 DEPS_test_cli := $(BUILD)/libajar.a
 DEPS_test_multidevice := $(BUILD)/libajar.a
+DEPS_test_integrators := $(BUILD)/libajar.a
 
 .PHONY: all lib cli tests test test-unit asan demo bench install uninstall clean deps help
 all: lib cli

@@ -170,6 +170,10 @@ void ajar_renderer_destroy(ajar_renderer **r);
 ajar_status ajar_renderer_render(ajar_renderer *r, ajar_progress_fn fn, void *user);
 /* Safe from a signal handler or another thread. */
 void ajar_renderer_cancel(ajar_renderer *r);
+/* Clears the image and starts over with another seed, keeping the
+ * prepared scene and compiled kernels: independent renders for variance
+ * estimates cost no set-up. Not while a render runs. */
+ajar_status ajar_renderer_restart(ajar_renderer *r, uint32_t seed);
 uint32_t ajar_renderer_spp(const ajar_renderer *r);
 /* The current estimate: width * height RGBA floats, row-major, top row first.
  * Not while ajar_renderer_render runs (call it before or after). */

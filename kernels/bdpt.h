@@ -149,17 +149,20 @@ INLINE float bdpt_weight(const SceneView *sc, const PathVertex *l, int s, const 
 	return mis_path_weight(mv, k, s, sc->params->mis);
 }
 
-/* Unoccluded segment between two vertices (either may be the camera). */
+/* Unoccluded segment between two vertices (either may be the camera,
+ * which sits in free space and is not offset). */
 INLINE int bdpt_visible(const SceneView *sc, const PathVertex *a, const PathVertex *b)
 {
-	V3 d = v3_sub(b->p, a->p);
-	V3 o = a->type == VERTEX_CAMERA ? a->p : ray_offset(a->p, a->ng, d);
-	V3 q = b->type == VERTEX_CAMERA ? b->p : ray_offset(b->p, b->ng, v3_neg(d));
-	V3 od = v3_sub(q, o);
-	float len = v3_len(od);
-	if (!(len > 0.0f))
-		return 0;
-	return !bvh_occluded(sc, o, v3_scale(od, 1.0f / len), len * (1.0f - 1e-4f));
+	if (a->type == VERTEX_CAMERA || b->type == VERTEX_CAMERA) {
+		const PathVertex *c = a->type == VERTEX_CAMERA ? a : b, *v = a->type == VERTEX_CAMERA ? b : a;
+		V3 d = v3_sub(c->p, v->p);
+		float len = v3_len(d);
+		if (!(len > 0.0f))
+			return 0;
+		d = v3_scale(d, 1.0f / len);
+		return !bvh_occluded(sc, ray_offset(v->p, v->ng, d), d, len * (1.0f - 1e-4f));
+	}
+	return segment_clear(sc, a->p, a->ng, b->p, b->ng);
 }
 
 /* f (with the shading-normal correction on light subpaths) times the

@@ -68,4 +68,94 @@ INLINE float mis_path_weight(const MisVertex *v, int k, int s, int heuristic)
 	}
 	return 1.0f / sum;
 }
+
+/* ---- BDPT and intermediate-subpath strategies together (design.md) ----
+ *
+ * A portal strategy (s, m, t') samples the path with x_0..x_{s-1} from a
+ * light subpath, x_s..x_m from the <- half of an intermediate subpath
+ * (walking toward the light, densities pr), the pair x_m, x_{m+1} from the
+ * portal point and direction, x_{m+2}..x_{m+t'} from the -> half (pf), and
+ * the rest from the eye subpath:
+ *   p = prod_{i<s} pf_i prod_{s<=i<m} pr_i p_pair(m) prod_{m+1<i<=m+t'} pf_i prod_{i>m+t'} pr_i
+ * with p_pair(m) = p_A(w_0) / (2 pi) G(x_m, x_{m+1}). Every crossing of
+ * edge m with a portal triangle is a separate strategy of the same
+ * density, so the strategies of edge m count cross[m] times. Densities are
+ * summed in log space from prefix sums, and for one edge the sum over
+ * (s, t') is a product of a sum over s and a sum over t'. */
+
+typedef struct {
+	int c;  /* 1: bdpt (s, t = k - s); 2: portal (s, m, t') */
+	int s;
+	int m;
+	int tp;
+} MisStrategy;
+
+INLINE int mis_bdpt_valid(const MisVertex *v, int k, int s)
+{
+	if (s == 0)
+		return 1;
+	if (s >= k || v[s - 1].delta || v[s].delta)
+		return 0;
+	return !(v[s - 1].infinite && s == k - 1);
+}
+
+/* Logs of the remapped densities and their prefix sums: PF[j] = sum of
+ * log pf_i for i < j, PR likewise; arrays of k + 1. */
+INLINE void mis_prefix(const MisVertex *v, int k, float *PF, float *PR)
+{
+	PF[0] = PR[0] = 0.0f;
+	for (int i = 0; i < k; i++) {
+		PF[i + 1] = PF[i] + log(mis_remap0(v[i].pf));
+		PR[i + 1] = PR[i] + log(mis_remap0(v[i].pr));
+	}
+}
+
+INLINE float mis_log_bdpt(const float *PF, const float *PR, int k, int s) { return PF[s] + PR[k] - PR[s]; }
+
+INLINE float mis_log_portal(const float *PF, const float *PR, const float *lpair, int k, int s, int m, int tp)
+{
+	return PF[s] + (PR[m] - PR[s]) + lpair[m] + (PF[m + tp + 1] - PF[m + 2]) + (PR[k] - PR[m + tp + 1]);
+}
+
+/* log(exp(a) + exp(b)) without overflow; -INF is the empty sum. */
+INLINE float mis_logadd(float a, float b)
+{
+	float hi = fmax(a, b), lo = fmin(a, b);
+	if (hi == -AJAR_INF)
+		return hi;
+	return hi + log(1.0f + exp(lo - hi));
+}
+
+/* Weight of strategy `cur` for the k-vertex path v among all BDPT and
+ * portal strategies. cross[i] counts the portal crossings of edge
+ * (x_i, x_{i+1}); lpair[i] is log p_pair(i) where cross[i] > 0. */
+INLINE float mis_union_weight(const MisVertex *v, int k, const int *cross, const float *lpair, MisStrategy cur,
+			      int heuristic)
+{
+	float PF[2 * 33 + 1], PR[2 * 33 + 1];
+	float beta = heuristic == MIS_BALANCE ? 1.0f : 2.0f;
+	mis_prefix(v, k, PF, PR);
+	float lcur = cur.c == 1 ? mis_log_bdpt(PF, PR, k, cur.s)
+				: mis_log_portal(PF, PR, lpair, k, cur.s, cur.m, cur.tp);
+	float total = -AJAR_INF; /* log of sum of (p_j / p_cur)^beta */
+	for (int s = 0; s < k; s++)
+		if (mis_bdpt_valid(v, k, s))
+			total = mis_logadd(total, beta * (mis_log_bdpt(PF, PR, k, s) - lcur));
+	for (int m = 0; m + 2 < k; m++) {
+		if (cross[m] <= 0)
+			continue;
+		/* Left factor: s in [0, m] with a valid light connection. */
+		float left = -AJAR_INF, right = -AJAR_INF;
+		for (int s = 0; s <= m; s++)
+			if (s == 0 || (!v[s - 1].delta && !v[s].delta))
+				left = mis_logadd(left, beta * (PF[s] + PR[m] - PR[s]));
+		/* Right factor: t' >= 1 with m + t' <= k - 2 and a valid eye connection. */
+		for (int tp = 1; m + tp <= k - 2; tp++)
+			if (!v[m + tp].delta && !v[m + tp + 1].delta)
+				right = mis_logadd(right, beta * ((PF[m + tp + 1] - PF[m + 2]) + (PR[k] - PR[m + tp + 1])));
+		float term = left + right + beta * (lpair[m] - lcur) + log((float)cross[m]);
+		total = mis_logadd(total, term);
+	}
+	return exp(-total);
+}
 #endif

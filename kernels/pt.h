@@ -64,9 +64,9 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 				float pdf_bsdf_w, pdf_rev_w;
 				V3 f = bsdf_eval(&bs, wo, ls.wi, BSDF_RADIANCE, &pdf_bsdf_w, &pdf_rev_w);
 				if (!v3_is_zero(f)) {
-					V3 org = ray_offset(s.p, s.ng, ls.wi);
-					float dist = ls.is_env ? AJAR_INF : ls.dist * (1.0f - 1e-4f);
-					if (!bvh_occluded(sc, org, ls.wi, dist)) {
+					int clear = ls.is_env ? !bvh_occluded(sc, ray_offset(s.p, s.ng, ls.wi), ls.wi, AJAR_INF)
+							      : segment_clear(sc, s.p, s.ng, ls.p, ls.n);
+					if (clear) {
 						float w = mis_power(ls.pdf_w, pdf_bsdf_w);
 						float k = fabs(v3_dot(s.ns, ls.wi)) * w / ls.pdf_w;
 						L = v3_add(L, v3_scale(v3_mul(v3_mul(beta, f), ls.Le), k));

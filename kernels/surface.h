@@ -76,6 +76,23 @@ INLINE void surface_from_hit(const SceneView *sc, const Hit *h, Surface *s)
 	s->material = t->material;
 }
 
+/* Whether the segment between surface points a and b (geometric normals
+ * na, nb, either side) is unoccluded. Both ends are pushed off their
+ * surfaces first and the ray stops short of the far end by a relative
+ * margin, so neither end's own triangle counts as a blocker: measuring
+ * the length from an offset origin but to an un-offset end lets the
+ * target's own surface block short segments. */
+INLINE int segment_clear(const SceneView *sc, V3 a, V3 na, V3 b, V3 nb)
+{
+	V3 d = v3_sub(b, a);
+	V3 o = ray_offset(a, na, d), q = ray_offset(b, nb, v3_neg(d));
+	V3 od = v3_sub(q, o);
+	float len = v3_len(od);
+	if (!(len > 0.0f))
+		return 0;
+	return !bvh_occluded(sc, o, v3_scale(od, 1.0f / len), len * (1.0f - 1e-4f));
+}
+
 INLINE V3 surface_base_color(const SceneView *sc, const Surface *s)
 {
 	GLOBAL const Material *m = &sc->materials[s->material];

@@ -67,91 +67,117 @@ INLINE float vertex_shading_correction(const PathVertex *v, V3 wo, V3 wi)
 	return fabs(v3_dot(wo, v->ns)) * fabs(v3_dot(wi, v->ng)) / den;
 }
 
-/* Continues a subpath whose last vertex is path[n - 1] along the ray (o, d)
- * with throughput beta. `pdf_w` is the solid-angle density of d at
+/* Appends to path[n] the vertex that the ray (o, d) from path[n - 1]
+ * hits, with throughput beta. `pdf_w` is the solid-angle density of d at
  * path[n - 1]; `parallel` says the ray is one of a parallel family (leaving
- * the environment's disk): then pdf_w is a density per unit perpendicular
- * area and no 1/d^2 applies. `light_side` says which density the walk fills
- * (pf for light subpaths and the portal's <- half). `escape_env` adds an
- * environment vertex when the ray escapes (eye side). Stops at max_verts
- * vertices, when the BSDF gives no sample, or by Russian roulette after
- * rr_depth vertices of this subpath. Returns the new vertex count. */
+ * the environment's disk): then pdf_w is per unit perpendicular area and no
+ * 1/d^2 applies. `light_side` says which density the walk fills (pf for
+ * light subpaths and the portal's -> half). A ray that escapes becomes an
+ * environment vertex if `escape_env` and the scene has one. Returns 1 if
+ * a vertex was appended. */
+INLINE int vertex_trace(const SceneView *sc, PathVertex *path, int n, V3 o, V3 d, V3 beta, float pdf_w,
+			int parallel, int light_side, int escape_env)
+{
+	PathVertex *prev = &path[n - 1], *v = &path[n];
+	Hit h;
+	v->beta = beta;
+	v->wo = v3_neg(d);
+	v->delta = 0;
+	v->pf = v->pr = 0.0f;
+	if (!bvh_intersect(sc, o, d, AJAR_INF, &h)) {
+		if (!escape_env || sc->params->env_type == ENV_NONE)
+			return 0;
+		v->type = VERTEX_ENV;
+		v->p = d;
+		v->ng = v->ns = v3_neg(d);
+		v->base = v3(0.0f, 0.0f, 0.0f);
+		v->material = v->tri = -1;
+		if (light_side)
+			v->pf = pdf_w;
+		else
+			v->pr = pdf_w;
+		return 1;
+	}
+	Surface s;
+	surface_from_hit(sc, &h, &s);
+	v->type = VERTEX_SURFACE;
+	v->p = s.p;
+	v->ng = s.ng;
+	v->ns = s.ns;
+	v->base = surface_base_color(sc, &s);
+	v->material = s.material;
+	v->tri = s.tri;
+	float pa = parallel ? pdf_w * fabs(v3_dot(s.ng, d)) : vertex_density_a(prev, v, pdf_w);
+	if (light_side)
+		v->pf = pa;
+	else
+		v->pr = pa;
+	return 1;
+}
+
+/* Samples the BSDF at surface vertex path[n - 1] (its predecessor along
+ * path[n - 1].wo is path[n - 2]): the next ray (*o, *d), its density *pdf_w
+ * (0 after a delta lobe) and the new throughput *beta; sets the reverse
+ * density of path[n - 2]. Russian roulette after rr_depth vertices, on the
+ * throughput relative to beta_ref. Returns 0 if the subpath ends here. */
+INLINE int vertex_scatter(const SceneView *sc, PathVertex *path, int n, int light_side, float beta_ref, V3 *beta,
+			  V3 *o, V3 *d, float *pdf_w, Rng *rng)
+{
+	PathVertex *v = &path[n - 1], *prev = &path[n - 2];
+	Bsdf bs;
+	BsdfSample bsm;
+	if (v->type != VERTEX_SURFACE)
+		return 0;
+	vertex_bsdf(sc, v, &bs);
+	float u0 = rng_f(rng), u1 = rng_f(rng), u2 = rng_f(rng);
+	if (!bsdf_sample(&bs, v->wo, u0, u1, u2, light_side ? BSDF_IMPORTANCE : BSDF_RADIANCE, &bsm) ||
+	    !(bsm.pdf_w > 0.0f))
+		return 0;
+	float k = fabs(v3_dot(v->ns, bsm.wi)) / bsm.pdf_w;
+	if (light_side)
+		k *= vertex_shading_correction(v, v->wo, bsm.wi);
+	*beta = v3_mul(v->beta, v3_scale(bsm.f, k));
+	v->delta = bsm.delta;
+	*pdf_w = bsm.delta ? 0.0f : bsm.pdf_w;
+	float rev_a = bsm.delta ? 0.0f : vertex_density_a(v, prev, bsm.pdf_rev_w);
+	if (light_side)
+		prev->pr = rev_a;
+	else
+		prev->pf = rev_a;
+	if (n >= sc->params->rr_depth) {
+		float q = fmin(v3_maxc(*beta) / beta_ref, 0.95f);
+		if (!(rng_f(rng) < q))
+			return 0;
+		*beta = v3_scale(*beta, 1.0f / q);
+	}
+	if (v3_is_zero(*beta))
+		return 0;
+	*o = ray_offset(v->p, v->ng, bsm.wi);
+	*d = bsm.wi;
+	return 1;
+}
+
+/* Extends a subpath from its last vertex path[n - 1] by BSDF sampling
+ * until max_verts vertices, a miss, or Russian roulette. Returns the new
+ * vertex count. */
+INLINE int vertex_extend(const SceneView *sc, PathVertex *path, int n, int max_verts, int light_side,
+			 int escape_env, float beta_ref, Rng *rng)
+{
+	V3 o, d, beta;
+	float pdf_w;
+	while (n < max_verts && vertex_scatter(sc, path, n, light_side, beta_ref, &beta, &o, &d, &pdf_w, rng) &&
+	       vertex_trace(sc, path, n, o, d, beta, pdf_w, 0, light_side, escape_env))
+		n++;
+	return n;
+}
+
+/* A subpath from path[n - 1] along the ray (o, d): the first hit, then
+ * BSDF sampling (vertex_trace and vertex_extend). */
 INLINE int vertex_walk(const SceneView *sc, PathVertex *path, int n, int max_verts, V3 o, V3 d, V3 beta,
 		       float pdf_w, int parallel, int light_side, int escape_env, Rng *rng)
 {
-	GLOBAL const Params *prm = sc->params;
-	int mode = light_side ? BSDF_IMPORTANCE : BSDF_RADIANCE;
-	float beta_ref = fmax(v3_maxc(beta), 1e-30f);
-	while (n < max_verts) {
-		PathVertex *prev = &path[n - 1], *v = &path[n];
-		Hit h;
-		if (!bvh_intersect(sc, o, d, AJAR_INF, &h)) {
-			if (!escape_env || prm->env_type == ENV_NONE)
-				break;
-			v->type = VERTEX_ENV;
-			v->p = d;
-			v->ng = v->ns = v3_neg(d);
-			v->wo = v3_neg(d);
-			v->beta = beta;
-			v->base = v3(0.0f, 0.0f, 0.0f);
-			v->material = v->tri = -1;
-			v->delta = 0;
-			v->pf = 0.0f;
-			v->pr = pdf_w;
-			return n + 1;
-		}
-		Surface s;
-		surface_from_hit(sc, &h, &s);
-		v->type = VERTEX_SURFACE;
-		v->p = s.p;
-		v->ng = s.ng;
-		v->ns = s.ns;
-		v->wo = v3_neg(d);
-		v->beta = beta;
-		v->base = surface_base_color(sc, &s);
-		v->material = s.material;
-		v->tri = s.tri;
-		v->delta = 0;
-		float pa = parallel ? pdf_w * fabs(v3_dot(s.ng, d)) : vertex_density_a(prev, v, pdf_w);
-		parallel = 0;
-		if (light_side) {
-			v->pf = pa;
-			v->pr = 0.0f;
-		} else {
-			v->pr = pa;
-			v->pf = 0.0f;
-		}
-		n++;
-		if (n >= max_verts)
-			break;
-		Bsdf bs;
-		BsdfSample bsm;
-		vertex_bsdf(sc, v, &bs);
-		float u0 = rng_f(rng), u1 = rng_f(rng), u2 = rng_f(rng);
-		if (!bsdf_sample(&bs, v->wo, u0, u1, u2, mode, &bsm) || !(bsm.pdf_w > 0.0f))
-			break;
-		float k = fabs(v3_dot(v->ns, bsm.wi)) / bsm.pdf_w;
-		if (light_side)
-			k *= vertex_shading_correction(v, v->wo, bsm.wi);
-		beta = v3_mul(beta, v3_scale(bsm.f, k));
-		v->delta = bsm.delta;
-		pdf_w = bsm.delta ? 0.0f : bsm.pdf_w;
-		float rev_a = bsm.delta ? 0.0f : vertex_density_a(v, prev, bsm.pdf_rev_w);
-		if (light_side)
-			prev->pr = rev_a;
-		else
-			prev->pf = rev_a;
-		if (n >= prm->rr_depth) {
-			float q = fmin(v3_maxc(beta) / beta_ref, 0.95f);
-			if (!(rng_f(rng) < q))
-				break;
-			beta = v3_scale(beta, 1.0f / q);
-		}
-		if (v3_is_zero(beta))
-			break;
-		o = ray_offset(s.p, s.ng, bsm.wi);
-		d = bsm.wi;
-	}
-	return n;
+	if (n >= max_verts || !vertex_trace(sc, path, n, o, d, beta, pdf_w, parallel, light_side, escape_env))
+		return n;
+	return vertex_extend(sc, path, n + 1, max_verts, light_side, escape_env, fmax(v3_maxc(beta), 1e-30f), rng);
 }
 #endif

@@ -376,6 +376,37 @@ void ajar_renderer_destroy(ajar_renderer **rp)
 	*rp = NULL;
 }
 
+ajar_status ajar_renderer_restart(ajar_renderer *r, uint32_t seed)
+{
+	if (!r)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_restart: renderer is NULL");
+	cl_long zero = 0;
+	r->data.params->seed = seed;
+	for (uint32_t k = 0; k < r->ndev; k++) {
+		RenderDevice *rd = &r->devs[k];
+		Device *d = &rd->dev;
+		if (!rd->alive)
+			continue;
+		cl_mem params = rd->bufs.mem[rd->bufs.count - 1]; /* last in AJAR_SCENE_BUFFERS */
+		CL_TRY(d, clEnqueueWriteBuffer(d->queue, params, CL_TRUE, 0, sizeof(Params), r->data.params, 0, NULL,
+					       NULL));
+		CL_TRY(d, clEnqueueFillBuffer(d->queue, rd->accum, &zero, sizeof zero, 0, film_bytes(r), 0, NULL, NULL));
+		CL_TRY(d, clEnqueueFillBuffer(d->queue, rd->splat, &zero, sizeof zero, 0, splat_bytes(r), 0, NULL, NULL));
+		CL_TRY(d, clFinish(d->queue));
+		rd->done.n = 0;
+		rd->spp_kept = 0;
+	}
+	free(r->salvage);
+	free(r->salvage_splat);
+	r->salvage = r->salvage_splat = NULL;
+	r->holes.n = 0;
+	r->seed = seed;
+	r->spp_done = r->next_first = 0;
+	r->elapsed = 0;
+	atomic_store(&r->cancel, 0);
+	return AJAR_OK;
+}
+
 void ajar_renderer_cancel(ajar_renderer *r)
 {
 	if (r)

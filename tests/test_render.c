@@ -258,10 +258,18 @@ static void test_bad_options(void **state)
 	ajar_options o;
 	assert_int_equal(ajar_scene_load(SCENE("cornell/cornell.gltf"), &s), AJAR_OK);
 	ajar_options_default(&o);
-	o.max_depth = 0;
+	o.max_depth = 2000;
 	assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_ERROR_INVALID_ARGUMENT);
 	assert_null(r);
 	assert_non_null(strstr(ajar_last_error(), "depth"));
+	ajar_options_default(&o);
+	o.integrator = AJAR_INTEGRATOR_BDPT;
+	o.max_depth = AJAR_BIDIR_MAX_DEPTH + 1;
+	assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_ERROR_INVALID_ARGUMENT);
+	assert_non_null(strstr(ajar_last_error(), "at most"));
+	ajar_options_default(&o);
+	o.strategy_len = 3; /* strategy images need a bidirectional integrator */
+	assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_ERROR_INVALID_ARGUMENT);
 	ajar_options_default(&o);
 	o.device = "no-such-device-anywhere";
 	assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_ERROR_DEVICE);

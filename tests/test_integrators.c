@@ -1,0 +1,103 @@
+/* test_integrators.c — the integrators agree on every shipped scene when
+ * run through the library on the OpenCL device (PoCL by default).
+ *
+ * Statistic: the image mean per channel from B = 16 independent batches
+ * (ajar_renderer_restart with a new seed); the batch spread gives the
+ * standard error of each integrator's mean, and two integrators must agree
+ * within 5 combined standard errors. With 15 degrees of freedom a false
+ * alarm is ~2e-4 per comparison. A bias of 1% is caught wherever the
+ * standard error is below 0.2% of the mean, which the sample counts below
+ * give on every scene (the printout shows it). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "ajar.h"
+#include "testutil.h"
+
+#define BATCHES 16
+
+typedef struct {
+	double mean[3], se[3];
+} Estimate;
+
+static void estimate(ajar_scene *s, ajar_integrator integ, uint32_t w, uint32_t h, uint32_t spp, uint32_t depth,
+		     Estimate *e)
+{
+	ajar_options o;
+	ajar_renderer *r;
+	ajar_options_default(&o);
+	o.width = w;
+	o.height = h;
+	o.spp = spp;
+	o.integrator = integ;
+	o.max_depth = depth;
+	if (ajar_renderer_create(s, &o, &r) != AJAR_OK)
+		fail_msg("%s", ajar_last_error());
+	float *img = malloc(sizeof(float) * 4 * w * h);
+	double s1[3] = {0}, s2[3] = {0};
+	for (int b = 0; b < BATCHES; b++) {
+		assert_int_equal(ajar_renderer_restart(r, 100 + b), AJAR_OK);
+		if (ajar_renderer_render(r, NULL, NULL) != AJAR_OK)
+			fail_msg("%s", ajar_last_error());
+		assert_int_equal(ajar_renderer_image(r, img, NULL, NULL), AJAR_OK);
+		for (int c = 0; c < 3; c++) {
+			double m = 0;
+			for (uint32_t i = 0; i < w * h; i++)
+				m += img[4 * i + c];
+			m /= w * h;
+			s1[c] += m;
+			s2[c] += m * m;
+		}
+	}
+	for (int c = 0; c < 3; c++) {
+		e->mean[c] = s1[c] / BATCHES;
+		e->se[c] = sqrt(fmax(0, (s2[c] - s1[c] * s1[c] / BATCHES) / (BATCHES - 1)) / BATCHES);
+	}
+	free(img);
+	ajar_renderer_destroy(&r);
+}
+
+static void agree(const char *what, const Estimate *a, const Estimate *b)
+{
+	for (int c = 0; c < 3; c++) {
+		double se = sqrt(a->se[c] * a->se[c] + b->se[c] * b->se[c]);
+		double z = se > 0 ? (a->mean[c] - b->mean[c]) / se : 0;
+		print_message("%s, channel %d: %.5f +- %.5f vs %.5f +- %.5f (%+.1f se, se %.2f%% of the mean)\n",
+			      what, c, a->mean[c], a->se[c], b->mean[c], b->se[c], z,
+			      100 * se / fmax(fabs(b->mean[c]), 1e-12));
+		if (fabs(z) > 5)
+			fail_msg("%s, channel %d: the integrators differ by %.1f standard errors", what, c, z);
+	}
+}
+
+static void compare(const char *path, uint32_t w, uint32_t h, uint32_t spp_pt, uint32_t spp_bdpt)
+{
+	ajar_scene *s;
+	Estimate pt, bdpt;
+	char what[256];
+	const uint32_t depth = 12;
+	if (ajar_scene_load(path, &s) != AJAR_OK)
+		fail_msg("%s", ajar_last_error());
+	estimate(s, AJAR_INTEGRATOR_PT, w, h, spp_pt, depth, &pt);
+	estimate(s, AJAR_INTEGRATOR_BDPT, w, h, spp_bdpt, depth, &bdpt);
+	snprintf(what, sizeof what, "%s bdpt vs pt", path);
+	agree(what, &bdpt, &pt);
+	ajar_scene_destroy(&s);
+}
+
+static void test_cornell(void **state) { compare(SCENE("cornell/cornell.gltf"), 32, 32, 32, 8); }
+static void test_window_room(void **state) { compare(SCENE("window-room/window-room.gltf"), 32, 32, 64, 16); }
+static void test_living_room(void **state) { compare(SCENE("living-room/living-room.gltf"), 32, 18, 64, 16); }
+static void test_bathroom(void **state) { compare(SCENE("bathroom/bathroom.gltf"), 24, 24, 32, 8); }
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_cornell),
+		cmocka_unit_test(test_window_room),
+		cmocka_unit_test(test_living_room),
+		cmocka_unit_test(test_bathroom),
+	};
+	return cmocka_run_group_tests_name("integrators", tests, NULL, NULL);
+}
