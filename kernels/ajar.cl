@@ -2,7 +2,7 @@
  * which the host also compiles for its tests. */
 #include "film.h"
 #include "layout.h"
-#include "bdpt.h"
+#include "portal.h"
 #include "pt.h"
 
 #define AJAR_KERNEL_ARG(type, name) __global const type *name,
@@ -26,15 +26,18 @@ __kernel void render_pass(AJAR_SCENE_BUFFERS(AJAR_KERNEL_ARG) __global long *acc
 		return;
 	float x = (float)(pixel % (uint)cam->width), y = (float)(pixel / (uint)cam->width);
 	long sum[3] = {0, 0, 0};
-	PathVertex light[SUBPATH_MAX], eye[SUBPATH_MAX];
+	PathVertex light[SUBPATH_MAX], eye[SUBPATH_MAX], back[SUBPATH_MAX], fwd[SUBPATH_MAX];
 	for (uint i = 0; i < sample_count; i++) {
 		Rng rng = rng_init(params->seed, pixel, sample_first + i, 0u);
 		float jx = rng_f(&rng), jy = rng_f(&rng);
 		V3 L;
-		if (params->integrator == INTEGRATOR_BDPT) {
+		if (params->integrator != INTEGRATOR_PT) {
 			BdptFilm out = {splat, splat + 3 * (ulong)cam->width * cam->height, pixel,
 					v3(0.0f, 0.0f, 0.0f)};
-			bdpt_sample(&sc, x + jx, y + jy, light, eye, &out, &rng);
+			if (params->integrator == INTEGRATOR_PORTAL)
+				portal_sample_pixel(&sc, x + jx, y + jy, light, eye, back, fwd, &out, &rng);
+			else
+				bdpt_sample(&sc, x + jx, y + jy, light, eye, &out, &rng);
 			L = out.L;
 		} else {
 			L = pt_radiance(&sc, cam->pos, camera_ray_dir(cam, x + jx, y + jy), &rng);

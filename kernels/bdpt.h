@@ -22,66 +22,8 @@
 #define AJAR_BDPT_H
 #include "camera.h"
 #include "film.h"
-#include "mis.h"
+#include "path_mis.h"
 #include "strategies.h"
-#include "vertex.h"
-
-/* Emitted radiance and light-origin densities of a light vertex `l`
- * (VERTEX_LIGHT on an emitter's front face, or VERTEX_ENV) toward w. */
-INLINE V3 bdpt_emitted(const SceneView *sc, const PathVertex *l, V3 w)
-{
-	if (l->type == VERTEX_ENV)
-		return env_radiance(sc, l->p);
-	return emitter_radiance(sc, l->tri, w);
-}
-
-/* Density of the light vertex as a light subpath's origin (pf_0). */
-INLINE float bdpt_origin_pdf(const SceneView *sc, const PathVertex *l)
-{
-	float ps = sc->params->env_pdf_select;
-	if (l->type == VERTEX_ENV)
-		return ps * env_pdf_w(sc, l->p);
-	return (1.0f - ps) * emitter_pdf_a(sc, l->tri);
-}
-
-/* Density with which the light vertex's emission sampling produces `to`
- * (pf_1): cosine-weighted directions from emitters, a disk of radius R
- * for the environment (parallel rays: per perpendicular area). */
-INLINE float bdpt_emission_pdf(const SceneView *sc, const PathVertex *l, const PathVertex *to)
-{
-	if (l->type == VERTEX_ENV) {
-		float r = sc->params->scene_radius;
-		return fabs(v3_dot(to->ng, l->p)) / (AJAR_PI * r * r);
-	}
-	V3 d = v3_sub(to->p, l->p);
-	float cos_l = v3_dot(l->ng, d) / v3_len(d);
-	if (!(cos_l > 0.0f))
-		return 0.0f;
-	return vertex_density_a(l, to, cos_l * AJAR_INV_PI);
-}
-
-/* Solid-angle density of `v`'s BSDF sampling `to`, given the vertex `from`
- * on its other side (wo), for the mode of the subpath v belongs to. */
-INLINE float bdpt_bsdf_pdf_w(const SceneView *sc, const PathVertex *v, const PathVertex *from, const PathVertex *to,
-			     int mode)
-{
-	Bsdf bs;
-	float pdf_w, pdf_rev_w;
-	V3 wo = from->type == VERTEX_ENV ? from->p : v3_norm(v3_sub(from->p, v->p));
-	V3 wi = to->type == VERTEX_ENV ? to->p : v3_norm(v3_sub(to->p, v->p));
-	vertex_bsdf(sc, v, &bs);
-	bsdf_eval(&bs, wo, wi, mode, &pdf_w, &pdf_rev_w);
-	return pdf_w;
-}
-
-/* Densities of `to` sampled from `v` when the path's other neighbour of v
- * is `from` (used on both sides of a connection). Camera and light origins
- * are handled by the callers. */
-INLINE float bdpt_pdf_a(const SceneView *sc, const PathVertex *v, const PathVertex *from, const PathVertex *to,
-			int mode)
-{
-	return vertex_density_a(v, to, bdpt_bsdf_pdf_w(sc, v, from, to, mode));
-}
 
 /* The MIS records of the path made of light vertices l[0..s-1] and eye
  * vertices e[t-1..0], with the densities next to the connection
@@ -142,8 +84,16 @@ INLINE int bdpt_mis_path(const SceneView *sc, const PathVertex *l, int s, const 
 	return k;
 }
 
+/* The weight of bdpt strategy (s, t): over the bdpt strategies alone, or,
+ * in the portal integrator, over both families (path_mis.h). */
 INLINE float bdpt_weight(const SceneView *sc, const PathVertex *l, int s, const PathVertex *e, int t)
 {
+	if (sc->params->integrator == INTEGRATOR_PORTAL) {
+		PathRef P;
+		MisStrategy cur = {1, s, 0, 0};
+		path_ref(&P, l, s, 0, 0, 0, 0, e, t);
+		return path_union_weight(sc, &P, cur);
+	}
 	MisVertex mv[2 * SUBPATH_MAX];
 	int k = bdpt_mis_path(sc, l, s, e, t, mv);
 	return mis_path_weight(mv, k, s, sc->params->mis);
@@ -342,22 +292,40 @@ INLINE int bdpt_eye_subpath(const SceneView *sc, float px, float py, PathVertex 
 	return vertex_walk(sc, e, 1, max_verts, cam->pos, dir, z0->beta, camera_pdf_w(cam, cos_c), 0, 0, 1, rng);
 }
 
-/* One pixel sample at raster (px, py) of pixel out->pixel: adds the eye
- * strategies to out->L and splats light tracing (t = 1). l and e hold
- * SUBPATH_MAX vertices each. */
-INLINE void bdpt_sample(const SceneView *sc, float px, float py, PathVertex *l, PathVertex *e, BdptFilm *out,
-			Rng *rng)
+/* The light vertex of a next-event sample (s = 1): its origin density
+ * pf_0 is solid angle for the environment, area for emitters. */
+INLINE void bdpt_light_vertex(PathVertex *y, const LightSample *ls)
+{
+	y->type = ls->is_env ? VERTEX_ENV : VERTEX_LIGHT;
+	y->p = ls->is_env ? ls->wi : ls->p;
+	y->ng = y->ns = y->wo = ls->n;
+	y->base = v3(0.0f, 0.0f, 0.0f);
+	y->beta = v3(1.0f, 1.0f, 1.0f);
+	y->delta = 0;
+	y->material = y->tri = -1;
+	y->cross = 0;
+	y->pf = ls->is_env ? ls->pdf_w : ls->pdf_w * fabs(v3_dot(ls->n, ls->wi)) / (ls->dist * ls->dist);
+	y->pr = 0.0f;
+}
+
+/* Whether the light sample is unoccluded from surface vertex z. */
+INLINE int bdpt_nee_visible(const SceneView *sc, const PathVertex *z, const LightSample *ls)
+{
+	if (ls->is_env)
+		return !bvh_occluded(sc, ray_offset(z->p, z->ng, ls->wi), ls->wi, AJAR_INF);
+	return segment_clear(sc, z->p, z->ng, ls->p, ls->n);
+}
+
+/* Every bdpt strategy of one light and one eye subpath: adds the eye
+ * strategies to out->L and splats light tracing (t = 1). */
+INLINE void bdpt_strategies(const SceneView *sc, PathVertex *l, int nl, PathVertex *e, int ne, BdptFilm *out,
+			    Rng *rng)
 {
 	int depth = sc->params->max_depth;
-	V3 one = v3(1.0f, 1.0f, 1.0f);
-
-	int nl = bdpt_light_subpath(sc, l, depth, rng);
-	int ne = bdpt_eye_subpath(sc, px, py, e, depth + 1, rng);
-	PathVertex *z0 = &e[0];
 
 	/* t = 1: every light vertex to the camera. */
 	for (int s = 1; s <= nl && s <= depth; s++)
-		bdpt_light_to_camera(sc, l, s, z0, out, rng);
+		bdpt_light_to_camera(sc, l, s, &e[0], out, rng);
 
 	for (int t = 2; t <= ne; t++) {
 		PathVertex *z = &e[t - 1];
@@ -375,24 +343,11 @@ INLINE void bdpt_sample(const SceneView *sc, float px, float py, PathVertex *l, 
 			float u0 = rng_f(rng), u1 = rng_f(rng), u2 = rng_f(rng);
 			if (light_sample(sc, z->p, u0, u1, u2, &ls) && !v3_is_zero(ls.Le)) {
 				PathVertex y;
-				y.type = ls.is_env ? VERTEX_ENV : VERTEX_LIGHT;
-				y.p = ls.is_env ? ls.wi : ls.p;
-				y.ng = y.ns = y.wo = ls.n;
-				y.base = v3(0.0f, 0.0f, 0.0f);
-				y.delta = 0;
-				y.material = y.tri = -1;
-				/* pf_0: solid angle for the environment, area for emitters. */
-				y.pf = ls.is_env ? ls.pdf_w : ls.pdf_w * fabs(v3_dot(ls.n, ls.wi)) / (ls.dist * ls.dist);
-				y.pr = 0.0f;
-				y.beta = one;
+				bdpt_light_vertex(&y, &ls);
 				V3 f = bdpt_scatter(sc, z, ls.wi, BSDF_RADIANCE);
-				if (!v3_is_zero(f)) {
-					V3 o = ray_offset(z->p, z->ng, ls.wi);
-					int vis = ls.is_env ? !bvh_occluded(sc, o, ls.wi, AJAR_INF) : bdpt_visible(sc, z, &y);
-					if (vis) {
-						V3 c = v3_scale(v3_mul(v3_mul(z->beta, f), ls.Le), 1.0f / ls.pdf_w);
-						bdpt_add(sc, out, 1, t, c, bdpt_weight(sc, &y, 1, e, t), out->pixel, rng);
-					}
+				if (!v3_is_zero(f) && bdpt_nee_visible(sc, z, &ls)) {
+					V3 c = v3_scale(v3_mul(v3_mul(z->beta, f), ls.Le), 1.0f / ls.pdf_w);
+					bdpt_add(sc, out, 1, t, c, bdpt_weight(sc, &y, 1, e, t), out->pixel, rng);
 				}
 			}
 		}
@@ -405,5 +360,16 @@ INLINE void bdpt_sample(const SceneView *sc, float px, float py, PathVertex *l, 
 				 out->pixel, rng);
 		}
 	}
+}
+
+/* One bdpt pixel sample at raster (px, py) of pixel out->pixel. l and e
+ * hold SUBPATH_MAX vertices each. */
+INLINE void bdpt_sample(const SceneView *sc, float px, float py, PathVertex *l, PathVertex *e, BdptFilm *out,
+			Rng *rng)
+{
+	int depth = sc->params->max_depth;
+	int nl = bdpt_light_subpath(sc, l, depth, rng);
+	int ne = bdpt_eye_subpath(sc, px, py, e, depth + 1, rng);
+	bdpt_strategies(sc, l, nl, e, ne, out, rng);
 }
 #endif

@@ -222,6 +222,13 @@ INLINE int bsdf_half_refract(V3 wo, V3 wi, float eta, V3 *h)
 	return 1;
 }
 
+/* Pure Lambertian (glTF with specular 0, no metal, no transmission) and
+ * not black: the diffuse lobe is then the only one. */
+INLINE int bsdf_lambert(const Bsdf *bs)
+{
+	return bs->metallic == 0.0f && bs->transmission == 0.0f && bs->specular == 0.0f && v3_maxc(bs->base_color) > 0.0f;
+}
+
 /* Lobe selection for outgoing cos_o > 0: weight x albedo estimate. */
 INLINE BsdfLobes bsdf_lobes(const Bsdf *bs, float cos_o)
 {
@@ -260,6 +267,10 @@ INLINE V3 bsdf_eval_local(const Bsdf *bs, V3 wo, V3 wi, float eta, int mode, flo
 {
 	V3 f = v3(0.0f, 0.0f, 0.0f);
 	float pdf = 0.0f;
+	if (bsdf_lambert(bs)) { /* the common case, exactly what the lobes below give */
+		*pdf_w = wi.z > 0.0f ? wi.z * AJAR_INV_PI : 0.0f;
+		return wi.z > 0.0f ? v3_scale(bs->base_color, AJAR_INV_PI) : f;
+	}
 	BsdfLobes p = bsdf_lobes(bs, wo.z);
 	int smooth = bsdf_smooth(bs);
 	if (wi.z > 0.0f) {
@@ -342,6 +353,17 @@ INLINE V3 bsdf_eval(const Bsdf *bs, V3 wo, V3 wi, int mode, float *pdf_w, float 
 	if (bsdf_pair(bs, wi, wo, &lo, &li, &eta))
 		bsdf_eval_local(bs, lo, li, eta, mode, pdf_rev_w);
 	return f;
+}
+
+/* Only the solid-angle density of sampling wi given wo (non-delta lobes):
+ * what MIS needs when it recomputes a vertex's density. */
+INLINE float bsdf_pdf_w(const Bsdf *bs, V3 wo, V3 wi)
+{
+	V3 lo, li;
+	float eta, pdf = 0.0f;
+	if (bsdf_pair(bs, wo, wi, &lo, &li, &eta))
+		bsdf_eval_local(bs, lo, li, eta, BSDF_RADIANCE, &pdf);
+	return pdf;
 }
 
 /* Probability of picking smooth glass's reflection (reflect = 1) or

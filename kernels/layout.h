@@ -7,7 +7,7 @@
 
 #define AJAR_LAYOUT_TYPES(X) \
 	X(BvhNode, 32) X(Tri, 48) X(TriShade, 64) X(Material, 64) X(Texture, 16) \
-	X(Emitter, 16) X(PortalTri, 48) X(Camera, 64) X(Params, 176)
+	X(Emitter, 16) X(PortalTri, 48) X(Camera, 64) X(Params, 192)
 
 #define AJAR_LAYOUT_FIELDS(X)                                                          \
 	X(BvhNode, bmin) X(BvhNode, index) X(BvhNode, bmax) X(BvhNode, count)          \
@@ -30,5 +30,6 @@
 	X(Params, scene_radius) X(Params, max_depth) X(Params, rr_depth)               \
 	X(Params, integrator) X(Params, seed) X(Params, emitter_power)                 \
 	X(Params, env_power) X(Params, mis) X(Params, min_depth)                       \
-	X(Params, strategy_len) X(Params, strategy_unweighted)
+	X(Params, strategy_len) X(Params, strategy_unweighted) X(Params, cross_filter)  \
+	X(Params, cross_lo) X(Params, cross_hi)
 #endif

@@ -120,8 +120,11 @@ typedef struct {
 	int min_depth;          /* only paths of at least this many segments */
 	int strategy_len;       /* 160, bdpt: per-strategy layers up to this path length, 0 = none */
 	int strategy_unweighted;/* layers without MIS weights */
-	int pad0, pad1;
-} Params; /* 176 */
+	int cross_filter;       /* pt, for tests: weight each path by its portal crossings on */
+	int cross_lo;           /* eye-side edges cross_lo..(segments - 1 - cross_hi) (edge 0 */
+	int cross_hi;           /* 176: leaves the camera); 0 = no filter */
+	int pad0, pad1, pad2;
+} Params; /* 192 */
 
 /* Layout of the float array `env`: for an ENV_IMAGE of W x H,
  *   [0, 3WH)                    linear RGB radiance, row-major, row 0 = top

@@ -14,6 +14,7 @@
 #include "bvh.h"
 #include "lights.h"
 #include "rng.h"
+#include "portal_geometry.h"
 #include "surface.h"
 
 #define VERTEX_CAMERA 0
@@ -36,6 +37,8 @@ typedef struct {
 	int delta;    /* scattered by a delta lobe */
 	int material; /* -1 for camera, env */
 	int tri;      /* hit triangle, -1 for camera, env */
+	int cross;    /* portal integrator: portal crossings of the edge to the previous vertex of this subpath */
+	int pad0, pad1, pad2;
 } PathVertex;
 
 INLINE void vertex_bsdf(const SceneView *sc, const PathVertex *v, Bsdf *bs)
@@ -80,10 +83,12 @@ INLINE int vertex_trace(const SceneView *sc, PathVertex *path, int n, V3 o, V3 d
 {
 	PathVertex *prev = &path[n - 1], *v = &path[n];
 	Hit h;
+	int portals = sc->params->integrator == INTEGRATOR_PORTAL;
 	v->beta = beta;
 	v->wo = v3_neg(d);
 	v->delta = 0;
 	v->pf = v->pr = 0.0f;
+	v->cross = 0;
 	if (!bvh_intersect(sc, o, d, AJAR_INF, &h)) {
 		if (!escape_env || sc->params->env_type == ENV_NONE)
 			return 0;
@@ -96,6 +101,8 @@ INLINE int vertex_trace(const SceneView *sc, PathVertex *path, int n, V3 o, V3 d
 			v->pf = pdf_w;
 		else
 			v->pr = pdf_w;
+		if (portals)
+			v->cross = portal_crossings(sc, prev->p, d, 1);
 		return 1;
 	}
 	Surface s;
@@ -112,6 +119,9 @@ INLINE int vertex_trace(const SceneView *sc, PathVertex *path, int n, V3 o, V3 d
 		v->pf = pa;
 	else
 		v->pr = pa;
+	if (portals) /* the edge to prev, or, from the sky, the ray back out */
+		v->cross = prev->type == VERTEX_ENV ? portal_crossings(sc, v->p, prev->p, 1)
+						    : portal_crossings(sc, prev->p, v->p, 0);
 	return 1;
 }
 

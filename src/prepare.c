@@ -116,7 +116,8 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	p->scene_radius = radius;
 	p->max_depth = (int)o->max_depth;
 	p->rr_depth = 3;
-	p->integrator = o->integrator;
+	/* Without portals the portal integrator is bdpt, sample for sample. */
+	p->integrator = o->integrator == INTEGRATOR_PORTAL && s->nportal_tris == 0 ? INTEGRATOR_BDPT : o->integrator;
 	p->seed = o->seed;
 	p->mis = o->mis;
 	p->min_depth = (int)o->min_depth;

@@ -94,7 +94,7 @@ struct ajar_renderer {
 	char device_names[1024];
 	atomic_int cancel;
 	int nlayers;                   /* per-strategy images after the splat film */
-	int strategy_unweighted;
+	int strategy_unweighted, strategy_len;
 	long *film, *film_splat;       /* host reduction */
 	long *salvage, *salvage_splat; /* films read back from dropped devices, or NULL */
 	pthread_mutex_t lock;
@@ -156,9 +156,9 @@ static ajar_status check_options(const ajar_options *in, ajar_options *out)
 	if (o->width > 16384 || o->height > 16384 || (o->width == 0) != (o->height == 0))
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "image size %ux%u: both must be in 1..16384",
 			       o->width, o->height);
-	if (o->integrator != AJAR_INTEGRATOR_PT && o->integrator != AJAR_INTEGRATOR_BDPT)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "integrator %d is not available in this version",
-			       (int)o->integrator);
+	if (o->integrator != AJAR_INTEGRATOR_PT && o->integrator != AJAR_INTEGRATOR_BDPT &&
+	    o->integrator != AJAR_INTEGRATOR_PORTAL)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "unknown integrator %d", (int)o->integrator);
 	if (o->max_depth < 1 || o->max_depth > 1024)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "max depth %u: must be in 1..1024", o->max_depth);
 	/* Bidirectional subpaths live in fixed-size private arrays (kernels/vertex.h). */
@@ -237,7 +237,8 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 	size_t max_local = 0;
 	CL_TRY(d, clGetKernelWorkGroupInfo(rd->k_render, d->id, CL_KERNEL_WORK_GROUP_SIZE, sizeof max_local,
 					   &max_local, NULL));
-	for (rd->local = 64; rd->local > 1 && rd->local > max_local; rd->local /= 2)
+	rd->local = getenv("AJAR_LOCAL") ? (size_t)atoi(getenv("AJAR_LOCAL")) : 64;
+	for (; rd->local > 1 && rd->local > max_local; rd->local /= 2)
 		;
 	log_msg(AJAR_LOG_INFO, "device %s (%s): kernels %s in %.2f s", d->name, d->selector,
 		d->from_cache ? "loaded from cache" : "compiled", d->build_seconds);
@@ -335,7 +336,10 @@ ajar_status ajar_renderer_create(const ajar_scene *scene, const ajar_options *op
 	r->seed = opt->seed;
 	r->max_depth = opt->max_depth;
 	r->nlayers = opt->strategy_len ? bdpt_layer_count((int)opt->strategy_len) : 0;
+	if (opt->strategy_len && opt->integrator == AJAR_INTEGRATOR_PORTAL)
+		r->nlayers += portal_layer_count((int)opt->strategy_len);
 	r->strategy_unweighted = opt->strategy_unweighted;
+	r->strategy_len = (int)opt->strategy_len;
 	snprintf(r->scene_name, sizeof r->scene_name, "%s", scene->source ? scene->source : "");
 	PrepareOptions po = {r->width, r->height, (int)opt->integrator, opt->max_depth, opt->seed,
 			     (int)opt->mis, opt->min_depth, opt->strategy_len, opt->strategy_unweighted};
@@ -904,14 +908,19 @@ ajar_status ajar_renderer_write_strategies(ajar_renderer *r, const char *path)
 	static const char rgb[] = "RGB";
 	for (int c = 0; c < 4; c++)
 		snprintf(names[c], sizeof names[c], "%c", "RGBA"[c]);
-	int len = 0;
-	while (bdpt_layer_count(len) < r->nlayers)
-		len++;
+	int len = r->strategy_len;
 	for (int n = 1; n <= len; n++)
 		for (int s = 0; s <= n; s++)
 			for (int c = 0; c < 3; c++)
 				snprintf(names[4 + 3 * bdpt_layer(n, s) + c], sizeof names[0], "len%d.s%dt%d.%c", n, s,
 					 n + 1 - s, rgb[c]);
+	if (r->nlayers > bdpt_layer_count(len)) /* the portal integrator's groups */
+		for (int n = 2; n <= len; n++)
+			for (int t = 1; t < n; t++)
+				for (int s = 0; s + t < n; s++)
+					for (int c = 0; c < 3; c++)
+						snprintf(names[4 + 3 * (bdpt_layer_count(len) + portal_layer(n, s, t)) + c],
+							 sizeof names[0], "len%d.portal.s%dt%d.%c", n, s, t, rgb[c]);
 	for (int c = 0; c < nch; c++)
 		np[c] = names[c];
 	double scale = r->spp_done ? 1.0 / ((double)FILM_SCALE * r->spp_done) : 0.0;

@@ -4,7 +4,7 @@
  * what the device compiles. */
 #ifndef AJAR_KERNEL_HOST_H
 #define AJAR_KERNEL_HOST_H
-#include "../kernels/bdpt.h"
+#include "../kernels/portal.h"
 #include "../kernels/pt.h"
 #include "prepare.h"
 

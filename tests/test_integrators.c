@@ -74,7 +74,7 @@ static void agree(const char *what, const Estimate *a, const Estimate *b)
 static void compare(const char *path, uint32_t w, uint32_t h, uint32_t spp_pt, uint32_t spp_bdpt)
 {
 	ajar_scene *s;
-	Estimate pt, bdpt;
+	Estimate pt, bdpt, portal;
 	char what[256];
 	const uint32_t depth = 12;
 	if (ajar_scene_load(path, &s) != AJAR_OK)
@@ -83,6 +83,11 @@ static void compare(const char *path, uint32_t w, uint32_t h, uint32_t spp_pt, u
 	estimate(s, AJAR_INTEGRATOR_BDPT, w, h, spp_bdpt, depth, &bdpt);
 	snprintf(what, sizeof what, "%s bdpt vs pt", path);
 	agree(what, &bdpt, &pt);
+	estimate(s, AJAR_INTEGRATOR_PORTAL, w, h, spp_bdpt, depth, &portal);
+	snprintf(what, sizeof what, "%s portal vs pt", path);
+	agree(what, &portal, &pt);
+	snprintf(what, sizeof what, "%s portal vs bdpt", path);
+	agree(what, &portal, &bdpt);
 	ajar_scene_destroy(&s);
 }
 

@@ -1,0 +1,65 @@
+/* densities.h — what light vertices emit, and the densities with which
+ * each way of sampling produces a vertex (design.md): a light subpath's
+ * origin (pf_0) and first vertex (pf_1), and BSDF sampling from a vertex,
+ * converted to area measure at the receiving vertex. Shared by the MIS
+ * bookkeeping of bdpt and of the portal integrator. */
+#ifndef AJAR_DENSITIES_H
+#define AJAR_DENSITIES_H
+#include "vertex.h"
+
+/* Emitted radiance and light-origin densities of a light vertex `l`
+ * (VERTEX_LIGHT on an emitter's front face, or VERTEX_ENV) toward w. */
+INLINE V3 bdpt_emitted(const SceneView *sc, const PathVertex *l, V3 w)
+{
+	if (l->type == VERTEX_ENV)
+		return env_radiance(sc, l->p);
+	return emitter_radiance(sc, l->tri, w);
+}
+
+/* Density of the light vertex as a light subpath's origin (pf_0). */
+INLINE float bdpt_origin_pdf(const SceneView *sc, const PathVertex *l)
+{
+	float ps = sc->params->env_pdf_select;
+	if (l->type == VERTEX_ENV)
+		return ps * env_pdf_w(sc, l->p);
+	return (1.0f - ps) * emitter_pdf_a(sc, l->tri);
+}
+
+/* Density with which the light vertex's emission sampling produces `to`
+ * (pf_1): cosine-weighted directions from emitters, a disk of radius R
+ * for the environment (parallel rays: per perpendicular area). */
+INLINE float bdpt_emission_pdf(const SceneView *sc, const PathVertex *l, const PathVertex *to)
+{
+	if (l->type == VERTEX_ENV) {
+		float r = sc->params->scene_radius;
+		return fabs(v3_dot(to->ng, l->p)) / (AJAR_PI * r * r);
+	}
+	V3 d = v3_sub(to->p, l->p);
+	float cos_l = v3_dot(l->ng, d) / v3_len(d);
+	if (!(cos_l > 0.0f))
+		return 0.0f;
+	return vertex_density_a(l, to, cos_l * AJAR_INV_PI);
+}
+
+/* Solid-angle density of `v`'s BSDF sampling `to`, given the vertex `from`
+ * on its other side (wo), for the mode of the subpath v belongs to. */
+INLINE float bdpt_bsdf_pdf_w(const SceneView *sc, const PathVertex *v, const PathVertex *from, const PathVertex *to,
+			     int mode)
+{
+	Bsdf bs;
+	V3 wo = from->type == VERTEX_ENV ? from->p : v3_norm(v3_sub(from->p, v->p));
+	V3 wi = to->type == VERTEX_ENV ? to->p : v3_norm(v3_sub(to->p, v->p));
+	vertex_bsdf(sc, v, &bs);
+	return bsdf_pdf_w(&bs, wo, wi); /* densities do not depend on the transport mode */
+}
+
+/* Densities of `to` sampled from `v` when the path's other neighbour of v
+ * is `from` (used on both sides of a connection). Camera and light origins
+ * are handled by the callers. */
+INLINE float bdpt_pdf_a(const SceneView *sc, const PathVertex *v, const PathVertex *from, const PathVertex *to,
+			int mode)
+{
+	return vertex_density_a(v, to, bdpt_bsdf_pdf_w(sc, v, from, to, mode));
+}
+
+#endif

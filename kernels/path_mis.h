@@ -1,0 +1,182 @@
+/* path_mis.h — the MIS weight of a whole path over the union of bdpt and
+ * portal strategies (mis_union_weight), for paths assembled from the
+ * subpaths that sampled them: l[0..s-1] (light), R[sp..1] (the <- half of
+ * an intermediate subpath), F[1..tp] (its -> half), e[t-1..0] (eye).
+ *
+ * The records come from the densities the walks stored; the ones that a
+ * walk could not know (next to each connection, next to the portal pair,
+ * and the light's own when an eye-side walk found it) are recomputed from
+ * the path, as are the portal crossings of the connection edges. */
+#ifndef AJAR_PATH_MIS_H
+#define AJAR_PATH_MIS_H
+#include "camera.h"
+#include "densities.h"
+#include "mis.h"
+#include "portal_geometry.h"
+
+/* A path assembled from up to four subpath segments, light first:
+ * l[0..s-1], R[sp..1], F[1..tp], e[t-1..0]; sp = tp = 0 for bdpt paths. */
+typedef struct {
+	const PathVertex *x[4 * SUBPATH_MAX];
+	int k, s, sp, tp, t;
+	int c1;   /* connection edge light side (x_{c1}, x_{c1+1}), or -1 */
+	int c2;   /* connection edge on the eye side, or -1 */
+	int pair; /* the portal pair's edge m, or -1 */
+} PathRef;
+
+INLINE void path_ref(PathRef *P, const PathVertex *l, int s, const PathVertex *R, int sp, const PathVertex *F, int tp,
+		     const PathVertex *e, int t)
+{
+	int k = 0;
+	for (int i = 0; i < s; i++)
+		P->x[k++] = &l[i];
+	for (int j = sp; j >= 1; j--)
+		P->x[k++] = &R[j];
+	for (int j = 1; j <= tp; j++)
+		P->x[k++] = &F[j];
+	for (int j = t - 1; j >= 0; j--)
+		P->x[k++] = &e[j];
+	P->k = k;
+	P->s = s;
+	P->sp = sp;
+	P->tp = tp;
+	P->t = t;
+	if (sp == 0) { /* bdpt: one connection, unless the eye found the light */
+		P->pair = -1;
+		P->c1 = s > 0 ? s - 1 : -1;
+		P->c2 = -1;
+	} else {
+		P->pair = s + sp - 1;
+		P->c1 = s > 0 ? s - 1 : -1;
+		P->c2 = P->pair + tp;
+	}
+}
+
+/* The standard densities of x_i from the path alone (design.md): pf from
+ * x_{i-1} given x_{i-2}, pr from x_{i+1} given x_{i+2}; 0 after a delta
+ * scattering (mis.h's convention). */
+INLINE float path_pf(const SceneView *sc, const PathRef *P, const MisVertex *mv, int i)
+{
+	const PathVertex *const *x = P->x;
+	if (i == 0)
+		return bdpt_origin_pdf(sc, x[0]);
+	if (i == 1)
+		return bdpt_emission_pdf(sc, x[0], x[1]);
+	if (i == P->k - 1 || mv[i - 1].delta)
+		return 0.0f;
+	return bdpt_pdf_a(sc, x[i - 1], x[i - 2], x[i], BSDF_IMPORTANCE);
+}
+
+INLINE float path_pr(const SceneView *sc, const PathRef *P, const MisVertex *mv, int i)
+{
+	const PathVertex *const *x = P->x;
+	int k = P->k;
+	if (i == k - 1)
+		return 1.0f;
+	if (i == k - 2) {
+		GLOBAL const Camera *cam = &sc->params->camera;
+		V3 d = x[i]->type == VERTEX_ENV ? v3_neg(x[i]->p) : v3_norm(v3_sub(x[i]->p, cam->pos));
+		return vertex_density_a(x[k - 1], x[i], camera_pdf_w(cam, v3_dot(d, cam->forward)));
+	}
+	if (mv[i + 1].delta)
+		return 0.0f;
+	return bdpt_pdf_a(sc, x[i + 1], x[i + 2], x[i], BSDF_RADIANCE);
+}
+
+/* Portal crossings of the edge (x_i, x_{i+1}) from the geometry. */
+INLINE int path_edge_crossings(const SceneView *sc, const PathRef *P, int i)
+{
+	const PathVertex *a = P->x[i], *b = P->x[i + 1];
+	if (a->type == VERTEX_ENV)
+		return portal_crossings(sc, b->p, a->p, 1);
+	return portal_crossings(sc, a->p, b->p, 0);
+}
+
+/* log p_pair(m) = log(p_A / (2 pi) G(x_m, x_{m+1})), geometric normals. */
+INLINE float path_log_pair(const SceneView *sc, const PathRef *P, int m)
+{
+	const PathVertex *a = P->x[m], *b = P->x[m + 1];
+	GLOBAL const PortalTri *pt = &sc->portals[0];
+	float pa = pt->pdf_select / pt->area; /* the same for every portal triangle */
+	float g;
+	if (a->type == VERTEX_ENV) {
+		g = fabs(v3_dot(b->ng, a->p));
+	} else {
+		V3 d = v3_sub(b->p, a->p);
+		float d2 = v3_len2(d);
+		g = fabs(v3_dot(a->ng, d)) * fabs(v3_dot(b->ng, d)) / (d2 * d2);
+	}
+	return log(fmax(pa * AJAR_INV_2PI * g, 1e-30f));
+}
+
+/* MIS records, crossings and pair densities of an assembled path. */
+INLINE void path_records(const SceneView *sc, const PathRef *P, MisVertex *mv, int *cross, float *lpair)
+{
+	const PathVertex *const *x = P->x;
+	int k = P->k;
+	for (int i = 0; i < k; i++) {
+		mv[i].pf = x[i]->pf;
+		mv[i].pr = x[i]->pr;
+		mv[i].delta = x[i]->delta;
+		mv[i].infinite = x[i]->type == VERTEX_ENV;
+	}
+	/* Connection ends, the light and the camera scatter through non-delta
+	 * lobes on this path whatever their subpaths did next. */
+	mv[0].delta = mv[k - 1].delta = 0;
+	if (P->c1 >= 0)
+		mv[P->c1].delta = mv[P->c1 + 1].delta = 0;
+	if (P->c2 >= 0)
+		mv[P->c2].delta = mv[P->c2 + 1].delta = 0;
+	/* Densities the subpaths could not know. */
+	if (P->s == 0) {
+		mv[0].pf = path_pf(sc, P, mv, 0);
+		if (k > 2)
+			mv[1].pf = path_pf(sc, P, mv, 1);
+	}
+	int conn[2] = {P->c1, P->c2};
+	for (int j = 0; j < 2; j++) {
+		int c = conn[j];
+		if (c < 0)
+			continue;
+		mv[c].pr = path_pr(sc, P, mv, c);
+		if (c >= 1)
+			mv[c - 1].pr = path_pr(sc, P, mv, c - 1);
+		if (c + 1 <= k - 2)
+			mv[c + 1].pf = path_pf(sc, P, mv, c + 1);
+		if (c + 2 <= k - 2)
+			mv[c + 2].pf = path_pf(sc, P, mv, c + 2);
+	}
+	if (P->pair >= 0) {
+		mv[P->pair + 1].pf = path_pf(sc, P, mv, P->pair + 1);
+		mv[P->pair].pr = path_pr(sc, P, mv, P->pair);
+	}
+	/* Crossings: each subpath's vertices cached their edge to the previous
+	 * vertex of their own walk; connection edges are new. */
+	int s = P->s, m = P->pair, tp = P->tp;
+	for (int i = 0; i + 1 < k; i++) {
+		int c;
+		if (i == P->c1 || i == P->c2)
+			c = path_edge_crossings(sc, P, i);
+		else if (i + 1 < s) /* light subpath: x_{i+1}'s predecessor is x_i */
+			c = x[i + 1]->cross;
+		else if (m >= 0 && i <= m) /* <- half (and the pair edge): x_i's predecessor is x_{i+1} */
+			c = x[i]->cross;
+		else if (m >= 0 && i < m + tp) /* -> half */
+			c = x[i + 1]->cross;
+		else /* eye subpath */
+			c = x[i]->cross;
+		cross[i] = c;
+		lpair[i] = c > 0 ? path_log_pair(sc, P, i) : 0.0f;
+	}
+}
+
+INLINE float path_union_weight(const SceneView *sc, const PathRef *P, MisStrategy cur)
+{
+	MisVertex mv[4 * SUBPATH_MAX];
+	int cross[4 * SUBPATH_MAX];
+	float lpair[4 * SUBPATH_MAX];
+	path_records(sc, P, mv, cross, lpair);
+	return mis_union_weight(mv, P->k, cross, lpair, cur, sc->params->mis);
+}
+
+#endif

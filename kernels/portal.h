@@ -1,0 +1,215 @@
+/* portal.h — portal-based bidirectional path tracing (the note in
+ * shared/seed, design.md "Path sampling and MIS"): every bdpt strategy plus
+ * the strategies of one intermediate subpath per pixel sample.
+ *
+ * An intermediate subpath starts at a point w_0 on a portal (by area,
+ * p_A = 1 / total portal area) with a direction w from the two-sided cosine
+ * distribution (1 / 2 pi per projected solid angle). The <- half traces -w
+ * toward the light, like an eye subpath, and its vertices connect to the
+ * light subpath (s >= 2), to a fresh light sample (s = 1), or are the light
+ * (s = 0). The -> half traces w, like a light subpath, and its vertices
+ * connect to the eye subpath (t >= 2) or to the camera (t = 1, splatted).
+ * The portal is invisible, so w_0 is no path vertex: the pair x_m, x_{m+1}
+ * (the first hits of the two halves) has density p_A / (2 pi) G(x_m, x_{m+1})
+ * and the contribution carries 2 pi / p_A.
+ *
+ * Every path, however it was sampled, is weighted over the union of both
+ * families (mis_union_weight): its MIS records come from the stored
+ * subpath densities, with the densities next to each connection and next to
+ * the portal pair recomputed from the path itself, and the portal
+ * crossings of every edge are counted.
+ *
+ * Arrays: l (light) and e (eye, e[0] the camera) as in bdpt.h; R holds the
+ * <- half with R[0] a copy of the -> half's first hit B (the vertex on the
+ * far side of the portal, as R's walk sees it) and R[1] = A its own first
+ * hit; F holds the -> half with F[0] a copy of A and F[1] = B. */
+#ifndef AJAR_PORTAL_H
+#define AJAR_PORTAL_H
+#include "bdpt.h"
+
+/* ---- The intermediate subpath -------------------------------------------- */
+
+/* Traces both halves; returns the vertex counts of R and F (each >= 2 when
+ * the half has a first vertex, counting the copy at index 0), or 0 when
+ * the sample is wasted. */
+INLINE void portal_intermediate(const SceneView *sc, PathVertex *R, int *nR, PathVertex *F, int *nF, Rng *rng)
+{
+	GLOBAL const Params *prm = sc->params;
+	int depth = prm->max_depth;
+	float u0 = rng_f(rng), u1 = rng_f(rng), u2 = rng_f(rng), u3 = rng_f(rng), u4 = rng_f(rng), u5 = rng_f(rng);
+	V3 w0, n;
+	float pdf_a;
+	*nR = *nF = 0;
+	if (portal_sample(sc, u0, u1, u2, &w0, &n, &pdf_a) < 0 || !(pdf_a > 0.0f))
+		return;
+	V3 t, b;
+	v3_basis(n, &t, &b);
+	V3 lc = sample_cosine_hemisphere(u3, u4);
+	if (u5 < 0.5f)
+		lc.z = -lc.z;
+	V3 w = v3_from_local(lc, t, b, n);
+	/* The two first hits. The walks' "previous vertex" of each first hit
+	 * is the other one: the portal passes rays straight through. */
+	PathVertex origin;
+	origin.type = VERTEX_SURFACE;
+	origin.p = w0;
+	origin.ng = origin.ns = n;
+	PathVertex tmp[2];
+	tmp[0] = origin;
+	if (!vertex_trace(sc, tmp, 1, w0, w, v3(1.0f, 1.0f, 1.0f), 0.0f, 0, 1, 0))
+		return; /* -> escaped: nothing in the scene to connect to the eye */
+	PathVertex B = tmp[1];
+	if (!vertex_trace(sc, tmp, 1, w0, v3_neg(w), v3(1.0f, 1.0f, 1.0f), 0.0f, 0, 0, 1))
+		return; /* <- escaped and there is no environment */
+	PathVertex A = tmp[1];
+	int cross_ab = A.type == VERTEX_ENV ? portal_crossings(sc, B.p, A.p, 1) : portal_crossings(sc, A.p, B.p, 0);
+	A.cross = B.cross = cross_ab > 0 ? cross_ab : 1; /* w_0 lies on the edge */
+	A.pf = A.pr = B.pf = B.pr = 0.0f; /* the pair's own densities are p_pair */
+	A.beta = v3(1.0f, 1.0f, 1.0f);
+	B.beta = v3(AJAR_PI * 2.0f / pdf_a, AJAR_PI * 2.0f / pdf_a, AJAR_PI * 2.0f / pdf_a);
+	R[0] = B;
+	R[1] = A;
+	F[0] = A;
+	F[1] = B;
+	*nR = A.type == VERTEX_ENV ? 2 : vertex_extend(sc, R, 2, depth + 1, 0, 1, 1.0f, rng);
+	*nF = vertex_extend(sc, F, 2, depth + 1, 1, 0, v3_maxc(B.beta), rng);
+	/* The walks wrote A's pr into F[0] and B's pf into R[0]; those are the
+	 * standard densities path_records recomputes anyway. */
+}
+
+/* Adds the contribution c (unweighted) of portal strategy (s, s', t', t)
+ * with weight w: eye pixel or splat, and the strategy layers grouped by
+ * (length, s, t) after the bdpt layers. */
+INLINE void portal_add(const SceneView *sc, BdptFilm *out, int s, int sp, int tp, int t, V3 c, float w, uint pixel,
+		       Rng *rng)
+{
+	GLOBAL const Params *prm = sc->params;
+	int n = s + sp + tp + t - 1;
+	if (n < prm->min_depth)
+		return;
+	V3 cw = v3_scale(c, w);
+	if (t == 1)
+		film_add(out->splat, pixel, cw, rng);
+	else
+		out->L = v3_add(out->L, cw);
+	if (n <= prm->strategy_len) {
+		uint npix = (uint)(prm->camera.width * prm->camera.height);
+		uint layer = (uint)(bdpt_layer_count(prm->strategy_len) + portal_layer(n, s, t));
+		film_add(out->layers + 3 * (ulong)npix * layer, pixel, prm->strategy_unweighted ? c : cw, rng);
+	}
+}
+
+/* The eye-side end of portal strategies: -> vertex F[b] to eye vertex
+ * e[t-1] (t >= 2) or to the camera (t = 1). Returns the contribution
+ * without F[b]'s beta... with it, and the pixel in *pixel. */
+INLINE V3 portal_right(const SceneView *sc, const PathVertex *F, int b, const PathVertex *e, int t, uint own_pixel,
+		       uint *pixel)
+{
+	const PathVertex *y = &F[b];
+	*pixel = own_pixel;
+	if (y->type != VERTEX_SURFACE)
+		return v3(0.0f, 0.0f, 0.0f);
+	if (t >= 2) {
+		if (e[t - 1].type != VERTEX_SURFACE)
+			return v3(0.0f, 0.0f, 0.0f);
+		V3 c = bdpt_connect(sc, y, &e[t - 1]);
+		return v3_mul(v3_mul(y->beta, c), e[t - 1].beta);
+	}
+	GLOBAL const Camera *cam = &sc->params->camera;
+	V3 d = v3_sub(cam->pos, y->p);
+	float d2 = v3_len2(d), px, py, cos_c;
+	if (!(d2 > 0.0f))
+		return v3(0.0f, 0.0f, 0.0f);
+	V3 wc = v3_scale(d, 1.0f / sqrt(d2));
+	if (!camera_raster(cam, v3_neg(wc), &px, &py, &cos_c))
+		return v3(0.0f, 0.0f, 0.0f);
+	V3 fy = bdpt_scatter(sc, y, wc, BSDF_IMPORTANCE);
+	if (v3_is_zero(fy) || !bdpt_visible(sc, y, &e[0]))
+		return v3(0.0f, 0.0f, 0.0f);
+	*pixel = (uint)py * (uint)cam->width + (uint)px;
+	return v3_scale(v3_mul(y->beta, fy), camera_pdf_w(cam, cos_c) / d2);
+}
+
+#define PORTAL_RIGHT_MAX 48
+
+/* One pixel sample of the portal integrator. */
+INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVertex *l, PathVertex *e, PathVertex *R,
+				PathVertex *F, BdptFilm *out, Rng *rng)
+{
+	int depth = sc->params->max_depth;
+	int nl = bdpt_light_subpath(sc, l, depth, rng);
+	int ne = bdpt_eye_subpath(sc, px, py, e, depth + 1, rng);
+	int nR, nF;
+	portal_intermediate(sc, R, &nR, F, &nF, rng);
+	bdpt_strategies(sc, l, nl, e, ne, out, rng);
+
+	/* Eye-side ends, in chunks so any number of them is handled. */
+	V3 rc[PORTAL_RIGHT_MAX];
+	int rb[PORTAL_RIGHT_MAX], rt[PORTAL_RIGHT_MAX];
+	uint rpix[PORTAL_RIGHT_MAX];
+	int b0 = 1, t0 = 1;
+	while (nR >= 2 && nF >= 2 && b0 < nF) {
+		int nr = 0;
+		for (; b0 < nF && nr < PORTAL_RIGHT_MAX; b0++, t0 = 1) {
+			for (; t0 <= ne && nr < PORTAL_RIGHT_MAX; t0++) {
+				if (b0 + t0 > depth) /* s = 0, s' = 1 is the shortest left end */
+					continue;
+				uint pix;
+				V3 c = portal_right(sc, F, b0, e, t0, out->pixel, &pix);
+				if (v3_is_zero(c))
+					continue;
+				rc[nr] = c;
+				rb[nr] = b0;
+				rt[nr] = t0;
+				rpix[nr] = pix;
+				nr++;
+			}
+			if (t0 <= ne)
+				break; /* the chunk is full in the middle of b0 */
+		}
+		if (nr == 0)
+			continue;
+		/* Light-side ends: <- vertex R[a] is the light (s = 0), gets a
+		 * light sample (s = 1), or meets light vertex l[s-1]. */
+		for (int a = 1; a < nR; a++) {
+			const PathVertex *z = &R[a];
+			for (int s = 0; s <= nl; s++) {
+				V3 lcon = v3(0.0f, 0.0f, 0.0f);
+				PathVertex y; /* the light sample for s = 1 */
+				const PathVertex *lp = l;
+				if (s == 0) {
+					if (z->type == VERTEX_ENV || sc->tris[z->tri].emitter >= 0)
+						lcon = v3_mul(z->beta, bdpt_emitted(sc, z, z->wo));
+				} else if (z->type != VERTEX_SURFACE) {
+					break;
+				} else if (s == 1) {
+					LightSample ls;
+					float v0 = rng_f(rng), v1 = rng_f(rng), v2 = rng_f(rng);
+					if (light_sample(sc, z->p, v0, v1, v2, &ls) && !v3_is_zero(ls.Le)) {
+						bdpt_light_vertex(&y, &ls);
+						V3 f = bdpt_scatter(sc, z, ls.wi, BSDF_RADIANCE);
+						if (!v3_is_zero(f) && bdpt_nee_visible(sc, z, &ls))
+							lcon = v3_scale(v3_mul(v3_mul(z->beta, f), ls.Le), 1.0f / ls.pdf_w);
+					}
+					lp = &y;
+				} else {
+					V3 c = bdpt_connect(sc, &l[s - 1], z);
+					lcon = v3_mul(v3_mul(l[s - 1].beta, c), z->beta);
+				}
+				if (v3_is_zero(lcon))
+					continue;
+				for (int j = 0; j < nr; j++) {
+					int b = rb[j], t = rt[j];
+					if (s + a + b + t - 1 > depth)
+						continue;
+					PathRef P;
+					MisStrategy cur = {2, s, s + a - 1, b};
+					path_ref(&P, lp, s, R, a, F, b, e, t);
+					float w = path_union_weight(sc, &P, cur);
+					portal_add(sc, out, s, a, b, t, v3_mul(lcon, rc[j]), w, rpix[j], rng);
+				}
+			}
+		}
+	}
+}
+#endif
