@@ -8,7 +8,25 @@
  * path segments, camera segment included (Mitsuba's max_depth); paths of
  * fewer than min_depth segments are left out, so max_depth = min_depth = k
  * gives the image of paths of exactly k segments, which each bidirectional
- * strategy must reproduce. */
+ * strategy must reproduce. With Params.cross_filter (a test mode) each
+ * path counts as many times as it crosses portals on the edges that one
+ * group of intermediate-subpath strategies can sample (pt_cross_weight):
+ * the image those strategies must reproduce. */
+
+#define PT_CROSS_EDGES 33
+
+/* The test mode's weight of a path of n segments whose eye-side edges
+ * (edge 0 leaves the camera) cross portals cnt[j] times; `last` replaces
+ * cnt[n - 1] (a next-event edge). 1 when the mode is off. */
+INLINE float pt_cross_weight(GLOBAL const Params *prm, const int *cnt, int n, int last)
+{
+	if (!prm->cross_filter)
+		return 1.0f;
+	int w = 0;
+	for (int j = prm->cross_lo; j <= n - 1 - prm->cross_hi; j++)
+		w += j == n - 1 ? last : (j < PT_CROSS_EDGES ? cnt[j] : 0);
+	return (float)w;
+}
 #ifndef AJAR_PT_H
 #define AJAR_PT_H
 #include "bsdf.h"
@@ -16,6 +34,7 @@
 #include "camera.h"
 #include "lights.h"
 #include "mis.h"
+#include "portal_geometry.h"
 #include "rng.h"
 #include "surface.h"
 
@@ -26,13 +45,21 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 	float prev_pdf_w = 0.0f;
 	int prev_delta = 1; /* the camera ray counts emission in full */
 	V3 prev_p = o;
+	int cnt[PT_CROSS_EDGES];
 	for (int depth = 0;; depth++) {
 		Hit h;
-		if (!bvh_intersect(sc, o, d, AJAR_INF, &h)) {
+		int hit = bvh_intersect(sc, o, d, AJAR_INF, &h);
+		int c_edge = 0;
+		if (prm->cross_filter)
+			c_edge = hit ? portal_crossings(sc, o, v3_add(o, v3_scale(d, h.t)), 0) : portal_crossings(sc, o, d, 1);
+		if (depth < PT_CROSS_EDGES)
+			cnt[depth] = c_edge;
+		if (!hit) {
 			V3 Le = env_radiance(sc, d);
 			if (!v3_is_zero(Le)) {
 				float w = prev_delta ? 1.0f
 						     : mis_power(prev_pdf_w, light_pdf_w(sc, prev_p, d, -1, AJAR_INF, 1.0f));
+				w *= pt_cross_weight(prm, cnt, depth + 1, c_edge);
 				if (depth + 1 >= prm->min_depth)
 					L = v3_add(L, v3_scale(v3_mul(beta, Le), w));
 			}
@@ -49,6 +76,7 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 					float cos_l = fabs(v3_dot(s.ng, wo));
 					w = mis_power(prev_pdf_w, light_pdf_w(sc, prev_p, d, s.tri, h.t, cos_l));
 				}
+				w *= pt_cross_weight(prm, cnt, depth + 1, c_edge);
 				L = v3_add(L, v3_scale(v3_mul(beta, Le), w));
 			}
 		}
@@ -67,7 +95,10 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 					int clear = ls.is_env ? !bvh_occluded(sc, ray_offset(s.p, s.ng, ls.wi), ls.wi, AJAR_INF)
 							      : segment_clear(sc, s.p, s.ng, ls.p, ls.n);
 					if (clear) {
-						float w = mis_power(ls.pdf_w, pdf_bsdf_w);
+						int c_nee = !prm->cross_filter ? 0
+								: ls.is_env ? portal_crossings(sc, s.p, ls.wi, 1)
+									    : portal_crossings(sc, s.p, ls.p, 0);
+						float w = mis_power(ls.pdf_w, pdf_bsdf_w) * pt_cross_weight(prm, cnt, depth + 2, c_nee);
 						float k = fabs(v3_dot(s.ns, ls.wi)) * w / ls.pdf_w;
 						L = v3_add(L, v3_scale(v3_mul(v3_mul(beta, f), ls.Le), k));
 					}

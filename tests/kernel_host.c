@@ -35,10 +35,12 @@ void host_render(HostScene *h, uint32_t spp, uint32_t seed, double *rgb, double 
 	Params *prm = h->data.params;
 	GLOBAL const Camera *cam = &prm->camera;
 	uint32_t npix = (uint32_t)(cam->width * cam->height);
-	int nlayers = bdpt_layer_count(prm->strategy_len);
+	int nlayers = bdpt_layer_count(prm->strategy_len) +
+		      (prm->integrator == INTEGRATOR_PORTAL ? portal_layer_count(prm->strategy_len) : 0);
 	long *film = calloc((size_t)3 * npix * (1 + (size_t)nlayers), sizeof *film);
 	double *eye = calloc((size_t)3 * npix, sizeof *eye);
 	PathVertex *lv = malloc(sizeof *lv * SUBPATH_MAX), *ev = malloc(sizeof *ev * SUBPATH_MAX);
+	PathVertex *rv = malloc(sizeof *rv * SUBPATH_MAX), *fv = malloc(sizeof *fv * SUBPATH_MAX);
 	prm->seed = seed;
 	for (uint32_t px = 0; px < npix; px++) {
 		for (uint32_t i = 0; i < spp; i++) {
@@ -46,9 +48,12 @@ void host_render(HostScene *h, uint32_t spp, uint32_t seed, double *rgb, double 
 			float x = (float)(px % (uint32_t)cam->width) + rng_f(&rng);
 			float y = (float)(px / (uint32_t)cam->width) + rng_f(&rng);
 			V3 L;
-			if (prm->integrator == INTEGRATOR_BDPT) {
+			if (prm->integrator != INTEGRATOR_PT) {
 				BdptFilm out = {film, film + 3 * (size_t)npix, px, v3(0, 0, 0)};
-				bdpt_sample(&h->view, x, y, lv, ev, &out, &rng);
+				if (prm->integrator == INTEGRATOR_PORTAL)
+					portal_sample_pixel(&h->view, x, y, lv, ev, rv, fv, &out, &rng);
+				else
+					bdpt_sample(&h->view, x, y, lv, ev, &out, &rng);
 				L = out.L;
 			} else {
 				L = pt_radiance(&h->view, cam->pos, camera_ray_dir(cam, x, y), &rng);
@@ -67,4 +72,6 @@ void host_render(HostScene *h, uint32_t spp, uint32_t seed, double *rgb, double 
 	free(eye);
 	free(lv);
 	free(ev);
+	free(rv);
+	free(fv);
 }

@@ -222,6 +222,29 @@ static void test_same_seed_same_bits(void **state)
 	ajar_scene_destroy(&s);
 }
 
+/* Without portals the portal integrator is bdpt, sample for sample. */
+static void test_portal_without_portals_is_bdpt(void **state)
+{
+	ajar_scene *s;
+	ajar_renderer *r;
+	ajar_options o;
+	float a[24 * 24 * 4], b[24 * 24 * 4];
+	assert_int_equal(ajar_scene_load(SCENE("cornell/cornell.gltf"), &s), AJAR_OK);
+	ajar_options_default(&o);
+	o.width = o.height = 24;
+	o.spp = 4;
+	o.seed = 9;
+	for (int k = 0; k < 2; k++) {
+		o.integrator = k ? AJAR_INTEGRATOR_PORTAL : AJAR_INTEGRATOR_BDPT;
+		assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_OK);
+		assert_int_equal(ajar_renderer_render(r, NULL, NULL), AJAR_OK);
+		assert_int_equal(ajar_renderer_image(r, k ? b : a, NULL, NULL), AJAR_OK);
+		ajar_renderer_destroy(&r);
+	}
+	assert_memory_equal(a, b, sizeof a);
+	ajar_scene_destroy(&s);
+}
+
 static int stop_after_first(const ajar_progress *p, void *user)
 {
 	int *calls = user;
@@ -284,6 +307,7 @@ int main(void)
 		cmocka_unit_test(test_furnace_closed),
 		cmocka_unit_test(test_cornell_reference),
 		cmocka_unit_test(test_same_seed_same_bits),
+		cmocka_unit_test(test_portal_without_portals_is_bdpt),
 		cmocka_unit_test(test_cancel_keeps_image),
 		cmocka_unit_test(test_bad_options),
 	};

@@ -1,0 +1,159 @@
+/* mis_oracle.c — see mis_oracle.h. Written from design.md's definitions,
+ * independently of the kernels' bookkeeping (it uses only their BSDF,
+ * light and camera densities, which have chi-square tests of their own). */
+#include "mis_oracle.h"
+
+#include <math.h>
+
+
+float oracle_convert(const PathVertex *from, const PathVertex *to, float pdf_w)
+{
+	if (to->type == VERTEX_ENV)
+		return pdf_w;
+	double dx = to->p.x - from->p.x, dy = to->p.y - from->p.y, dz = to->p.z - from->p.z;
+	double d2 = dx * dx + dy * dy + dz * dz, d = sqrt(d2);
+	double c = fabs(to->ng.x * dx + to->ng.y * dy + to->ng.z * dz) / d;
+	return (float)(pdf_w * c / d2);
+}
+
+V3 oracle_dir(const PathVertex *from, const PathVertex *to)
+{
+	return to->type == VERTEX_ENV ? to->p : v3_norm(v3_sub(to->p, from->p));
+}
+
+/* Solid-angle density that v's BSDF samples toward `to` given `from`. */
+float oracle_bsdf(const SceneView *sc, const PathVertex *v, const PathVertex *from, const PathVertex *to)
+{
+	Bsdf bs;
+	float pdf, rev;
+	bsdf_setup(&bs, &sc->materials[v->material], v->base, v->ns, v->ng);
+	bsdf_eval(&bs, oracle_dir(v, from), oracle_dir(v, to), BSDF_RADIANCE, &pdf, &rev);
+	return pdf;
+}
+
+/* x[0] light (emitter point or environment), x[k-1] camera; delta[i] says
+ * x[i] scattered through a delta lobe on this path. */
+void oracle(const SceneView *sc, const PathVertex *x, const int *delta, int k, MisVertex *mv)
+{
+	GLOBAL const Params *prm = sc->params;
+	float ps = prm->env_pdf_select;
+	for (int i = 0; i < k; i++) {
+		mv[i].delta = delta[i];
+		mv[i].infinite = x[i].type == VERTEX_ENV;
+		/* pf */
+		if (i == k - 1)
+			mv[i].pf = 0;
+		else if (i == 0)
+			mv[i].pf = x[0].type == VERTEX_ENV ? ps * env_pdf_w(sc, x[0].p)
+							   : (1 - ps) * emitter_pdf_a(sc, x[0].tri);
+		else if (i == 1 && x[0].type == VERTEX_ENV)
+			mv[i].pf = fabs(v3_dot(x[1].ng, x[0].p)) /
+				   (AJAR_PI * prm->scene_radius * prm->scene_radius);
+		else if (i == 1) {
+			V3 d = v3_norm(v3_sub(x[1].p, x[0].p));
+			float c = v3_dot(v3_norm(tri_normal(&sc->tris[x[0].tri])), d);
+			mv[i].pf = c > 0 ? oracle_convert(&x[0], &x[1], c / AJAR_PI) : 0;
+		} else
+			mv[i].pf = delta[i - 1] ? 0 : oracle_convert(&x[i - 1], &x[i], oracle_bsdf(sc, &x[i - 1], &x[i - 2], &x[i]));
+		/* pr */
+		if (i == k - 1)
+			mv[i].pr = 1;
+		else if (i == k - 2) {
+			GLOBAL const Camera *cam = &prm->camera;
+			V3 d = oracle_dir(&x[k - 1], &x[i]);
+			mv[i].pr = oracle_convert(&x[k - 1], &x[i], camera_pdf_w(cam, v3_dot(d, cam->forward)));
+		} else
+			mv[i].pr = delta[i + 1] ? 0 : oracle_convert(&x[i + 1], &x[i], oracle_bsdf(sc, &x[i + 1], &x[i + 2], &x[i]));
+	}
+}
+
+/* Whether an edge that the densities of vertex i depend on is shorter
+ * than 1% of the scene radius: there the ray offset (a few hundred ulps),
+ * seen at a grazing angle, is a sizeable fraction of the edge. */
+int near_contact(const PathVertex *x, int k, int i, float radius)
+{
+	for (int j = i - 2; j < i + 2; j++) {
+		if (j < 0 || j + 1 >= k || x[j].type == VERTEX_ENV || x[j + 1].type == VERTEX_ENV)
+			continue;
+		if (v3_len(v3_sub(x[j + 1].p, x[j].p)) < 1e-2f * radius)
+			return 1;
+	}
+	return 0;
+}
+
+int strategy_valid(const MisVertex *v, int k, int s)
+{
+	if (s == 0)
+		return 1;
+	if (v[s - 1].delta || v[s].delta)
+		return 0;
+	return !(v[s - 1].infinite && s == k - 1);
+}
+
+/* Relative difference of two densities. The walk converts the density of
+ * the direction it sampled; the oracle that of the direction between the
+ * vertices, which differs by the ray origin's offset: at grazing angles or
+ * for vertices a few ulps-offsets apart (corners) that reaches percents.
+ * A wrong conversion, vertex or BSDF mode is off on most paths, so the
+ * test allows 1% of records beyond 1% and none beyond 10%. */
+double rel_diff(float a, float b)
+{
+	if (a == b)
+		return 0;
+	return fabs(a - b) / fmax(fabs(a), fabs(b));
+}
+
+
+/* Moeller-Trumbore in double precision, written again on purpose. */
+static int crosses(const double *o, const double *d, double tmax, V3 a, V3 b, V3 c)
+{
+	double e1[3] = {b.x - a.x, b.y - a.y, b.z - a.z}, e2[3] = {c.x - a.x, c.y - a.y, c.z - a.z};
+	double pv[3] = {d[1] * e2[2] - d[2] * e2[1], d[2] * e2[0] - d[0] * e2[2], d[0] * e2[1] - d[1] * e2[0]};
+	double det = e1[0] * pv[0] + e1[1] * pv[1] + e1[2] * pv[2];
+	if (det == 0)
+		return 0;
+	double tv[3] = {o[0] - a.x, o[1] - a.y, o[2] - a.z};
+	double u = (tv[0] * pv[0] + tv[1] * pv[1] + tv[2] * pv[2]) / det;
+	if (u < 0 || u > 1)
+		return 0;
+	double qv[3] = {tv[1] * e1[2] - tv[2] * e1[1], tv[2] * e1[0] - tv[0] * e1[2], tv[0] * e1[1] - tv[1] * e1[0]};
+	double v = (d[0] * qv[0] + d[1] * qv[1] + d[2] * qv[2]) / det;
+	if (v < 0 || u + v > 1)
+		return 0;
+	double t = (e2[0] * qv[0] + e2[1] * qv[1] + e2[2] * qv[2]) / det;
+	return t > 0 && t < tmax;
+}
+
+int oracle_crossings(const SceneView *sc, const PathVertex *a, const PathVertex *b)
+{
+	double o[3], d[3], tmax = 1;
+	if (a->type == VERTEX_ENV || b->type == VERTEX_ENV) {
+		const PathVertex *p = a->type == VERTEX_ENV ? b : a, *env = a->type == VERTEX_ENV ? a : b;
+		o[0] = p->p.x, o[1] = p->p.y, o[2] = p->p.z;
+		d[0] = env->p.x, d[1] = env->p.y, d[2] = env->p.z;
+		tmax = 1e30;
+	} else {
+		o[0] = a->p.x, o[1] = a->p.y, o[2] = a->p.z;
+		d[0] = b->p.x - a->p.x, d[1] = b->p.y - a->p.y, d[2] = b->p.z - a->p.z;
+	}
+	int n = 0;
+	for (int i = 0; i < sc->params->num_portals; i++)
+		n += crosses(o, d, tmax, sc->portals[i].p0, sc->portals[i].p1, sc->portals[i].p2);
+	return n;
+}
+
+double oracle_log_pair(const SceneView *sc, const PathVertex *a, const PathVertex *b)
+{
+	double area = 0;
+	for (int i = 0; i < sc->params->num_portals; i++)
+		area += sc->portals[i].area;
+	double g;
+	if (a->type == VERTEX_ENV) {
+		g = fabs(v3_dot(b->ng, a->p));
+	} else {
+		double dx = b->p.x - a->p.x, dy = b->p.y - a->p.y, dz = b->p.z - a->p.z, d2 = dx * dx + dy * dy + dz * dz;
+		g = fabs(a->ng.x * dx + a->ng.y * dy + a->ng.z * dz) * fabs(b->ng.x * dx + b->ng.y * dy + b->ng.z * dz) /
+		    (d2 * d2);
+	}
+	return log(g / (2 * M_PI * area));
+}
