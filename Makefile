@@ -134,7 +134,7 @@ test:
 	$(Q)sh tests/run.sh $(BUILD) $(TESTS)
 
 # Host tests that need no OpenCL device, under ASan + UBSan.
-ASAN_TESTS := test_bsdf test_sampling test_bvh test_lights test_scene test_exr
+ASAN_TESTS := test_bsdf test_sampling test_bvh test_lights test_scene test_exr test_bdpt test_portal
 asan:
 	$(Q)$(MAKE) --no-print-directory deps
 	$(Q)$(MAKE) --no-print-directory MODE=asan $(ASAN_TESTS:%=build/asan/tests/%)

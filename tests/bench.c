@@ -195,6 +195,92 @@ static double startup(const char *cache, int cold)
 	return now() - t0;
 }
 
+/* ---- Efficiency at equal time ------------------------------------------- */
+
+/* Renders for `seconds` (or spp samples if seconds is 0); returns the
+ * image (malloc'ed) and the samples per pixel done. */
+static float *render_for(ajar_scene *s, ajar_integrator integ, uint32_t size, double seconds, uint32_t seed,
+			 uint32_t *spp)
+{
+	ajar_options o;
+	ajar_renderer *r;
+	ajar_options_default(&o);
+	o.width = o.height = size;
+	o.integrator = integ;
+	o.max_depth = 32;
+	o.seed = seed;
+	o.spp = 0;
+	o.time_limit = seconds;
+	check(ajar_renderer_create(s, &o, &r));
+	check(ajar_renderer_render(r, NULL, NULL));
+	float *img = malloc(sizeof(float) * 4 * size * size);
+	check(ajar_renderer_image(r, img, NULL, NULL));
+	*spp = ajar_renderer_spp(r);
+	ajar_renderer_destroy(&r);
+	return img;
+}
+
+/* Relative MSE of a against b: mean over pixels and channels of
+ * (a - b)^2 / (b^2 + eps), eps = (0.1 mean(b))^2 so dark scenes are not
+ * judged by absolute error. */
+static double rel_mse(const float *a, const float *b, size_t npix, double mean_b)
+{
+	double sum = 0, eps = 0.01 * mean_b * mean_b;
+	for (size_t i = 0; i < npix; i++)
+		for (int c = 0; c < 3; c++) {
+			double d = a[4 * i + c] - b[4 * i + c];
+			sum += d * d / ((double)b[4 * i + c] * b[4 * i + c] + eps);
+		}
+	return sum / (3.0 * npix);
+}
+
+/* pt, bdpt and portal for `seconds` each against a reference of two
+ * independent portal renders of ref_seconds; the reference's own noise,
+ * estimated from its two halves, is subtracted. */
+static void bench_equal_time(const char *path, uint32_t size, double seconds, double ref_seconds)
+{
+	ajar_scene *s;
+	uint32_t spp1, spp2, spp;
+	size_t npix = (size_t)size * size;
+	check(ajar_scene_load(path, &s));
+	float *r1 = render_for(s, AJAR_INTEGRATOR_PORTAL, size, ref_seconds, 1001, &spp1);
+	float *r2 = render_for(s, AJAR_INTEGRATOR_PORTAL, size, ref_seconds, 1002, &spp2);
+	double mean = 0;
+	for (size_t i = 0; i < 4 * npix; i++) {
+		r1[i] = 0.5f * (r1[i] + r2[i]);
+		if (i % 4 != 3)
+			mean += r1[i] / (3.0 * npix);
+	}
+	/* For R = (R1 + R2) / 2, E|R1 - R2|^2 / 4 is the variance of R. */
+	double ref_noise = 0;
+	for (size_t i = 0; i < npix; i++)
+		for (int c = 0; c < 3; c++) {
+			double d = 2.0 * (r2[4 * i + c] - r1[4 * i + c]); /* = R2 - R1 */
+			ref_noise += d * d / 4 / ((double)r1[4 * i + c] * r1[4 * i + c] + 0.01 * mean * mean);
+		}
+	ref_noise /= 3.0 * npix;
+	printf("%s, %ux%u, %.0f s each; reference: portal %u + %u spp, mean %.5f, its relMSE %.2e\n", path, size, size,
+	       seconds, spp1, spp2, mean, ref_noise);
+	static const ajar_integrator integ[] = {AJAR_INTEGRATOR_PT, AJAR_INTEGRATOR_BDPT, AJAR_INTEGRATOR_PORTAL};
+	static const char *const names[] = {"pt", "bdpt", "portal"};
+	double e[3];
+	for (int k = 0; k < 3; k++) {
+		float *img = render_for(s, integ[k], size, seconds, 7, &spp);
+		e[k] = rel_mse(img, r1, npix, mean) - ref_noise;
+		double m = 0;
+		for (size_t i = 0; i < npix; i++)
+			m += (img[4 * i] + img[4 * i + 1] + img[4 * i + 2]) / (3.0 * npix);
+		printf("  %-7s %6u spp  relMSE %.3e  mean %.5f  (%+.2f%% vs reference)\n", names[k], spp, e[k], m,
+		       100 * (m / mean - 1));
+		free(img);
+	}
+	printf("  relMSE ratios at equal time: bdpt/portal %.2f, pt/portal %.2f, pt/bdpt %.2f\n", e[1] / e[2],
+	       e[0] / e[2], e[0] / e[1]);
+	free(r1);
+	free(r2);
+	ajar_scene_destroy(&s);
+}
+
 int main(int argc, char **argv)
 {
 	char dir[] = "/tmp/ajar-bench-XXXXXX";
@@ -209,6 +295,14 @@ int main(int argc, char **argv)
 	       cold / warm);
 	bench_scene("scenes/cornell/cornell.gltf", 16);
 	bench_scene("scenes/bathroom/bathroom.gltf", 4);
+	/* Equal time: AJAR_BENCH_SECONDS per integrator (default 10), the
+	 * reference 2 x 4 times as long. */
+	double secs = getenv("AJAR_BENCH_SECONDS") ? atof(getenv("AJAR_BENCH_SECONDS")) : 10.0;
+	static const char *const scenes[] = {"scenes/window-room/window-room.gltf", "scenes/door-ajar/door-ajar.gltf",
+					     "scenes/living-room/living-room.gltf", "scenes/bathroom/bathroom.gltf",
+					     "scenes/cornell/cornell.gltf"};
+	for (size_t i = 0; i < sizeof scenes / sizeof scenes[0]; i++)
+		bench_equal_time(scenes[i], 128, secs, 4 * secs);
 	char rm[128];
 	snprintf(rm, sizeof rm, "rm -rf %s", dir);
 	return system(rm) != 0;
