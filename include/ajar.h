@@ -136,7 +136,7 @@ typedef struct {
 	uint32_t min_depth;      /* paths of fewer segments are left out (0: none) */
 	uint32_t seed;
 	ajar_mis mis;            /* bidirectional integrators' MIS heuristic */
-	uint32_t strategy_len;   /* bdpt: keep one image per strategy (s, t) for paths
+	uint32_t strategy_len;   /* bdpt, portal: keep one image per strategy for paths
 				  * of up to this many segments (1..8), 0 = none */
 	int strategy_unweighted; /* those images without MIS weights */
 	const char *device;      /* selector ("0:0", "cpu", "gpu", name substring), a comma-
@@ -180,8 +180,10 @@ uint32_t ajar_renderer_spp(const ajar_renderer *r);
 ajar_status ajar_renderer_image(ajar_renderer *r, float *rgba, uint32_t *width, uint32_t *height);
 ajar_status ajar_renderer_write_exr(ajar_renderer *r, const char *path);
 ajar_status ajar_renderer_write_png(ajar_renderer *r, const char *path);
-/* The image plus one RGB layer per bdpt strategy (channels
- * "len<n>.s<s>t<t>.R" etc.), when options.strategy_len > 0. */
+/* The image plus one RGB layer per strategy of paths up to
+ * options.strategy_len segments (bdpt, portal): "len<n>.s<s>t<t>.R" etc. for
+ * bdpt's (s, t), "len<n>.portal.s<s>t<t>.R" for the portal integrator's
+ * intermediate strategies grouped by light and eye vertices. */
 ajar_status ajar_renderer_write_strategies(ajar_renderer *r, const char *path);
 /* The device(s) used, for reports. */
 const char *ajar_renderer_device_name(const ajar_renderer *r);

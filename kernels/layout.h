@@ -31,5 +31,6 @@
 	X(Params, integrator) X(Params, seed) X(Params, emitter_power)                 \
 	X(Params, env_power) X(Params, mis) X(Params, min_depth)                       \
 	X(Params, strategy_len) X(Params, strategy_unweighted) X(Params, cross_filter)  \
-	X(Params, cross_lo) X(Params, cross_hi)
+	X(Params, cross_lo) X(Params, cross_hi) X(Params, portal_s_max)                   \
+	X(Params, portal_sp_max) X(Params, portal_tp_max)
 #endif

@@ -90,6 +90,13 @@ typedef struct {
 	int tp;
 } MisStrategy;
 
+/* Which intermediate strategies are in use: at most s_max light vertices,
+ * sp_max <- vertices (s' = m - s + 1) and tp_max -> vertices. The weights
+ * sum over exactly these, so any choice is unbiased. */
+typedef struct {
+	int s_max, sp_max, tp_max;
+} MisPortalSet;
+
 INLINE int mis_bdpt_valid(const MisVertex *v, int k, int s)
 {
 	if (s == 0)
@@ -130,7 +137,7 @@ INLINE float mis_logadd(float a, float b)
  * portal strategies. cross[i] counts the portal crossings of edge
  * (x_i, x_{i+1}); lpair[i] is log p_pair(i) where cross[i] > 0. */
 INLINE float mis_union_weight(const MisVertex *v, int k, const int *cross, const float *lpair, MisStrategy cur,
-			      int heuristic)
+			      MisPortalSet set, int heuristic)
 {
 	float PF[2 * 33 + 1], PR[2 * 33 + 1];
 	float beta = heuristic == MIS_BALANCE ? 1.0f : 2.0f;
@@ -146,11 +153,11 @@ INLINE float mis_union_weight(const MisVertex *v, int k, const int *cross, const
 			continue;
 		/* Left factor: s in [0, m] with a valid light connection. */
 		float left = -AJAR_INF, right = -AJAR_INF;
-		for (int s = 0; s <= m; s++)
+		for (int s = max(0, m + 1 - set.sp_max); s <= m && s <= set.s_max; s++)
 			if (s == 0 || (!v[s - 1].delta && !v[s].delta))
 				left = mis_logadd(left, beta * (PF[s] + PR[m] - PR[s]));
 		/* Right factor: t' >= 1 with m + t' <= k - 2 and a valid eye connection. */
-		for (int tp = 1; m + tp <= k - 2; tp++)
+		for (int tp = 1; m + tp <= k - 2 && tp <= set.tp_max; tp++)
 			if (!v[m + tp].delta && !v[m + tp + 1].delta)
 				right = mis_logadd(right, beta * ((PF[m + tp + 1] - PF[m + 2]) + (PR[k] - PR[m + tp + 1])));
 		float term = left + right + beta * (lpair[m] - lcur) + log((float)cross[m]);

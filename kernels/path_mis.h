@@ -170,13 +170,19 @@ INLINE void path_records(const SceneView *sc, const PathRef *P, MisVertex *mv, i
 	}
 }
 
+INLINE MisPortalSet path_portal_set(GLOBAL const Params *prm)
+{
+	MisPortalSet set = {prm->portal_s_max, prm->portal_sp_max, prm->portal_tp_max};
+	return set;
+}
+
 INLINE float path_union_weight(const SceneView *sc, const PathRef *P, MisStrategy cur)
 {
 	MisVertex mv[4 * SUBPATH_MAX];
 	int cross[4 * SUBPATH_MAX];
 	float lpair[4 * SUBPATH_MAX];
 	path_records(sc, P, mv, cross, lpair);
-	return mis_union_weight(mv, P->k, cross, lpair, cur, sc->params->mis);
+	return mis_union_weight(mv, P->k, cross, lpair, cur, path_portal_set(sc->params), sc->params->mis);
 }
 
 #endif

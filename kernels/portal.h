@@ -71,8 +71,10 @@ INLINE void portal_intermediate(const SceneView *sc, PathVertex *R, int *nR, Pat
 	R[1] = A;
 	F[0] = A;
 	F[1] = B;
-	*nR = A.type == VERTEX_ENV ? 2 : vertex_extend(sc, R, 2, depth + 1, 0, 1, 1.0f, rng);
-	*nF = vertex_extend(sc, F, 2, depth + 1, 1, 0, v3_maxc(B.beta), rng);
+	/* Each half only as long as the strategies in use reach. */
+	int rmax = min(depth, prm->portal_sp_max) + 1, fmax_ = min(depth, prm->portal_tp_max) + 1;
+	*nR = A.type == VERTEX_ENV ? 2 : vertex_extend(sc, R, 2, rmax, 0, 1, 1.0f, rng);
+	*nF = vertex_extend(sc, F, 2, fmax_, 1, 0, v3_maxc(B.beta), rng);
 	/* The walks wrote A's pr into F[0] and B's pf into R[0]; those are the
 	 * standard densities path_records recomputes anyway. */
 }
@@ -173,7 +175,7 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 		 * light sample (s = 1), or meets light vertex l[s-1]. */
 		for (int a = 1; a < nR; a++) {
 			const PathVertex *z = &R[a];
-			for (int s = 0; s <= nl; s++) {
+			for (int s = 0; s <= nl && s <= sc->params->portal_s_max; s++) {
 				V3 lcon = v3(0.0f, 0.0f, 0.0f);
 				PathVertex y; /* the light sample for s = 1 */
 				const PathVertex *lp = l;

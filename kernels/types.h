@@ -123,7 +123,9 @@ typedef struct {
 	int cross_filter;       /* pt, for tests: weight each path by its portal crossings on */
 	int cross_lo;           /* eye-side edges cross_lo..(segments - 1 - cross_hi) (edge 0 */
 	int cross_hi;           /* 176: leaves the camera); 0 = no filter */
-	int pad0, pad1, pad2;
+	int portal_s_max;       /* intermediate strategies use at most this many light vertices, */
+	int portal_sp_max;      /* <- vertices and */
+	int portal_tp_max;      /* -> vertices (portal.h) */
 } Params; /* 192 */
 
 /* Layout of the float array `env`: for an ENV_IMAGE of W x H,

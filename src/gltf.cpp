@@ -571,8 +571,11 @@ ajar_status load_material(Loader &L, int mi, uint32_t *id)
 	m.specular = (float)specular;
 	m.flags = gm.doubleSided ? MATERIAL_DOUBLE_SIDED : 0;
 	m.alpha_cutoff = (float)gm.alphaCutoff;
-	if (gm.alphaMode == "MASK")
+	if (gm.alphaMode == "MASK") {
 		m.flags |= MATERIAL_ALPHA_MASK;
+		log_msg(AJAR_LOG_WARNING, "%s: materials[%d]: alphaMode MASK is not applied yet: the surface is opaque",
+			L.file, mi);
+	}
 
 	const tg::TextureInfo &bt = pbr.baseColorTexture;
 	if (bt.index >= 0) {

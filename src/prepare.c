@@ -5,6 +5,7 @@
 #include "prepare.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -123,6 +124,15 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	p->min_depth = (int)o->min_depth;
 	p->strategy_len = (int)o->strategy_len;
 	p->strategy_unweighted = o->strategy_unweighted;
+	/* The intermediate strategies in use (kernels/portal.h): chosen by
+	 * measurement (README, "Integrators"); AJAR_PORTAL_SET="s,s',t'"
+	 * overrides it for experiments, e.g. "32,32,32" for all of them. */
+	p->portal_s_max = 1;
+	p->portal_sp_max = 2;
+	p->portal_tp_max = 2;
+	const char *set = getenv("AJAR_PORTAL_SET");
+	if (set && sscanf(set, "%d,%d,%d", &p->portal_s_max, &p->portal_sp_max, &p->portal_tp_max) != 3)
+		log_msg(AJAR_LOG_WARNING, "AJAR_PORTAL_SET='%s' is not three numbers s,s',t'; ignored", set);
 	p->emitter_power = d->lights.emitter_power;
 	p->env_power = d->lights.env_power;
 	if (p->num_emitters == 0 && p->env_type == ENV_NONE)

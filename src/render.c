@@ -933,7 +933,8 @@ ajar_status ajar_renderer_write_strategies(ajar_renderer *r, const char *path)
 	}
 	uint32_t n = header_fill(r, &h);
 	h.kv[2 * n] = "ajar:strategies";
-	h.kv[2 * n + 1] = r->strategy_unweighted ? "unweighted" : "weighted (the layers sum to the image)";
+	h.kv[2 * n + 1] = r->strategy_unweighted ? "unweighted"
+						 : "weighted (they sum to the image of paths up to their length)";
 	st = exr_write_channels(path, px, nch, np, r->width, r->height, h.kv, n + 1);
 	free(px);
 	free(names);

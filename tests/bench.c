@@ -287,6 +287,8 @@ int main(int argc, char **argv)
 	if (!mkdtemp(dir))
 		return 1;
 	printf("Ajar %s bench (device: first CPU device; one run, compare figures within it)\n", ajar_version());
+	if (getenv("AJAR_BENCH_SCENES"))
+		goto equal_time;
 	bench_devices();
 	double cold = startup(dir, 1);
 	startup(dir, 0); /* fills PoCL's cache */
@@ -295,14 +297,22 @@ int main(int argc, char **argv)
 	       cold / warm);
 	bench_scene("scenes/cornell/cornell.gltf", 16);
 	bench_scene("scenes/bathroom/bathroom.gltf", 4);
+equal_time:;
 	/* Equal time: AJAR_BENCH_SECONDS per integrator (default 10), the
-	 * reference 2 x 4 times as long. */
+	 * reference 2 x 4 times as long; AJAR_BENCH_SCENES picks scenes and
+	 * skips the other figures. */
 	double secs = getenv("AJAR_BENCH_SECONDS") ? atof(getenv("AJAR_BENCH_SECONDS")) : 10.0;
 	static const char *const scenes[] = {"scenes/window-room/window-room.gltf", "scenes/door-ajar/door-ajar.gltf",
 					     "scenes/living-room/living-room.gltf", "scenes/bathroom/bathroom.gltf",
 					     "scenes/cornell/cornell.gltf"};
-	for (size_t i = 0; i < sizeof scenes / sizeof scenes[0]; i++)
-		bench_equal_time(scenes[i], 128, secs, 4 * secs);
+	const char *only = getenv("AJAR_BENCH_SCENES"); /* e.g. "door-ajar,window-room" */
+	for (size_t i = 0; i < sizeof scenes / sizeof scenes[0]; i++) {
+		const char *name = strrchr(scenes[i], '/') + 1;
+		char stem[64];
+		snprintf(stem, sizeof stem, "%.*s", (int)(strchr(name, '.') - name), name);
+		if (!only || strstr(only, stem))
+			bench_equal_time(scenes[i], 128, secs, 4 * secs);
+	}
 	char rm[128];
 	snprintf(rm, sizeof rm, "rm -rf %s", dir);
 	return system(rm) != 0;

@@ -13,7 +13,8 @@
  *     eye vertices t), unweighted, converges to the path tracer's image of
  *     paths of n segments counted once per portal crossing on the edges
  *     those strategies can cross (Params.cross_filter).
- *   - Without portals, the portal integrator is bdpt to the bit.
+ * (That the portal integrator without portals is bdpt to the bit is
+ * checked through the device in test_render.c.)
  * Statistics as in test_bdpt.c: batch means, 5 standard errors. */
 #include <math.h>
 #include <stdio.h>
@@ -77,22 +78,26 @@ static void check_path(const SceneView *sc, const PathRef *P, MisStats *st)
 		if (i > 0 && ocross[i] > 0 && ocross[i - 1] > 0)
 			st->consecutive++;
 	}
+	GLOBAL const Params *prm = sc->params;
+	MisPortalSet set = {prm->portal_s_max, prm->portal_sp_max, prm->portal_tp_max};
 	for (int heur = 0; heur < 2; heur++) {
 		double sum = 0;
 		for (int s = 0; s < k; s++)
 			if (strategy_valid(orc, k, s)) {
 				MisStrategy j = {1, s, 0, 0};
-				sum += mis_union_weight(orc, k, ocross, lpair, j, heur);
+				sum += mis_union_weight(orc, k, ocross, lpair, j, set, heur);
 			}
 		for (int m = 0; m + 2 < k; m++)
 			for (int s = 0; ocross[m] > 0 && s <= m; s++)
 				for (int tp = 1; m + tp <= k - 2; tp++) {
+					if (s > set.s_max || m - s + 1 > set.sp_max || tp > set.tp_max)
+						continue; /* not in use */
 					if (s > 0 && (orc[s - 1].delta || orc[s].delta))
 						continue;
 					if (orc[m + tp].delta || orc[m + tp + 1].delta)
 						continue;
 					MisStrategy j = {2, s, m, tp};
-					sum += ocross[m] * mis_union_weight(orc, k, ocross, lpair, j, heur);
+					sum += ocross[m] * mis_union_weight(orc, k, ocross, lpair, j, set, heur);
 				}
 		if (fabs(sum - 1) > 1e-3)
 			fail_msg("path (s=%d, s'=%d, t'=%d, t=%d): weights sum to %.6f (heuristic %d)", P->s, P->sp, P->tp,
@@ -137,7 +142,7 @@ static MisStats check_scene_mis(HostScene *h, int nsamples)
 		}
 		/* portal paths */
 		for (int a = 1; a < nR; a++)
-			for (int s = 0; s <= nl; s++) {
+			for (int s = 0; s <= nl && s <= prm->portal_s_max; s++) {
 				const PathVertex *z = &R[a];
 				if (s == 0 && !(z->type == VERTEX_ENV || (z->tri >= 0 && sc->tris[z->tri].emitter >= 0 &&
 									  !v3_is_zero(bdpt_emitted(sc, z, z->wo)))))
@@ -161,10 +166,18 @@ static MisStats check_scene_mis(HostScene *h, int nsamples)
 	return st;
 }
 
+/* Every intermediate strategy in use, not only the default set. */
+static void use_all_portal_strategies(HostScene *h)
+{
+	h->data.params->portal_s_max = h->data.params->portal_sp_max = h->data.params->portal_tp_max = SUBPATH_MAX;
+}
+
 static void test_mis_window_room(void **state)
 {
 	HostScene h;
 	host_scene_open(&h, SCENE("window-room/window-room.gltf"), NULL, 24, 24, INTEGRATOR_PORTAL, 8);
+	assert_true(check_scene_mis(&h, 200).portal_paths > 100); /* the default set */
+	use_all_portal_strategies(&h);
 	MisStats st = check_scene_mis(&h, 400);
 	assert_true(st.portal_paths > 200);
 	host_scene_close(&h);
@@ -174,6 +187,7 @@ static void test_mis_living_room(void **state)
 {
 	HostScene h;
 	host_scene_open(&h, SCENE("living-room/living-room.gltf"), NULL, 32, 18, INTEGRATOR_PORTAL, 8);
+	use_all_portal_strategies(&h);
 	MisStats st = check_scene_mis(&h, 300);
 	assert_true(st.portal_paths > 100);
 	host_scene_close(&h);
@@ -183,6 +197,8 @@ static void test_mis_bathroom(void **state)
 {
 	HostScene h;
 	host_scene_open(&h, SCENE("bathroom/bathroom.gltf"), NULL, 24, 24, INTEGRATOR_PORTAL, 8);
+	assert_true(check_scene_mis(&h, 150).portal_paths > 20);
+	use_all_portal_strategies(&h);
 	MisStats st = check_scene_mis(&h, 300);
 	assert_true(st.portal_paths > 50);
 	host_scene_close(&h);
@@ -246,6 +262,7 @@ static void test_mis_portal_surface_portal(void **state)
 {
 	HostScene h;
 	host_scene_open(&h, NULL, round_trip_scene(), 24, 24, INTEGRATOR_PORTAL, 8);
+	use_all_portal_strategies(&h);
 	MisStats st = check_scene_mis(&h, 400);
 	assert_true(st.consecutive > 20);
 	host_scene_close(&h);
@@ -309,6 +326,7 @@ static int check_groups(HostScene *hp, HostScene *ht, int len, uint32_t spp_port
 {
 	int lit = 0;
 	Params *pp = hp->data.params, *pt = ht->data.params;
+	pp->portal_s_max = pp->portal_sp_max = pp->portal_tp_max = SUBPATH_MAX; /* every group */
 	pp->strategy_len = len;
 	pp->strategy_unweighted = 1;
 	for (int n = 2; n <= len; n++)

@@ -42,11 +42,6 @@ LEAF_Z0 = Z_WALL0 + 0.5 * (WALL_T - LEAF_T)
 LEAF_Z1 = LEAF_Z0 + LEAF_T
 DEFAULT_ANGLE_DEG = 8.0
 
-# Inside the opening but on the camera side of the leaf at any opening angle
-# (the leaf never comes closer than z = LEAF_Z0 to the camera room), so the
-# portal does not slice through the leaf as the wall's middle plane would.
-PORTAL_Z = Z_WALL0 + 0.01
-
 LIGHT_SIZE = 0.5
 LIGHT_Y = ROOM_H - 0.01         # just below the ceiling, not coplanar with it
 LIGHT_CENTER = (3.0, 5.0)       # (x, z): beside the free edge of the door
@@ -79,7 +74,7 @@ def normalize(a):
 
 
 class Mesh:
-	"""Flat-shaded triangles built from quads; each quad gets its own vertices."""
+	"""Flat-shaded triangles built from quads and triangles, each with its own vertices."""
 
 	def __init__(self):
 		self.pos = []
@@ -93,6 +88,15 @@ class Mesh:
 		self.pos += [a, b, c, d]
 		self.nrm += [n] * 4
 		self.idx += [base, base + 1, base + 2, base, base + 2, base + 3]
+		return self
+
+	def tri(self, a, b, c):
+		"""Triangle a-b-c, counter-clockwise seen from the side its normal faces."""
+		n = normalize(cross(sub(b, a), sub(c, a)))
+		base = len(self.pos)
+		self.pos += [a, b, c]
+		self.nrm += [n] * 3
+		self.idx += [base, base + 1, base + 2]
 		return self
 
 	def box(self, x0, y0, z0, x1, y1, z1, bottom=True):
@@ -279,9 +283,24 @@ def scene_objects(angle_deg):
 	add("box_cam_room_crate", Mesh().box(-0.25, 0.0, -0.25, 0.25, 0.4, 0.25, bottom=False), "box_blue",
 		translation=[2.9, 0.0, 2.9], rotation=quat_y(-25.0))
 
-	# Portal: exactly the door opening, normal -z (into the camera room).
-	add("portal_door", rect_z(DOOR_X0, DOOR_X1, 0.0, DOOR_H, PORTAL_Z, False), None,
-		extras={"portal": True})
+	# Portal: the gap itself. Light reaches the camera room only through the
+	# wedge between the open leaf and the wall's light-room face, which is
+	# open to the light room on two sides: the slit from the free jamb's
+	# corner (DOOR_X1, Z_WALL1) to the leaf's free edge, full height, and a
+	# thin triangle over the leaf's top (the lintel only spans the wall's
+	# thickness). Both are portal triangles; nothing else lets light through.
+	if angle_deg > 0.0:
+		t = math.radians(angle_deg)
+		# The leaf's camera-side face: x(u), z(u) for u along the leaf.
+		fx0, fz0 = DOOR_X0 + LEAF_T * math.sin(t), LEAF_Z1 - LEAF_T * math.cos(t)
+		ex, ez = fx0 + DOOR_W * math.cos(t), fz0 + DOOR_W * math.sin(t)
+		assert ez > Z_WALL1, "the free edge must clear the wall for the gap portal"
+		u = (Z_WALL1 - fz0) / math.sin(t)  # where that face crosses the wall's light-room plane
+		cx = fx0 + u * math.cos(t)
+		gap = Mesh()
+		gap.quad((DOOR_X1, 0.0, Z_WALL1), (ex, 0.0, ez), (ex, DOOR_H, ez), (DOOR_X1, DOOR_H, Z_WALL1))
+		gap.tri((cx, DOOR_H, Z_WALL1), (ex, DOOR_H, ez), (DOOR_X1, DOOR_H, Z_WALL1))
+		add("portal_door_gap", gap, None, extras={"portal": True})
 	return objs
 
 

@@ -64,10 +64,12 @@ static const char usage_render[] =
 	"                         (default 64 for pt, 32 for bdpt and portal, their limit)\n"
 	"  --min-depth N          leave out paths of fewer segments\n"
 	"  --mis NAME             power (default) or balance heuristic (bdpt, portal)\n"
-	"  --strategies OUT.exr   bdpt: also write one RGB layer per strategy (s, t) of\n"
-	"                         paths of up to --strategy-len N segments (default 4),\n"
-	"                         channels len<n>.s<s>t<t>.R/G/B; weighted, they sum\n"
-	"                         to the image\n"
+	"  --strategies OUT.exr   bdpt, portal: also write one RGB layer per strategy of\n"
+	"                         paths of up to --strategy-len N segments (default 4):\n"
+	"                         len<n>.s<s>t<t>.R/G/B for bdpt's (s, t), and for\n"
+	"                         portal len<n>.portal.s<s>t<t>.* for its intermediate\n"
+	"                         strategies by light and eye vertices; weighted, they\n"
+	"                         sum to the image of paths of up to N segments\n"
 	"  --unweighted           the strategy layers without MIS weights\n"
 	"  --seed N               random seed (same seed, device and options: same image)\n"
 	"  --device SELECTOR      platform:device index (e.g. 0:1), cpu, gpu, a part of the\n"
@@ -369,7 +371,8 @@ static int cmd_devices(int argc, char **argv)
 		       dev[i].compute_units, mem, dev[i].platform);
 	}
 	printf("\nSelect one with --device %s (platform:device), --device cpu, --device gpu,\n"
-	       "or --device NAME where NAME is any part of a device's name.\n",
+	       "or --device NAME where NAME is any part of a device's name; several at once\n"
+	       "with a comma-separated list of these, or --device all.\n",
 	       dev[0].selector);
 	free(dev);
 	return EXIT_OK;
