@@ -302,7 +302,8 @@ INLINE void bdpt_light_vertex(PathVertex *y, const LightSample *ls)
 	y->base = v3(0.0f, 0.0f, 0.0f);
 	y->beta = v3(1.0f, 1.0f, 1.0f);
 	y->delta = 0;
-	y->material = y->tri = -1;
+	y->material = -1;
+	y->tri = ls->tri; /* the portal direction density needs the emitter */
 	y->cross = 0;
 	y->pf = ls->is_env ? ls->pdf_w : ls->pdf_w * fabs(v3_dot(ls->n, ls->wi)) / (ls->dist * ls->dist);
 	y->pr = 0.0f;

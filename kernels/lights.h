@@ -165,6 +165,7 @@ typedef struct {
 	V3 Le;       /* radiance arriving at x along -wi */
 	float pdf_w; /* solid angle at x, selection included */
 	int is_env;
+	int tri;     /* the emitter triangle, -1 for the environment */
 } LightSample;
 
 /* Next-event estimation from shading point x: the environment with
@@ -176,6 +177,7 @@ INLINE int light_sample(const SceneView *sc, V3 x, float u_sel, float u1, float 
 {
 	float ps = sc->params->env_pdf_select;
 	ls->is_env = 0;
+	ls->tri = -1;
 	ls->pdf_w = 0.0f;
 	ls->Le = v3(0.0f, 0.0f, 0.0f);
 	if (u_sel < ps) {
@@ -212,6 +214,7 @@ INLINE int light_sample(const SceneView *sc, V3 x, float u_sel, float u1, float 
 	ls->n = n;
 	ls->wi = wi;
 	ls->dist = dist;
+	ls->tri = tri;
 	ls->Le = sc->materials[sc->tris[tri].material].emission;
 	ls->pdf_w = (1.0f - ps) * pdf_a * dist2 / cos_light;
 	return 1;

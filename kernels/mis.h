@@ -119,11 +119,6 @@ INLINE void mis_prefix(const MisVertex *v, int k, float *PF, float *PR)
 
 INLINE float mis_log_bdpt(const float *PF, const float *PR, int k, int s) { return PF[s] + PR[k] - PR[s]; }
 
-INLINE float mis_log_portal(const float *PF, const float *PR, const float *lpair, int k, int s, int m, int tp)
-{
-	return PF[s] + (PR[m] - PR[s]) + lpair[m] + (PF[m + tp + 1] - PF[m + 2]) + (PR[k] - PR[m + tp + 1]);
-}
-
 /* log(exp(a) + exp(b)) without overflow; -INF is the empty sum. */
 INLINE float mis_logadd(float a, float b)
 {
@@ -133,17 +128,22 @@ INLINE float mis_logadd(float a, float b)
 	return hi + log(1.0f + exp(lo - hi));
 }
 
+INLINE float mis_beta(int heuristic) { return heuristic == MIS_BALANCE ? 1.0f : 2.0f; }
+
 /* Weight of strategy `cur` for the k-vertex path v among all BDPT and
- * portal strategies. cross[i] counts the portal crossings of edge
- * (x_i, x_{i+1}); lpair[i] is log p_pair(i) where cross[i] > 0. */
-INLINE float mis_union_weight(const MisVertex *v, int k, const int *cross, const float *lpair, MisStrategy cur,
-			      MisPortalSet set, int heuristic)
+ * portal strategies in use. cross[i] > 0 marks an edge (x_i, x_{i+1})
+ * that crosses portals; lpsum[i] = log sum over its crossings c of
+ * p_pair_c^beta (each crossing is a strategy of its own, with its own
+ * direction density); lpair_cur is log p_pair of cur's own crossing. */
+INLINE float mis_union_weight(const MisVertex *v, int k, const int *cross, const float *lpsum, float lpair_cur,
+			      MisStrategy cur, MisPortalSet set, int heuristic)
 {
-	float PF[2 * 33 + 1], PR[2 * 33 + 1];
-	float beta = heuristic == MIS_BALANCE ? 1.0f : 2.0f;
+	float PF[4 * 33 + 1], PR[4 * 33 + 1];
+	float beta = mis_beta(heuristic);
 	mis_prefix(v, k, PF, PR);
 	float lcur = cur.c == 1 ? mis_log_bdpt(PF, PR, k, cur.s)
-				: mis_log_portal(PF, PR, lpair, k, cur.s, cur.m, cur.tp);
+				: PF[cur.s] + (PR[cur.m] - PR[cur.s]) + lpair_cur + (PF[cur.m + cur.tp + 1] - PF[cur.m + 2]) +
+					  (PR[k] - PR[cur.m + cur.tp + 1]);
 	float total = -AJAR_INF; /* log of sum of (p_j / p_cur)^beta */
 	for (int s = 0; s < k; s++)
 		if (mis_bdpt_valid(v, k, s))
@@ -160,7 +160,7 @@ INLINE float mis_union_weight(const MisVertex *v, int k, const int *cross, const
 		for (int tp = 1; m + tp <= k - 2 && tp <= set.tp_max; tp++)
 			if (!v[m + tp].delta && !v[m + tp + 1].delta)
 				right = mis_logadd(right, beta * ((PF[m + tp + 1] - PF[m + 2]) + (PR[k] - PR[m + tp + 1])));
-		float term = left + right + beta * (lpair[m] - lcur) + log((float)cross[m]);
+		float term = left + right + lpsum[m] - beta * lcur;
 		total = mis_logadd(total, term);
 	}
 	return exp(-total);

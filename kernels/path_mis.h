@@ -12,6 +12,7 @@
 #include "camera.h"
 #include "densities.h"
 #include "mis.h"
+#include "lights.h"
 #include "portal_geometry.h"
 
 /* A path assembled from up to four subpath segments, light first:
@@ -92,10 +93,41 @@ INLINE int path_edge_crossings(const SceneView *sc, const PathRef *P, int i)
 	return portal_crossings(sc, a->p, b->p, 0);
 }
 
-/* log p_pair(m) = log(p_A / (2 pi) G(x_m, x_{m+1})), geometric normals. */
-INLINE float path_log_pair(const SceneView *sc, const PathRef *P, int m)
+/* The portal direction density, per projected solid angle about the
+ * portal normal n_p, of the intermediate subpath whose <- half leaves
+ * portal point w toward x_m (design.md; kernels/portal.h): a mixture of
+ * the two-sided cosine (weight PORTAL_COSINE) and of a light sample from
+ * w, which only counts when the <- half reaches the sampled light point:
+ * x_m on an emitter's front face, or the environment. */
+#define PORTAL_COSINE 0.5f
+
+INLINE float portal_direction_psa(const SceneView *sc, const PathVertex *xm, V3 w, V3 n_p)
 {
-	const PathVertex *a = P->x[m], *b = P->x[m + 1];
+	V3 to_m; /* from w toward x_m */
+	float guided = 0.0f;
+	if (xm->type == VERTEX_ENV) {
+		to_m = xm->p;
+		guided = light_pdf_w(sc, w, to_m, -1, AJAR_INF, 1.0f);
+	} else {
+		V3 d = v3_sub(xm->p, w);
+		float dist = v3_len(d);
+		if (!(dist > 0.0f))
+			return 0.0f;
+		to_m = v3_scale(d, 1.0f / dist);
+		if (xm->tri >= 0 && sc->tris[xm->tri].emitter >= 0) {
+			float cos_l = -v3_dot(xm->ng, to_m); /* ng is the front face */
+			guided = light_pdf_w(sc, w, to_m, xm->tri, dist, cos_l);
+		}
+	}
+	float c = fabs(v3_dot(to_m, n_p));
+	return PORTAL_COSINE * AJAR_INV_2PI + (c > 0.0f ? (1.0f - PORTAL_COSINE) * guided / c : 0.0f);
+}
+
+/* log p_pair = log(p_A q(w | portal point) G(x_m, x_{m+1})), geometric
+ * normals, for the crossing of edge (a = x_m, b = x_{m+1}) at portal
+ * point w of portal triangle normal n_p. */
+INLINE float portal_pair_log(const SceneView *sc, const PathVertex *a, const PathVertex *b, V3 w, V3 n_p)
+{
 	GLOBAL const PortalTri *pt = &sc->portals[0];
 	float pa = pt->pdf_select / pt->area; /* the same for every portal triangle */
 	float g;
@@ -106,11 +138,61 @@ INLINE float path_log_pair(const SceneView *sc, const PathRef *P, int m)
 		float d2 = v3_len2(d);
 		g = fabs(v3_dot(a->ng, d)) * fabs(v3_dot(b->ng, d)) / (d2 * d2);
 	}
-	return log(fmax(pa * AJAR_INV_2PI * g, 1e-30f));
+	return log(fmax(pa * portal_direction_psa(sc, a, w, n_p) * g, 1e-30f));
 }
 
-/* MIS records, crossings and pair densities of an assembled path. */
-INLINE void path_records(const SceneView *sc, const PathRef *P, MisVertex *mv, int *cross, float *lpair)
+/* The normal of the portal triangle whose plane holds portal point w. */
+INLINE V3 portal_normal_at(const SceneView *sc, V3 w)
+{
+	V3 best_n = v3(0.0f, 0.0f, 1.0f);
+	float best = AJAR_INF;
+	for (int j = 0; j < sc->params->num_portals; j++) {
+		GLOBAL const PortalTri *pt = &sc->portals[j];
+		V3 n = v3_norm(v3_cross(v3_sub(pt->p1, pt->p0), v3_sub(pt->p2, pt->p0)));
+		float d = fabs(v3_dot(n, v3_sub(w, pt->p0)));
+		if (d < best) {
+			best = d;
+			best_n = n;
+		}
+	}
+	return best_n;
+}
+
+/* For edge (x_i, x_{i+1}): log of the sum over its portal crossings of
+ * p_pair^beta. With `w0` (the pair edge of the current portal strategy),
+ * its own crossing is taken at the sampled w0, log p_pair in *lcur, and
+ * geometric crossings within a hair of it are dropped: the crossing test
+ * is not watertight, and at a portal quad's diagonal it can find the
+ * sampled point twice or not at all. */
+INLINE float path_pair_logsum(const SceneView *sc, const PathRef *P, int i, float beta, const V3 *w0, float *lcur)
+{
+	const PathVertex *a = P->x[i], *b = P->x[i + 1];
+	V3 o = a->type == VERTEX_ENV ? b->p : a->p;
+	V3 d = a->type == VERTEX_ENV ? a->p : v3_sub(b->p, a->p);
+	float tmax = a->type == VERTEX_ENV ? AJAR_INF : 1.0f;
+	float sum = -AJAR_INF, hair2 = 1e-8f * sc->params->scene_radius * sc->params->scene_radius;
+	if (w0) {
+		*lcur = portal_pair_log(sc, a, b, *w0, portal_normal_at(sc, *w0));
+		sum = beta * *lcur;
+	}
+	for (int j = 0; j < sc->params->num_portals; j++) {
+		GLOBAL const PortalTri *pt = &sc->portals[j];
+		float t;
+		if (!portal_tri_crossing(o, d, tmax, pt->p0, pt->p1, pt->p2, &t))
+			continue;
+		V3 w = v3_add(o, v3_scale(d, t));
+		if (w0 && v3_len2(v3_sub(w, *w0)) < hair2)
+			continue;
+		V3 n_p = v3_norm(v3_cross(v3_sub(pt->p1, pt->p0), v3_sub(pt->p2, pt->p0)));
+		sum = mis_logadd(sum, beta * portal_pair_log(sc, a, b, w, n_p));
+	}
+	return sum;
+}
+
+/* MIS records, crossings and pair densities (lpsum, lpair_cur as in
+ * mis_union_weight) of an assembled path. */
+INLINE void path_records(const SceneView *sc, const PathRef *P, int heuristic, MisVertex *mv, int *cross,
+			 float *lpsum, float *lpair_cur)
 {
 	const PathVertex *const *x = P->x;
 	int k = P->k;
@@ -166,7 +248,18 @@ INLINE void path_records(const SceneView *sc, const PathRef *P, MisVertex *mv, i
 		else /* eye subpath */
 			c = x[i]->cross;
 		cross[i] = c;
-		lpair[i] = c > 0 ? path_log_pair(sc, P, i) : 0.0f;
+	}
+	/* Pair densities: edges that cross portals, and the current sample's
+	 * own crossing (its w_0, kept in the pair's vertices). */
+	float beta = mis_beta(heuristic);
+	*lpair_cur = 0.0f;
+	for (int i = 0; i + 1 < k; i++) {
+		lpsum[i] = -AJAR_INF;
+		if (cross[i] <= 0 && i != m)
+			continue;
+		lpsum[i] = path_pair_logsum(sc, P, i, beta, i == m ? &x[i]->w0 : 0, lpair_cur);
+		if (i == m && cross[i] <= 0) /* the sampled crossing, whatever the test found */
+			cross[i] = 1;
 	}
 }
 
@@ -180,9 +273,10 @@ INLINE float path_union_weight(const SceneView *sc, const PathRef *P, MisStrateg
 {
 	MisVertex mv[4 * SUBPATH_MAX];
 	int cross[4 * SUBPATH_MAX];
-	float lpair[4 * SUBPATH_MAX];
-	path_records(sc, P, mv, cross, lpair);
-	return mis_union_weight(mv, P->k, cross, lpair, cur, path_portal_set(sc->params), sc->params->mis);
+	float lpsum[4 * SUBPATH_MAX], lpair_cur;
+	int heuristic = sc->params->mis;
+	path_records(sc, P, heuristic, mv, cross, lpsum, &lpair_cur);
+	return mis_union_weight(mv, P->k, cross, lpsum, lpair_cur, cur, path_portal_set(sc->params), heuristic);
 }
 
 #endif

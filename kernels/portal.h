@@ -3,15 +3,18 @@
  * the strategies of one intermediate subpath per pixel sample.
  *
  * An intermediate subpath starts at a point w_0 on a portal (by area,
- * p_A = 1 / total portal area) with a direction w from the two-sided cosine
- * distribution (1 / 2 pi per projected solid angle). The <- half traces -w
+ * p_A = 1 / total portal area) with a direction w: with probability 1/2
+ * from the two-sided cosine distribution (1 / 2 pi per projected solid
+ * angle), else with -w toward a light sample from w_0, kept only if the
+ * <- half reaches that light point (so the density of w is a function of
+ * the path: path_mis.h, portal_direction_psa). The <- half traces -w
  * toward the light, like an eye subpath, and its vertices connect to the
  * light subpath (s >= 2), to a fresh light sample (s = 1), or are the light
  * (s = 0). The -> half traces w, like a light subpath, and its vertices
  * connect to the eye subpath (t >= 2) or to the camera (t = 1, splatted).
  * The portal is invisible, so w_0 is no path vertex: the pair x_m, x_{m+1}
- * (the first hits of the two halves) has density p_A / (2 pi) G(x_m, x_{m+1})
- * and the contribution carries 2 pi / p_A.
+ * (the first hits of the two halves) has density p_A q(w) G(x_m, x_{m+1})
+ * and the contribution carries 1 / (p_A q(w)).
  *
  * Every path, however it was sampled, is weighted over the union of both
  * families (mis_union_weight): its MIS records come from the stored
@@ -37,17 +40,29 @@ INLINE void portal_intermediate(const SceneView *sc, PathVertex *R, int *nR, Pat
 	GLOBAL const Params *prm = sc->params;
 	int depth = prm->max_depth;
 	float u0 = rng_f(rng), u1 = rng_f(rng), u2 = rng_f(rng), u3 = rng_f(rng), u4 = rng_f(rng), u5 = rng_f(rng);
+	float u_mix = rng_f(rng);
 	V3 w0, n;
 	float pdf_a;
 	*nR = *nF = 0;
 	if (portal_sample(sc, u0, u1, u2, &w0, &n, &pdf_a) < 0 || !(pdf_a > 0.0f))
 		return;
-	V3 t, b;
-	v3_basis(n, &t, &b);
-	V3 lc = sample_cosine_hemisphere(u3, u4);
-	if (u5 < 0.5f)
-		lc.z = -lc.z;
-	V3 w = v3_from_local(lc, t, b, n);
+	/* The direction: two-sided cosine, or the <- half toward a light
+	 * sample from w_0 (path_mis.h, portal_direction_psa). */
+	V3 w;
+	LightSample ls;
+	int guided = u_mix >= PORTAL_COSINE;
+	if (!guided) {
+		V3 t, b;
+		v3_basis(n, &t, &b);
+		V3 lc = sample_cosine_hemisphere(u3, u4);
+		if (u5 < 0.5f)
+			lc.z = -lc.z;
+		w = v3_from_local(lc, t, b, n);
+	} else {
+		if (!light_sample(sc, w0, u3, u4, u5, &ls))
+			return;
+		w = v3_neg(ls.wi);
+	}
 	/* The two first hits. The walks' "previous vertex" of each first hit
 	 * is the other one: the portal passes rays straight through. */
 	PathVertex origin;
@@ -62,11 +77,23 @@ INLINE void portal_intermediate(const SceneView *sc, PathVertex *R, int *nR, Pat
 	if (!vertex_trace(sc, tmp, 1, w0, v3_neg(w), v3(1.0f, 1.0f, 1.0f), 0.0f, 0, 0, 1))
 		return; /* <- escaped and there is no environment */
 	PathVertex A = tmp[1];
+	if (guided) { /* counts only if the <- half reached the sampled light point */
+		int reached = ls.is_env ? A.type == VERTEX_ENV
+					: A.type == VERTEX_SURFACE && sc->tris[A.tri].emitter >= 0 &&
+						  fabs(v3_len(v3_sub(A.p, w0)) - ls.dist) <= 1e-3f * ls.dist + 1e-6f;
+		if (!reached)
+			return;
+	}
 	int cross_ab = A.type == VERTEX_ENV ? portal_crossings(sc, B.p, A.p, 1) : portal_crossings(sc, A.p, B.p, 0);
 	A.cross = B.cross = cross_ab > 0 ? cross_ab : 1; /* w_0 lies on the edge */
 	A.pf = A.pr = B.pf = B.pr = 0.0f; /* the pair's own densities are p_pair */
+	A.w0 = B.w0 = w0;
+	float q = portal_direction_psa(sc, &A, w0, n);
+	if (!(q > 0.0f))
+		return;
+	float k = 1.0f / (pdf_a * q); /* f / p_pair = 1 / (p_A q): G cancels */
 	A.beta = v3(1.0f, 1.0f, 1.0f);
-	B.beta = v3(AJAR_PI * 2.0f / pdf_a, AJAR_PI * 2.0f / pdf_a, AJAR_PI * 2.0f / pdf_a);
+	B.beta = v3(k, k, k);
 	R[0] = B;
 	R[1] = A;
 	F[0] = A;

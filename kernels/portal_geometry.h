@@ -8,8 +8,9 @@
 #include "types.h"
 
 /* Whether the ray o + t d (t in (0, tmax)) crosses triangle (p0, p1, p2),
- * by Moeller-Trumbore; a ray in the triangle's plane does not cross it. */
-INLINE int portal_tri_crossed(V3 o, V3 d, float tmax, V3 p0, V3 p1, V3 p2)
+ * by Moeller-Trumbore; a ray in the triangle's plane does not cross it.
+ * *t_hit gets the crossing's t. */
+INLINE int portal_tri_crossing(V3 o, V3 d, float tmax, V3 p0, V3 p1, V3 p2, float *t_hit)
 {
 	V3 e1 = v3_sub(p1, p0), e2 = v3_sub(p2, p0);
 	V3 pv = v3_cross(d, e2);
@@ -26,7 +27,14 @@ INLINE int portal_tri_crossed(V3 o, V3 d, float tmax, V3 p0, V3 p1, V3 p2)
 	if (v < 0.0f || u + v > 1.0f)
 		return 0;
 	float t = v3_dot(e2, qv) * inv;
+	*t_hit = t;
 	return t > 0.0f && t < tmax;
+}
+
+INLINE int portal_tri_crossed(V3 o, V3 d, float tmax, V3 p0, V3 p1, V3 p2)
+{
+	float t;
+	return portal_tri_crossing(o, d, tmax, p0, p1, p2, &t);
 }
 
 /* Portal triangles crossed by the segment a -> b, or, if `to_infinity`,

@@ -38,7 +38,7 @@ typedef struct {
 	int material; /* -1 for camera, env */
 	int tri;      /* hit triangle, -1 for camera, env */
 	int cross;    /* portal integrator: portal crossings of the edge to the previous vertex of this subpath */
-	int pad0, pad1, pad2;
+	V3 w0;        /* an intermediate subpath's first vertices: the portal point it started from */
 } PathVertex;
 
 INLINE void vertex_bsdf(const SceneView *sc, const PathVertex *v, Bsdf *bs)

@@ -104,8 +104,9 @@ double rel_diff(float a, float b)
 }
 
 
-/* Moeller-Trumbore in double precision, written again on purpose. */
-static int crosses(const double *o, const double *d, double tmax, V3 a, V3 b, V3 c)
+/* Moeller-Trumbore in double precision, written again on purpose; *th
+ * gets the crossing's parameter. */
+static int crosses(const double *o, const double *d, double tmax, V3 a, V3 b, V3 c, double *th)
 {
 	double e1[3] = {b.x - a.x, b.y - a.y, b.z - a.z}, e2[3] = {c.x - a.x, c.y - a.y, c.z - a.z};
 	double pv[3] = {d[1] * e2[2] - d[2] * e2[1], d[2] * e2[0] - d[0] * e2[2], d[0] * e2[1] - d[1] * e2[0]};
@@ -120,15 +121,62 @@ static int crosses(const double *o, const double *d, double tmax, V3 a, V3 b, V3
 	double v = (d[0] * qv[0] + d[1] * qv[1] + d[2] * qv[2]) / det;
 	if (v < 0 || u + v > 1)
 		return 0;
-	double t = (e2[0] * qv[0] + e2[1] * qv[1] + e2[2] * qv[2]) / det;
-	return t > 0 && t < tmax;
+	*th = (e2[0] * qv[0] + e2[1] * qv[1] + e2[2] * qv[2]) / det;
+	return *th > 0 && *th < tmax;
 }
 
-int oracle_crossings(const SceneView *sc, const PathVertex *a, const PathVertex *b)
+/* Density per projected solid angle of the portal direction toward a
+ * (x_m) from portal point w with portal normal n: half two-sided cosine,
+ * half a light sample from w that reached a (design of kernels/portal.h). */
+/* The emitter triangle that point p lies on, found by geometry (not from
+ * the vertex's own bookkeeping), or -1. */
+static int emitter_at(const SceneView *sc, V3 p)
+{
+	for (int e = 0; e < sc->params->num_emitters; e++) {
+		GLOBAL const Tri *t = &sc->tris[sc->emitters[e].tri];
+		V3 n = tri_normal(t);
+		double n2 = v3_len2(n);
+		if (fabs(v3_dot(n, v3_sub(p, t->p0))) > 1e-4 * sqrt(n2))
+			continue; /* off the plane */
+		V3 c0 = v3_cross(v3_sub(t->p1, t->p0), v3_sub(p, t->p0)), c1 = v3_cross(v3_sub(t->p2, t->p1), v3_sub(p, t->p1)),
+		   c2 = v3_cross(v3_sub(t->p0, t->p2), v3_sub(p, t->p2));
+		double tol = -1e-6 * n2;
+		if (v3_dot(c0, n) >= tol && v3_dot(c1, n) >= tol && v3_dot(c2, n) >= tol)
+			return sc->emitters[e].tri;
+	}
+	return -1;
+}
+
+static double direction_psa(const SceneView *sc, const PathVertex *a, const double *w, const double *n)
+{
+	double to[3], guided = 0;
+	if (a->type == VERTEX_ENV) {
+		to[0] = a->p.x, to[1] = a->p.y, to[2] = a->p.z;
+		guided = sc->params->env_pdf_select * env_pdf_w(sc, a->p);
+	} else {
+		double d[3] = {a->p.x - w[0], a->p.y - w[1], a->p.z - w[2]};
+		double dist = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+		for (int c = 0; c < 3; c++)
+			to[c] = d[c] / dist;
+		int tri = emitter_at(sc, a->p);
+		if (tri >= 0) {
+			V3 fn = v3_norm(tri_normal(&sc->tris[tri]));
+			double cos_l = -(fn.x * to[0] + fn.y * to[1] + fn.z * to[2]);
+			if (cos_l > 0)
+				guided = (1 - sc->params->env_pdf_select) * emitter_pdf_a(sc, tri) * dist * dist / cos_l;
+		}
+	}
+	double c = fabs(to[0] * n[0] + to[1] * n[1] + to[2] * n[2]);
+	return 0.5 / (2 * M_PI) + (c > 0 ? 0.5 * guided / c : 0);
+}
+
+int oracle_pair_logs(const SceneView *sc, const PathVertex *a, const PathVertex *b, double *lp, double (*pts)[3],
+		     int max)
 {
 	double o[3], d[3], tmax = 1;
+	const PathVertex *p = a->type == VERTEX_ENV ? b : a;
 	if (a->type == VERTEX_ENV || b->type == VERTEX_ENV) {
-		const PathVertex *p = a->type == VERTEX_ENV ? b : a, *env = a->type == VERTEX_ENV ? a : b;
+		const PathVertex *env = a->type == VERTEX_ENV ? a : b;
 		o[0] = p->p.x, o[1] = p->p.y, o[2] = p->p.z;
 		d[0] = env->p.x, d[1] = env->p.y, d[2] = env->p.z;
 		tmax = 1e30;
@@ -136,14 +184,6 @@ int oracle_crossings(const SceneView *sc, const PathVertex *a, const PathVertex 
 		o[0] = a->p.x, o[1] = a->p.y, o[2] = a->p.z;
 		d[0] = b->p.x - a->p.x, d[1] = b->p.y - a->p.y, d[2] = b->p.z - a->p.z;
 	}
-	int n = 0;
-	for (int i = 0; i < sc->params->num_portals; i++)
-		n += crosses(o, d, tmax, sc->portals[i].p0, sc->portals[i].p1, sc->portals[i].p2);
-	return n;
-}
-
-double oracle_log_pair(const SceneView *sc, const PathVertex *a, const PathVertex *b)
-{
 	double area = 0;
 	for (int i = 0; i < sc->params->num_portals; i++)
 		area += sc->portals[i].area;
@@ -151,9 +191,26 @@ double oracle_log_pair(const SceneView *sc, const PathVertex *a, const PathVerte
 	if (a->type == VERTEX_ENV) {
 		g = fabs(v3_dot(b->ng, a->p));
 	} else {
-		double dx = b->p.x - a->p.x, dy = b->p.y - a->p.y, dz = b->p.z - a->p.z, d2 = dx * dx + dy * dy + dz * dz;
-		g = fabs(a->ng.x * dx + a->ng.y * dy + a->ng.z * dz) * fabs(b->ng.x * dx + b->ng.y * dy + b->ng.z * dz) /
-		    (d2 * d2);
+		double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+		g = fabs(a->ng.x * d[0] + a->ng.y * d[1] + a->ng.z * d[2]) *
+		    fabs(b->ng.x * d[0] + b->ng.y * d[1] + b->ng.z * d[2]) / (d2 * d2);
 	}
-	return log(g / (2 * M_PI * area));
+	int n = 0;
+	for (int i = 0; i < sc->params->num_portals; i++) {
+		GLOBAL const PortalTri *t = &sc->portals[i];
+		double th;
+		if (!crosses(o, d, tmax, t->p0, t->p1, t->p2, &th))
+			continue;
+		double w[3] = {o[0] + th * d[0], o[1] + th * d[1], o[2] + th * d[2]};
+		V3 nv = v3_norm(v3_cross(v3_sub(t->p1, t->p0), v3_sub(t->p2, t->p0)));
+		double nn[3] = {nv.x, nv.y, nv.z};
+		if (n < max) {
+			lp[n] = log(direction_psa(sc, a, w, nn) * g / area);
+			if (pts)
+				for (int c = 0; c < 3; c++)
+					pts[n][c] = w[c];
+		}
+		n++;
+	}
+	return n;
 }

@@ -17,8 +17,9 @@ int strategy_valid(const MisVertex *v, int k, int s);
 /* Whether an edge near vertex i is shorter than 1% of the scene radius. */
 int near_contact(const PathVertex *x, int k, int i, float radius);
 double rel_diff(float a, float b);
-/* Portal triangles crossed by the edge a-b (either may be the environment). */
-int oracle_crossings(const SceneView *sc, const PathVertex *a, const PathVertex *b);
-/* log p_A / (2 pi) G(a, b) */
-double oracle_log_pair(const SceneView *sc, const PathVertex *a, const PathVertex *b);
+/* The portal crossings of edge a = x_m, b = x_{m+1} (either may be the
+ * environment): returns their number; lp[c] = log p_pair of crossing c
+ * (p_A, the direction density, G) and pts[c] its point, for c < max. */
+int oracle_pair_logs(const SceneView *sc, const PathVertex *a, const PathVertex *b, double *lp, double (*pts)[3],
+		     int max);
 #endif
