@@ -129,7 +129,7 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	 * overrides it for experiments, e.g. "32,32,32" for all of them. */
 	p->portal_s_max = 1;
 	p->portal_sp_max = 2;
-	p->portal_tp_max = 2;
+	p->portal_tp_max = 1;
 	const char *set = getenv("AJAR_PORTAL_SET");
 	if (set && sscanf(set, "%d,%d,%d", &p->portal_s_max, &p->portal_sp_max, &p->portal_tp_max) != 3)
 		log_msg(AJAR_LOG_WARNING, "AJAR_PORTAL_SET='%s' is not three numbers s,s',t'; ignored", set);
