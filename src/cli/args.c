@@ -139,7 +139,7 @@ int args_parse_render(int argc, char **argv, RenderArgs *a)
 		}
 		static const char *const known[] = {"-o", "--output", "--spp", "--time", "--size", "--integrator",
 						    "--max-depth", "--seed", "--device", "--png", "--min-depth",
-						    "--mis", "--strategies", "--strategy-len"};
+						    "--mis", "--strategies", "--strategy-len", "--exposure"};
 		size_t k = 0;
 		while (k < sizeof known / sizeof known[0] && strcmp(name, known[k]) != 0)
 			k++;
@@ -177,6 +177,12 @@ int args_parse_render(int argc, char **argv, RenderArgs *a)
 			rc = parse_u32(name, val, 1, 8, &strategy_len);
 		else if (!strcmp(name, "--strategies"))
 			a->strategies = val;
+		else if (!strcmp(name, "--exposure")) {
+			char *end;
+			a->exposure = strtod(val, &end);
+			if (*end || !(a->exposure >= -30 && a->exposure <= 30))
+				rc = args_usage_error("--exposure: '%s' is not a number in -30..30", val);
+		}
 		else if (!strcmp(name, "--mis")) {
 			if (!strcmp(val, "power"))
 				a->opt.mis = AJAR_MIS_POWER;

@@ -23,6 +23,7 @@ typedef struct {
 	const char *exr;   /* -o */
 	const char *png;   /* --png, or NULL */
 	const char *strategies; /* --strategies, or NULL */
+	double exposure;   /* --exposure, EV for the PNG preview */
 	ajar_options opt;  /* spp, time_limit, size, integrator, depth, seed, device */
 	int quiet;
 	int help;          /* --help was given: print render help, nothing else */

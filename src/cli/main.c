@@ -76,6 +76,7 @@ static const char usage_render[] =
 	"                         device name, a comma-separated list of these, or all:\n"
 	"                         several devices render at once; see 'ajar devices'\n"
 	"  --png OUT.png          also write a tone-mapped 8-bit sRGB preview\n"
+	"  --exposure EV          brighten (EV > 0) or darken the preview by 2^EV (default 0)\n"
 	"  -q, --quiet            print nothing but errors\n"
 	"  -h, --help             this text\n"
 	"\n"
@@ -208,6 +209,27 @@ static int interrupted_early(void)
 	return EXIT_INTERRUPTED;
 }
 
+/* The PNG preview at 2^exposure: the image scaled before tone mapping. */
+static ajar_status write_png(ajar_renderer *r, const char *path, double exposure)
+{
+	uint32_t w, h;
+	ajar_status st = ajar_renderer_image(r, NULL, &w, &h);
+	if (st != AJAR_OK)
+		return st;
+	float *rgba = malloc(sizeof(float) * 4 * (size_t)w * h);
+	if (!rgba)
+		return AJAR_ERROR_OUT_OF_MEMORY;
+	if ((st = ajar_renderer_image(r, rgba, &w, &h)) == AJAR_OK) {
+		float k = (float)pow(2.0, exposure);
+		for (size_t i = 0; i < 4 * (size_t)w * h; i++)
+			if (i % 4 != 3)
+				rgba[i] *= k;
+		st = ajar_write_png(path, rgba, w, h);
+	}
+	free(rgba);
+	return st;
+}
+
 static int write_outputs(ajar_renderer *r, const RenderArgs *a)
 {
 	ajar_status st = ajar_renderer_write_exr(r, a->exr);
@@ -223,7 +245,7 @@ static int write_outputs(ajar_renderer *r, const RenderArgs *a)
 		}
 	}
 	if (a->png) {
-		st = ajar_renderer_write_png(r, a->png);
+		st = write_png(r, a->png, a->exposure);
 		if (st != AJAR_OK) {
 			report(st, a->png);
 			return exit_code(st) == EXIT_BAD_INPUT ? EXIT_IO : exit_code(st);
