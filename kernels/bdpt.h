@@ -247,29 +247,37 @@ INLINE V3 bdpt_connect(const SceneView *sc, const PathVertex *y, const PathVerte
 	return v3_scale(v3_mul(fy, fz), 1.0f / d2);
 }
 
-/* Light vertex y (s >= 1) seen by the camera: splats its weighted
- * contribution into the pixel it lands in. */
-INLINE void bdpt_light_to_camera(const SceneView *sc, PathVertex *l, int s, PathVertex *cam_v, BdptFilm *out,
-				 Rng *rng)
+/* Light-side vertex y (its subpath predecessor along y->wo; `origin` if it
+ * is a light subpath's first vertex, which emits rather than scatters)
+ * connected to the camera cam_v: the contribution without MIS weight, and
+ * the pixel it lands in; 0 if it misses the image or is occluded. */
+INLINE V3 bdpt_to_camera(const SceneView *sc, const PathVertex *y, int origin, const PathVertex *cam_v, uint *pixel)
 {
 	GLOBAL const Camera *cam = &sc->params->camera;
-	const PathVertex *y = &l[s - 1];
+	V3 zero = v3(0.0f, 0.0f, 0.0f);
 	V3 d = v3_sub(cam->pos, y->p);
 	float d2 = v3_len2(d), px, py, cos_c;
 	if (!(d2 > 0.0f) || y->type == VERTEX_ENV)
-		return;
+		return zero;
 	V3 w = v3_scale(d, 1.0f / sqrt(d2));
 	if (!camera_raster(cam, v3_neg(w), &px, &py, &cos_c))
-		return;
-	V3 fy = s == 1 ? v3_scale(bdpt_emitted(sc, y, w), fabs(v3_dot(y->ng, w)))
-		       : bdpt_scatter(sc, y, w, BSDF_IMPORTANCE);
+		return zero;
+	V3 fy = origin ? v3_scale(bdpt_emitted(sc, y, w), fabs(v3_dot(y->ng, w))) : bdpt_scatter(sc, y, w, BSDF_IMPORTANCE);
 	if (v3_is_zero(fy) || !bdpt_visible(sc, y, cam_v))
-		return;
+		return zero;
+	*pixel = (uint)py * (uint)cam->width + (uint)px;
 	/* We G = cos_c / (A cos_c^4) / d^2 for the pinhole (camera.h). */
-	float we = camera_pdf_w(cam, cos_c) / d2;
-	V3 c = v3_scale(v3_mul(y->beta, fy), we);
-	uint pixel = (uint)py * (uint)cam->width + (uint)px;
-	bdpt_add(sc, out, s, 1, c, bdpt_weight(sc, l, s, cam_v, 1), pixel, rng);
+	return v3_scale(v3_mul(y->beta, fy), camera_pdf_w(cam, cos_c) / d2);
+}
+
+/* Light vertex s - 1 seen by the camera: splats its weighted contribution. */
+INLINE void bdpt_light_to_camera(const SceneView *sc, PathVertex *l, int s, PathVertex *cam_v, BdptFilm *out,
+				 Rng *rng)
+{
+	uint pixel;
+	V3 c = bdpt_to_camera(sc, &l[s - 1], s == 1, cam_v, &pixel);
+	if (!v3_is_zero(c))
+		bdpt_add(sc, out, s, 1, c, bdpt_weight(sc, l, s, cam_v, 1), pixel, rng);
 }
 
 /* Traces the eye subpath through raster point (px, py) into e[]; e[0] is

@@ -129,8 +129,8 @@ INLINE void portal_add(const SceneView *sc, BdptFilm *out, int s, int sp, int tp
 }
 
 /* The eye-side end of portal strategies: -> vertex F[b] to eye vertex
- * e[t-1] (t >= 2) or to the camera (t = 1). Returns the contribution
- * without F[b]'s beta... with it, and the pixel in *pixel. */
+ * e[t-1] (t >= 2) or to the camera (t = 1): the contribution from F[b]'s
+ * throughput on, and the pixel it lands in. */
 INLINE V3 portal_right(const SceneView *sc, const PathVertex *F, int b, const PathVertex *e, int t, uint own_pixel,
 		       uint *pixel)
 {
@@ -144,19 +144,7 @@ INLINE V3 portal_right(const SceneView *sc, const PathVertex *F, int b, const Pa
 		V3 c = bdpt_connect(sc, y, &e[t - 1]);
 		return v3_mul(v3_mul(y->beta, c), e[t - 1].beta);
 	}
-	GLOBAL const Camera *cam = &sc->params->camera;
-	V3 d = v3_sub(cam->pos, y->p);
-	float d2 = v3_len2(d), px, py, cos_c;
-	if (!(d2 > 0.0f))
-		return v3(0.0f, 0.0f, 0.0f);
-	V3 wc = v3_scale(d, 1.0f / sqrt(d2));
-	if (!camera_raster(cam, v3_neg(wc), &px, &py, &cos_c))
-		return v3(0.0f, 0.0f, 0.0f);
-	V3 fy = bdpt_scatter(sc, y, wc, BSDF_IMPORTANCE);
-	if (v3_is_zero(fy) || !bdpt_visible(sc, y, &e[0]))
-		return v3(0.0f, 0.0f, 0.0f);
-	*pixel = (uint)py * (uint)cam->width + (uint)px;
-	return v3_scale(v3_mul(y->beta, fy), camera_pdf_w(cam, cos_c) / d2);
+	return bdpt_to_camera(sc, y, 0, &e[0], pixel);
 }
 
 #define PORTAL_RIGHT_MAX 48

@@ -1,6 +1,7 @@
 /* kernel_host.c — see kernel_host.h. */
 #include "kernel_host.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -74,4 +75,34 @@ void host_render(HostScene *h, uint32_t spp, uint32_t seed, double *rgb, double 
 	free(ev);
 	free(rv);
 	free(fv);
+}
+
+void host_batch_estimate(HostScene *h, uint32_t spp, int layer, int batches, uint32_t seed0, Estimate *est)
+{
+	Params *prm = h->data.params;
+	uint32_t npix = (uint32_t)(prm->camera.width * prm->camera.height);
+	int nlayers = bdpt_layer_count(prm->strategy_len) +
+		      (prm->integrator == INTEGRATOR_PORTAL ? portal_layer_count(prm->strategy_len) : 0);
+	double *rgb = malloc(sizeof(double) * 3 * npix);
+	double *lay = nlayers ? malloc(sizeof(double) * 3 * npix * nlayers) : NULL;
+	double s1[3] = {0}, s2[3] = {0};
+	for (int b = 0; b < batches; b++) {
+		host_render(h, spp, seed0 + (uint32_t)b, rgb, lay);
+		const double *img = layer >= 0 ? lay + (size_t)3 * npix * layer : rgb;
+		for (int c = 0; c < 3; c++) {
+			double m = 0;
+			for (uint32_t i = 0; i < npix; i++)
+				m += img[3 * i + c];
+			m /= npix;
+			s1[c] += m;
+			s2[c] += m * m;
+		}
+	}
+	for (int c = 0; c < 3; c++) {
+		est->mean[c] = s1[c] / batches;
+		double var = (s2[c] - s1[c] * s1[c] / batches) / (batches - 1);
+		est->se[c] = sqrt(fmax(var, 0) / batches);
+	}
+	free(rgb);
+	free(lay);
 }

@@ -24,4 +24,12 @@ void host_scene_close(HostScene *h);
  * layers (if not NULL) the per-strategy means for paths up to
  * params->strategy_len segments, 3 doubles per pixel per layer. */
 void host_render(HostScene *h, uint32_t spp, uint32_t seed, double *rgb, double *layers);
+
+/* Image mean per channel of the image (layer < 0) or of strategy layer
+ * `layer`, from `batches` independent renders (seeds seed0, seed0 + 1, ..)
+ * of spp samples: the mean of the batch means and its standard error. */
+typedef struct {
+	double mean[3], se[3];
+} Estimate;
+void host_batch_estimate(HostScene *h, uint32_t spp, int layer, int batches, uint32_t seed0, Estimate *est);
 #endif

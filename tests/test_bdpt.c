@@ -201,38 +201,9 @@ static void test_mis_living_room(void **state)
 
 #define BATCHES 32
 
-typedef struct {
-	double mean[3], se[3];
-} Estimate;
-
-/* Image mean per channel over BATCHES renders with different seeds. */
 static void batch_estimate(HostScene *h, uint32_t spp, int layer, Estimate *est)
 {
-	Params *prm = h->data.params;
-	uint32_t npix = (uint32_t)(prm->camera.width * prm->camera.height);
-	int nlayers = bdpt_layer_count(prm->strategy_len);
-	double *rgb = malloc(sizeof(double) * 3 * npix);
-	double *lay = nlayers ? malloc(sizeof(double) * 3 * npix * nlayers) : NULL;
-	double s1[3] = {0}, s2[3] = {0};
-	for (int b = 0; b < BATCHES; b++) {
-		host_render(h, spp, 1000 + b, rgb, lay);
-		const double *img = layer >= 0 ? lay + (size_t)3 * npix * layer : rgb;
-		for (int c = 0; c < 3; c++) {
-			double m = 0;
-			for (uint32_t i = 0; i < npix; i++)
-				m += img[3 * i + c];
-			m /= npix;
-			s1[c] += m;
-			s2[c] += m * m;
-		}
-	}
-	for (int c = 0; c < 3; c++) {
-		est->mean[c] = s1[c] / BATCHES;
-		double var = (s2[c] - s1[c] * s1[c] / BATCHES) / (BATCHES - 1);
-		est->se[c] = sqrt(fmax(var, 0) / BATCHES);
-	}
-	free(rgb);
-	free(lay);
+	host_batch_estimate(h, spp, layer, BATCHES, 1000, est);
 }
 
 /* |a - b| within z combined standard errors, per channel. */
