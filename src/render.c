@@ -34,6 +34,7 @@
 #include "exr.h"
 #include "prepare.h"
 #include "scene.h"
+#include "render_info.h"
 #include "upload.h"
 #include "../kernels/compat.h"
 #include "../kernels/film.h"
@@ -834,126 +835,23 @@ static const char *integrator_name(ajar_integrator i)
 	return i == AJAR_INTEGRATOR_BDPT ? "bdpt" : i == AJAR_INTEGRATOR_PORTAL ? "portal" : "pt";
 }
 
-static ajar_status read_image(ajar_renderer *r, float **rgba)
+void render_info(const ajar_renderer *r, RenderInfo *info)
 {
-	*rgba = malloc(sizeof(float) * 4 * (size_t)r->width * r->height);
-	if (!*rgba)
-		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory for the image");
-	ajar_status st = ajar_renderer_image(r, *rgba, NULL, NULL);
-	if (st != AJAR_OK)
-		free(*rgba);
-	return st;
-}
-
-/* The header attributes every output of this renderer carries. */
-typedef struct {
-	char spp[32], seed[32], depth[32], secs[32], shares[2048];
-	const char *kv[20];
-} Header;
-
-static uint32_t header_fill(ajar_renderer *r, Header *h)
-{
-	snprintf(h->spp, sizeof h->spp, "%u", r->spp_done);
-	snprintf(h->seed, sizeof h->seed, "%u", r->seed);
-	snprintf(h->depth, sizeof h->depth, "%u", r->max_depth);
-	snprintf(h->secs, sizeof h->secs, "%.3f", r->elapsed);
-	device_shares(r, h->shares, sizeof h->shares);
-	const char *kv[] = {"ajar:spp", h->spp, "ajar:integrator", integrator_name(r->integrator),
-			    "ajar:seed", h->seed, "ajar:max_depth", h->depth, "ajar:render_seconds", h->secs,
-			    "ajar:device", r->device_names, "ajar:devices", h->shares,
-			    "ajar:scene", r->scene_name, "ajar:version", AJAR_VERSION_STRING};
-	memcpy(h->kv, kv, sizeof kv);
-	return sizeof kv / sizeof kv[0] / 2;
-}
-
-ajar_status ajar_renderer_write_exr(ajar_renderer *r, const char *path)
-{
-	float *rgba;
-	ajar_status st;
-	Header h;
-	if (!r || !path)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_write_exr: NULL argument");
-	if ((st = read_image(r, &rgba)) != AJAR_OK)
-		return st;
-	uint32_t n = header_fill(r, &h);
-	st = ajar_write_exr(path, rgba, r->width, r->height, h.kv, n);
-	free(rgba);
-	return st;
-}
-
-ajar_status ajar_renderer_write_strategies(ajar_renderer *r, const char *path)
-{
-	float *rgba;
-	ajar_status st;
-	Header h;
-	if (!r || !path)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_write_strategies: NULL argument");
-	if (r->nlayers == 0)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT,
-			       "%s: the renderer keeps no strategy images (set ajar_options.strategy_len)", path);
-	if ((st = read_image(r, &rgba)) != AJAR_OK) /* also reduces the layers into film_splat */
-		return st;
-	size_t npix = (size_t)r->width * r->height;
-	int nch = 4 + 3 * r->nlayers;
-	float *px = malloc(sizeof(float) * nch * npix);
-	char(*names)[48] = malloc(sizeof *names * nch);
-	const char **np = malloc(sizeof *np * nch);
-	if (!px || !names || !np) {
-		free(px);
-		free(names);
-		free(np);
-		free(rgba);
-		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory for strategy images", path);
-	}
-	static const char rgb[] = "RGB";
-	for (int c = 0; c < 4; c++)
-		snprintf(names[c], sizeof names[c], "%c", "RGBA"[c]);
-	int len = r->strategy_len;
-	for (int n = 1; n <= len; n++)
-		for (int s = 0; s <= n; s++)
-			for (int c = 0; c < 3; c++)
-				snprintf(names[4 + 3 * bdpt_layer(n, s) + c], sizeof names[0], "len%d.s%dt%d.%c", n, s,
-					 n + 1 - s, rgb[c]);
-	if (r->nlayers > bdpt_layer_count(len)) /* the portal integrator's groups */
-		for (int n = 2; n <= len; n++)
-			for (int t = 1; t < n; t++)
-				for (int s = 0; s + t < n; s++)
-					for (int c = 0; c < 3; c++)
-						snprintf(names[4 + 3 * (bdpt_layer_count(len) + portal_layer(n, s, t)) + c],
-							 sizeof names[0], "len%d.portal.s%dt%d.%c", n, s, t, rgb[c]);
-	for (int c = 0; c < nch; c++)
-		np[c] = names[c];
-	double scale = r->spp_done ? 1.0 / ((double)FILM_SCALE * r->spp_done) : 0.0;
-	for (size_t i = 0; i < npix; i++) {
-		memcpy(&px[nch * i], &rgba[4 * i], 4 * sizeof(float));
-		for (int l = 0; l < r->nlayers; l++)
-			for (int c = 0; c < 3; c++)
-				px[nch * i + 4 + 3 * l + c] =
-					(float)(r->film_splat[3 * npix * (1 + (size_t)l) + 3 * i + c] * scale);
-	}
-	uint32_t n = header_fill(r, &h);
-	h.kv[2 * n] = "ajar:strategies";
-	h.kv[2 * n + 1] = r->strategy_unweighted ? "unweighted"
-						 : "weighted (they sum to the image of paths up to their length)";
-	st = exr_write_channels(path, px, nch, np, r->width, r->height, h.kv, n + 1);
-	free(px);
-	free(names);
-	free(np);
-	free(rgba);
-	return st;
-}
-
-ajar_status ajar_renderer_write_png(ajar_renderer *r, const char *path)
-{
-	float *rgba;
-	ajar_status st;
-	if (!r || !path)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_write_png: NULL argument");
-	if ((st = read_image(r, &rgba)) != AJAR_OK)
-		return st;
-	st = ajar_write_png(path, rgba, r->width, r->height);
-	free(rgba);
-	return st;
+	memset(info, 0, sizeof *info);
+	info->width = r->width;
+	info->height = r->height;
+	info->spp = r->spp_done;
+	info->seed = r->seed;
+	info->max_depth = r->max_depth;
+	info->seconds = r->elapsed;
+	info->integrator = integrator_name(r->integrator);
+	info->devices = r->device_names;
+	device_shares(r, info->shares, sizeof info->shares);
+	info->scene = r->scene_name;
+	info->nlayers = r->nlayers;
+	info->strategy_len = r->strategy_len;
+	info->strategy_unweighted = r->strategy_unweighted;
+	info->layers = r->film_splat + 3 * (size_t)r->width * r->height;
 }
 
 ajar_status ajar_devices(ajar_device_info *out, uint32_t capacity, uint32_t *count)

@@ -17,7 +17,10 @@
 #include <string.h>
 
 #include "ajar.h"
+#include "exr.h"
 #include "testutil.h"
+
+#include <unistd.h>
 
 static float *render(ajar_scene *s, uint32_t w, uint32_t h, uint32_t spp, uint32_t seed, uint32_t depth)
 {
@@ -245,6 +248,40 @@ static void test_portal_without_portals_is_bdpt(void **state)
 	ajar_scene_destroy(&s);
 }
 
+/* Strategy images: written with their header, refused when not kept. */
+static void test_strategy_file(void **state)
+{
+	ajar_scene *s;
+	ajar_renderer *r;
+	ajar_options o;
+	char *dir = test_tmpdir(), path[256], value[128];
+	assert_non_null(dir);
+	snprintf(path, sizeof path, "%s/strategies.exr", dir);
+	assert_int_equal(ajar_scene_load(SCENE("cornell/cornell.gltf"), &s), AJAR_OK);
+	ajar_options_default(&o);
+	o.width = o.height = 16;
+	o.spp = 2;
+	o.integrator = AJAR_INTEGRATOR_BDPT;
+	assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_OK);
+	assert_int_equal(ajar_renderer_render(r, NULL, NULL), AJAR_OK);
+	assert_int_equal(ajar_renderer_write_strategies(r, path), AJAR_ERROR_INVALID_ARGUMENT);
+	ajar_renderer_destroy(&r);
+	o.strategy_len = 2;
+	o.strategy_unweighted = 1;
+	assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_OK);
+	assert_int_equal(ajar_renderer_render(r, NULL, NULL), AJAR_OK);
+	assert_int_equal(ajar_renderer_write_strategies(r, path), AJAR_OK);
+	assert_int_equal(exr_read_attr(path, "ajar:strategies", value, sizeof value), AJAR_OK);
+	assert_string_equal(value, "unweighted");
+	assert_int_equal(exr_read_attr(path, "ajar:spp", value, sizeof value), AJAR_OK);
+	assert_string_equal(value, "2");
+	ajar_renderer_destroy(&r);
+	ajar_scene_destroy(&s);
+	remove(path);
+	rmdir(dir);
+	free(dir);
+}
+
 static int stop_after_first(const ajar_progress *p, void *user)
 {
 	int *calls = user;
@@ -308,6 +345,7 @@ int main(void)
 		cmocka_unit_test(test_cornell_reference),
 		cmocka_unit_test(test_same_seed_same_bits),
 		cmocka_unit_test(test_portal_without_portals_is_bdpt),
+		cmocka_unit_test(test_strategy_file),
 		cmocka_unit_test(test_cancel_keeps_image),
 		cmocka_unit_test(test_bad_options),
 	};
