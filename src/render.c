@@ -238,8 +238,7 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 	size_t max_local = 0;
 	CL_TRY(d, clGetKernelWorkGroupInfo(rd->k_render, d->id, CL_KERNEL_WORK_GROUP_SIZE, sizeof max_local,
 					   &max_local, NULL));
-	rd->local = getenv("AJAR_LOCAL") ? (size_t)atoi(getenv("AJAR_LOCAL")) : 64;
-	for (; rd->local > 1 && rd->local > max_local; rd->local /= 2)
+	for (rd->local = 64; rd->local > 1 && rd->local > max_local; rd->local /= 2)
 		;
 	log_msg(AJAR_LOG_INFO, "device %s (%s): kernels %s in %.2f s", d->name, d->selector,
 		d->from_cache ? "loaded from cache" : "compiled", d->build_seconds);
