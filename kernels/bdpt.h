@@ -208,24 +208,32 @@ INLINE void film_add(GLOBAL long *film, uint pixel, V3 c, Rng *rng)
 	atom_add(&film[3 * pixel + 2], film_fixed(c.z, rng_f(rng)));
 }
 
-/* Records the unweighted contribution c of strategy (s, t) with MIS weight
- * w, landing in `pixel` (this sample's pixel unless t = 1). */
-INLINE void bdpt_add(const SceneView *sc, BdptFilm *out, int s, int t, V3 c, float w, uint pixel, Rng *rng)
+/* Records the unweighted contribution c of a path of n segments with MIS
+ * weight w: into this sample's pixel sum, or, when it reached the camera
+ * by a connection (t = 1), splatted into `pixel`; and into strategy layer
+ * `layer` when layers are kept for length n. */
+INLINE void bdpt_film_add(const SceneView *sc, BdptFilm *out, int n, int layer, int splat, V3 c, float w, uint pixel,
+			  Rng *rng)
 {
 	GLOBAL const Params *prm = sc->params;
-	int n = s + t - 1;
 	if (n < prm->min_depth)
 		return;
 	V3 cw = v3_scale(c, w);
-	if (t == 1)
+	if (splat)
 		film_add(out->splat, pixel, cw, rng);
 	else
 		out->L = v3_add(out->L, cw);
 	if (n <= prm->strategy_len) {
 		uint npix = (uint)(prm->camera.width * prm->camera.height);
-		uint layer = (uint)bdpt_layer(n, s);
-		film_add(out->layers + 3 * (ulong)npix * layer, pixel, prm->strategy_unweighted ? c : cw, rng);
+		film_add(out->layers + 3 * (ulong)npix * (uint)layer, pixel, prm->strategy_unweighted ? c : cw, rng);
 	}
+}
+
+/* Bdpt strategy (s, t): a path of s + t - 1 segments. */
+INLINE void bdpt_add(const SceneView *sc, BdptFilm *out, int s, int t, V3 c, float w, uint pixel, Rng *rng)
+{
+	int n = s + t - 1;
+	bdpt_film_add(sc, out, n, bdpt_layer(n, s), t == 1, c, w, pixel, rng);
 }
 
 /* Connecting light vertex y (s >= 2) to eye vertex z (t >= 2), both on

@@ -141,7 +141,7 @@ INLINE float emitter_pdf_a(const SceneView *sc, int tri)
 INLINE int emitter_sample(const SceneView *sc, float u_sel, float u1, float u2, V3 *p, V3 *n,
 			  float *pdf_a)
 {
-	float p_sel, u_rest, b1, b2;
+	float p_sel, u_rest;
 	*pdf_a = 0.0f;
 	*p = v3(0.0f, 0.0f, 0.0f);
 	*n = v3(0.0f, 0.0f, 1.0f);
@@ -150,9 +150,7 @@ INLINE int emitter_sample(const SceneView *sc, float u_sel, float u1, float u2, 
 		return -1;
 	GLOBAL const Emitter *e = &sc->emitters[k];
 	GLOBAL const Tri *t = &sc->tris[e->tri];
-	sample_triangle(u1, u2, &b1, &b2);
-	*p = v3_add(t->p0, v3_add(v3_scale(v3_sub(t->p1, t->p0), b1), v3_scale(v3_sub(t->p2, t->p0), b2)));
-	*n = v3_norm(tri_normal(t));
+	sample_triangle_point(t->p0, t->p1, t->p2, u1, u2, p, n);
 	*pdf_a = e->pdf_select / e->area;
 	return e->tri;
 }
@@ -241,7 +239,7 @@ INLINE float light_pdf_w(const SceneView *sc, V3 x, V3 wi, int tri, float dist, 
 INLINE int portal_sample(const SceneView *sc, float u_sel, float u1, float u2, V3 *p, V3 *n,
 			 float *pdf_a)
 {
-	float p_sel, u_rest, b1, b2;
+	float p_sel, u_rest;
 	*pdf_a = 0.0f;
 	*p = v3(0.0f, 0.0f, 0.0f);
 	*n = v3(0.0f, 0.0f, 1.0f);
@@ -249,10 +247,7 @@ INLINE int portal_sample(const SceneView *sc, float u_sel, float u1, float u2, V
 	if (k < 0)
 		return -1;
 	GLOBAL const PortalTri *t = &sc->portals[k];
-	sample_triangle(u1, u2, &b1, &b2);
-	V3 e1 = v3_sub(t->p1, t->p0), e2 = v3_sub(t->p2, t->p0);
-	*p = v3_add(t->p0, v3_add(v3_scale(e1, b1), v3_scale(e2, b2)));
-	*n = v3_norm(v3_cross(e1, e2));
+	sample_triangle_point(t->p0, t->p1, t->p2, u1, u2, p, n);
 	*pdf_a = t->pdf_select / t->area;
 	return k;
 }

@@ -112,20 +112,9 @@ INLINE void portal_intermediate(const SceneView *sc, PathVertex *R, int *nR, Pat
 INLINE void portal_add(const SceneView *sc, BdptFilm *out, int s, int sp, int tp, int t, V3 c, float w, uint pixel,
 		       Rng *rng)
 {
-	GLOBAL const Params *prm = sc->params;
 	int n = s + sp + tp + t - 1;
-	if (n < prm->min_depth)
-		return;
-	V3 cw = v3_scale(c, w);
-	if (t == 1)
-		film_add(out->splat, pixel, cw, rng);
-	else
-		out->L = v3_add(out->L, cw);
-	if (n <= prm->strategy_len) {
-		uint npix = (uint)(prm->camera.width * prm->camera.height);
-		uint layer = (uint)(bdpt_layer_count(prm->strategy_len) + portal_layer(n, s, t));
-		film_add(out->layers + 3 * (ulong)npix * layer, pixel, prm->strategy_unweighted ? c : cw, rng);
-	}
+	int layer = bdpt_layer_count(sc->params->strategy_len) + portal_layer(n, s, t);
+	bdpt_film_add(sc, out, n, layer, t == 1, c, w, pixel, rng);
 }
 
 /* The eye-side end of portal strategies: -> vertex F[b] to eye vertex

@@ -74,6 +74,17 @@ INLINE void sample_triangle(float u1, float u2, float *b1, float *b2)
 	*b2 = u2 * s;
 }
 
+/* A uniform point *p on triangle (p0, p1, p2) and its unit normal *n,
+ * (p1 - p0) x (p2 - p0): the CCW front face. */
+INLINE void sample_triangle_point(V3 p0, V3 p1, V3 p2, float u1, float u2, V3 *p, V3 *n)
+{
+	float b1, b2;
+	sample_triangle(u1, u2, &b1, &b2);
+	V3 e1 = v3_sub(p1, p0), e2 = v3_sub(p2, p0);
+	*p = v3_add(p0, v3_add(v3_scale(e1, b1), v3_scale(e2, b2)));
+	*n = v3_norm(v3_cross(e1, e2));
+}
+
 /* Bucket i of a tabulated CDF (n + 1 entries, cdf[0] = 0, cdf[n] = 1) with
  * cdf[i] <= u < cdf[i + 1]. Zero-width buckets are never returned: the
  * search finds the last i with cdf[i] <= u, which is past any run of equal
