@@ -30,43 +30,13 @@ extern const unsigned ajar_layout_count;
 static char *root; /* temporary root: every cache directory lives here */
 static unsigned next_dir;
 
-static char *join(const char *dir, const char *name)
-{
-	size_t n = strlen(dir) + strlen(name) + 2;
-	char *p = malloc(n);
-	assert_non_null(p);
-	snprintf(p, n, "%s/%s", dir, name);
-	return p;
-}
-
-static void remove_tree(const char *dir)
-{
-	DIR *d = opendir(dir);
-	if (!d)
-		return;
-	struct dirent *e;
-	while ((e = readdir(d))) {
-		if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
-			continue;
-		char *p = join(dir, e->d_name);
-		struct stat st;
-		if (lstat(p, &st) == 0 && S_ISDIR(st.st_mode))
-			remove_tree(p);
-		else
-			unlink(p);
-		free(p);
-	}
-	closedir(d);
-	rmdir(dir);
-}
-
 /* A fresh, not yet existing cache directory that AJAR_CACHE_DIR names
  * (device.c creates it on the first write). */
 static char *fresh_cache_dir(void)
 {
 	char name[32];
 	snprintf(name, sizeof name, "cache%u", next_dir++);
-	char *dir = join(root, name);
+	char *dir = test_path(root, name);
 	assert_int_equal(setenv("AJAR_CACHE_DIR", dir, 1), 0);
 	return dir;
 }
@@ -101,7 +71,7 @@ static char *only_cache_file(const char *dir)
 	size_t len = strlen(names[0]);
 	if (strncmp(names[0], "kernel-", 7) != 0 || len < 4 || strcmp(names[0] + len - 4, ".bin") != 0)
 		fail_msg("%s: unexpected entry '%s'", dir, names[0]);
-	return join(dir, names[0]);
+	return test_path(dir, names[0]);
 }
 
 static unsigned char *read_all(const char *path, long *size)
@@ -285,7 +255,7 @@ static void test_corrupt_file_is_rebuilt(void **state)
 static void test_off_disables_the_cache(void **state)
 {
 	char *dir = fresh_cache_dir();
-	char *xdg = join(root, "xdg"), *home = join(root, "home");
+	char *xdg = test_path(root, "xdg"), *home = test_path(root, "home");
 	char names[4][256];
 	Device a, b;
 	build(&a, BASE_OPTIONS);
@@ -338,7 +308,7 @@ int main(void)
 		return 1;
 	}
 	/* Before any OpenCL call: PoCL reads it when the platform starts. */
-	char *pocl = join(root, "pocl");
+	char *pocl = test_path(root, "pocl");
 	setenv("POCL_CACHE_DIR", pocl, 1);
 	/* Every test names its own directory; until then nothing may touch
 	 * the user's cache. */
@@ -351,7 +321,7 @@ int main(void)
 		cmocka_unit_test(test_directory_fallbacks),
 	};
 	int rc = cmocka_run_group_tests_name("cache", tests, NULL, NULL);
-	remove_tree(root);
+	test_remove_tree(root);
 	free(pocl);
 	free(root);
 	return rc;

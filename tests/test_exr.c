@@ -17,15 +17,6 @@
 #include "exr.h"
 #include "testutil.h"
 
-static char *join(const char *dir, const char *name)
-{
-	size_t n = strlen(dir) + strlen(name) + 2;
-	char *p = malloc(n);
-	assert_non_null(p);
-	snprintf(p, n, "%s/%s", dir, name);
-	return p;
-}
-
 /* Number of entries in `dir` other than . and .. */
 static int count_entries(const char *dir)
 {
@@ -38,27 +29,6 @@ static int count_entries(const char *dir)
 			n++;
 	closedir(d);
 	return n;
-}
-
-static void remove_tree(const char *dir)
-{
-	DIR *d = opendir(dir);
-	if (!d)
-		return;
-	struct dirent *e;
-	while ((e = readdir(d))) {
-		if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
-			continue;
-		char *p = join(dir, e->d_name);
-		struct stat st;
-		if (stat(p, &st) == 0 && S_ISDIR(st.st_mode))
-			remove_tree(p);
-		else
-			unlink(p);
-		free(p);
-	}
-	closedir(d);
-	rmdir(dir);
 }
 
 static int file_exists(const char *path)
@@ -154,7 +124,7 @@ static float awkward(int i)
 static void test_roundtrip_bit_exact(void **state)
 {
 	char *dir = test_tmpdir();
-	char *path = join(dir, "round.exr");
+	char *path = test_path(dir, "round.exr");
 	/* 37 rows cross the 16-line ZIP chunks, the last one partial. */
 	const uint32_t w = 5, h = 37;
 	float *px = malloc(sizeof(float) * 4 * w * h);
@@ -192,7 +162,7 @@ static void test_roundtrip_bit_exact(void **state)
 
 	free(px);
 	free(path);
-	remove_tree(dir);
+	test_remove_tree(dir);
 	free(dir);
 }
 
@@ -200,7 +170,7 @@ static void test_roundtrip_bit_exact(void **state)
 static void test_read_mixed_types(void **state)
 {
 	char *dir = test_tmpdir();
-	char *path = join(dir, "mixed.exr");
+	char *path = test_path(dir, "mixed.exr");
 	enum { W = 3, H = 19 };
 	/* 0.5, 2, -0.25, 1, 65504, 0 as IEEE half bits. */
 	static const uint16_t half_bits[6] = {0x3800, 0x4000, 0xB400, 0x3C00, 0x7BFF, 0x0000};
@@ -229,7 +199,7 @@ static void test_read_mixed_types(void **state)
 	}
 	free(px);
 	free(path);
-	remove_tree(dir);
+	test_remove_tree(dir);
 	free(dir);
 }
 
@@ -237,7 +207,7 @@ static void test_read_mixed_types(void **state)
 static void test_read_tiled_y(void **state)
 {
 	char *dir = test_tmpdir();
-	char *path = join(dir, "tiled.exr");
+	char *path = test_path(dir, "tiled.exr");
 	enum { W = 7, H = 5 };
 	float y[W * H], a[W * H];
 	for (int i = 0; i < W * H; i++) {
@@ -259,7 +229,7 @@ static void test_read_tiled_y(void **state)
 	}
 	free(px);
 	free(path);
-	remove_tree(dir);
+	test_remove_tree(dir);
 	free(dir);
 }
 
@@ -269,12 +239,12 @@ static void test_read_errors(void **state)
 	float *px = (float *)&px; /* must be reset to NULL on failure */
 	uint32_t w, h;
 
-	char *missing = join(dir, "missing.exr");
+	char *missing = test_path(dir, "missing.exr");
 	assert_int_equal(ajar_read_exr(missing, &px, &w, &h), AJAR_ERROR_IO);
 	assert_null(px);
 	assert_non_null(strstr(ajar_last_error(), missing));
 
-	char *garbage = join(dir, "garbage.exr");
+	char *garbage = test_path(dir, "garbage.exr");
 	FILE *f = fopen(garbage, "wb");
 	assert_non_null(f);
 	fputs("this is not an OpenEXR file, only some text\n", f);
@@ -282,7 +252,7 @@ static void test_read_errors(void **state)
 	assert_int_equal(ajar_read_exr(garbage, &px, &w, &h), AJAR_ERROR_BAD_INPUT);
 	assert_non_null(strstr(ajar_last_error(), garbage));
 
-	char *empty = join(dir, "empty.exr");
+	char *empty = test_path(dir, "empty.exr");
 	f = fopen(empty, "wb");
 	assert_non_null(f);
 	fclose(f);
@@ -290,7 +260,7 @@ static void test_read_errors(void **state)
 	assert_non_null(strstr(ajar_last_error(), empty));
 
 	/* A valid file cut inside its header, then inside its pixel data. */
-	char *trunc = join(dir, "truncated.exr");
+	char *trunc = test_path(dir, "truncated.exr");
 	enum { W = 64, H = 64 };
 	float *img = malloc(sizeof(float) * 4 * W * H);
 	for (int i = 0; i < 4 * W * H; i++)
@@ -315,7 +285,7 @@ static void test_read_errors(void **state)
 	free(garbage);
 	free(empty);
 	free(trunc);
-	remove_tree(dir);
+	test_remove_tree(dir);
 	free(dir);
 }
 
@@ -325,7 +295,7 @@ static void test_write_errors(void **state)
 	float px[4 * 4] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16};
 
 	/* A directory that does not exist. */
-	char *nodir = join(dir, "no/such/dir/out.exr");
+	char *nodir = test_path(dir, "no/such/dir/out.exr");
 	assert_int_equal(ajar_write_exr(nodir, px, 2, 2, NULL, 0), AJAR_ERROR_IO);
 	assert_non_null(strstr(ajar_last_error(), nodir));
 	assert_false(file_exists(nodir));
@@ -334,9 +304,9 @@ static void test_write_errors(void **state)
 
 	/* The target is a non-empty directory: the temporary is written, the
 	 * rename fails, and nothing but the directory remains. */
-	char *sub = join(dir, "sub");
+	char *sub = test_path(dir, "sub");
 	assert_int_equal(mkdir(sub, 0755), 0);
-	char *inner = join(sub, "keep");
+	char *inner = test_path(sub, "keep");
 	fclose(fopen(inner, "wb"));
 	assert_int_equal(ajar_write_exr(sub, px, 2, 2, NULL, 0), AJAR_ERROR_IO);
 	assert_non_null(strstr(ajar_last_error(), sub));
@@ -346,7 +316,7 @@ static void test_write_errors(void **state)
 
 	/* A header attribute OpenEXR refuses (name too long) fails after the
 	 * temporary was created: it is removed, no target appears. */
-	char *out = join(dir, "out.exr");
+	char *out = test_path(dir, "out.exr");
 	char longname[300];
 	memset(longname, 'n', sizeof longname - 1);
 	longname[sizeof longname - 1] = '\0';
@@ -364,7 +334,7 @@ static void test_write_errors(void **state)
 	free(sub);
 	free(inner);
 	free(out);
-	remove_tree(dir);
+	test_remove_tree(dir);
 	free(dir);
 }
 
@@ -406,7 +376,7 @@ static void png_unfilter(unsigned char *rows, uint32_t width, uint32_t height)
 static void test_png(void **state)
 {
 	char *dir = test_tmpdir();
-	char *path = join(dir, "small.png");
+	char *path = test_path(dir, "small.png");
 	enum { W = 3, H = 2 };
 	/* Linear values and their sRGB 8-bit codes, worked out by hand:
 	 * 0.5 -> 1.055 * 0.5^(1/2.4) - 0.055 = 0.7354 -> 188; 0.2 -> 124;
@@ -469,7 +439,7 @@ static void test_png(void **state)
 		assert_memory_equal(rows + y * (1 + 3 * W) + 1, expect + y * 3 * W, 3 * W);
 
 	free(path);
-	remove_tree(dir);
+	test_remove_tree(dir);
 	free(dir);
 }
 

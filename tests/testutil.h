@@ -21,4 +21,8 @@ double chi2_sf(double x, double dof);
 
 /* A fresh temporary directory (removed by the caller) or NULL. */
 char *test_tmpdir(void);
+/* "dir/name", malloc'ed. */
+char *test_path(const char *dir, const char *name);
+/* Removes dir and everything under it (links are not followed). */
+void test_remove_tree(const char *dir);
 #endif
