@@ -51,10 +51,11 @@ INLINE int bdpt_mis_path(const SceneView *sc, const PathVertex *l, int s, const 
 	if (s > 0)
 		mv[s - 1].delta = 0;
 	mv[s].delta = 0;
+	const PathVertex *x0 = s > 0 ? &l[0] : &e[t - 1];
+	bdpt_light_records(sc, mv, x0, s >= 2 ? &l[1] : (s == 1 ? &e[t - 1] : &e[t - 2]), k);
 	if (s == 0) {
-		/* e[t-1] is the light: its origin density and emission density. */
+		/* e[t-1] is the light: its emission density. */
 		const PathVertex *lt = &e[t - 1];
-		mv[0].pf = bdpt_origin_pdf(sc, lt);
 		if (t >= 3)
 			mv[1].pf = bdpt_emission_pdf(sc, lt, &e[t - 2]);
 		return k;

@@ -5,6 +5,7 @@
  * bookkeeping of bdpt and of the portal integrator. */
 #ifndef AJAR_DENSITIES_H
 #define AJAR_DENSITIES_H
+#include "mis.h"
 #include "vertex.h"
 
 /* Emitted radiance and light-origin densities of a light vertex `l`
@@ -23,6 +24,24 @@ INLINE float bdpt_origin_pdf(const SceneView *sc, const PathVertex *l)
 	if (l->type == VERTEX_ENV)
 		return ps * env_pdf_w(sc, l->p);
 	return (1.0f - ps) * emitter_pdf_a(sc, l->tri);
+}
+
+/* Density of the light vertex as a next-event sample from vertex x
+ * (pn_0, the s = 1 strategy; lights.h, light_sample). */
+INLINE float bdpt_nee_pdf(const SceneView *sc, const PathVertex *l, const PathVertex *x)
+{
+	float ps = sc->params->env_pdf_select;
+	if (l->type == VERTEX_ENV)
+		return ps * env_nee_pdf_w(sc, x->p, l->p);
+	return (1.0f - ps) * emitter_pdf_a(sc, l->tri);
+}
+
+/* x_0's two densities in a path's MIS records: as the light subpath's
+ * origin (pf) and as a next-event sample from x_1 (pn). */
+INLINE void bdpt_light_records(const SceneView *sc, MisVertex *mv, const PathVertex *x0, const PathVertex *x1, int k)
+{
+	mv[0].pf = bdpt_origin_pdf(sc, x0);
+	mv[0].pn = k >= 3 ? bdpt_nee_pdf(sc, x0, x1) : mv[0].pf;
 }
 
 /* Density with which the light vertex's emission sampling produces `to`

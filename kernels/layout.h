@@ -7,7 +7,7 @@
 
 #define AJAR_LAYOUT_TYPES(X) \
 	X(BvhNode, 32) X(Tri, 48) X(TriShade, 64) X(Material, 64) X(Texture, 16) \
-	X(Emitter, 16) X(PortalTri, 48) X(Camera, 64) X(Params, 192)
+	X(Emitter, 16) X(PortalTri, 64) X(Camera, 64) X(Params, 192)
 
 #define AJAR_LAYOUT_FIELDS(X)                                                          \
 	X(BvhNode, bmin) X(BvhNode, index) X(BvhNode, bmax) X(BvhNode, count)          \
@@ -20,7 +20,8 @@
 	X(Material, alpha_cutoff)                                                       \
 	X(Texture, offset) X(Texture, width) X(Texture, height)                        \
 	X(Emitter, tri) X(Emitter, area) X(Emitter, pdf_select)                        \
-	X(PortalTri, p0) X(PortalTri, p2) X(PortalTri, area) X(PortalTri, pdf_select)  \
+	X(PortalTri, p0) X(PortalTri, p2) X(PortalTri, n) X(PortalTri, area)          \
+	X(PortalTri, pdf_select) X(PortalTri, side_plus) X(PortalTri, env_side)       \
 	X(Camera, pos) X(Camera, tan_half_fov_y) X(Camera, right) X(Camera, aspect)    \
 	X(Camera, up) X(Camera, width) X(Camera, forward) X(Camera, height)            \
 	X(Params, camera) X(Params, num_tris) X(Params, num_emitters)                  \

@@ -1,120 +1,14 @@
 /* lights.h — evaluating and sampling what emits light: emissive triangles
- * (one-sided, front = CCW), the environment (a constant colour or an
- * equirectangular image), and the portal triangles where intermediate
- * subpaths start. Tables come from src/lights.c.
- *
- * Environment convention: a unit direction d pointing from the scene out
- * to the sky maps to u = 0.5 + atan2(d.x, -d.z) / (2 pi),
- * v = acos(d.y) / pi, row 0 at the top (+Y), so the image centre looks
- * down -Z. Radiance is piecewise constant per texel (nearest texel); a
- * texel is sampled uniformly in (u, v), so the solid-angle density is
- * p_row p_col W H / (2 pi^2 sin(theta)), and env_sample reports exactly
- * what env_pdf_w returns for the same direction. Every pdf names its measure: _a area, _w solid angle. */
+ * (one-sided, front = CCW) and the environment (env.h, env_portal.h), for
+ * next-event estimation, and the portal triangles where intermediate
+ * subpaths start. Tables come from src/lights.c and src/portal_flux.c.
+ * Every pdf names its measure: _a area, _w solid angle. */
 #ifndef AJAR_KERNEL_LIGHTS_H
 #define AJAR_KERNEL_LIGHTS_H
 #include "types.h"
 #include "sampling.h"
 #include "bvh.h"
-
-/* Direction of equirect coordinates (u, v) in [0,1]^2. */
-INLINE V3 env_dir(float u, float v)
-{
-	float phi = 2.0f * AJAR_PI * (u - 0.5f), theta = AJAR_PI * v;
-	float st = sin(theta);
-	return v3(st * sin(phi), cos(theta), -st * cos(phi));
-}
-
-/* Texel (row, col) under unit direction d; returns sin(theta) of d. */
-INLINE float env_texel(GLOBAL const Params *prm, V3 d, int *row, int *col)
-{
-	float y = fmin(fmax(d.y, -1.0f), 1.0f);
-	float u = 0.5f + atan2(d.x, -d.z) * AJAR_INV_2PI;
-	float v = acos(y) * AJAR_INV_PI;
-	int w = prm->env_width, h = prm->env_height;
-	int c = (int)(u * (float)w), r = (int)(v * (float)h);
-	*col = c < 0 ? 0 : (c >= w ? w - 1 : c);
-	*row = r < 0 ? 0 : (r >= h ? h - 1 : r);
-	/* Not sqrt(1 - y^2): near the poles y rounds to 1 long before
-	 * sin(theta) is negligible. */
-	return sqrt(d.x * d.x + d.z * d.z);
-}
-
-INLINE V3 env_pixel(const SceneView *sc, int row, int col)
-{
-	int w = sc->params->env_width;
-	GLOBAL const float *p = sc->env + ENV_PIXELS(w, sc->params->env_height) + 3 * (row * w + col);
-	return v3(p[0], p[1], p[2]);
-}
-
-/* Solid-angle density of the image's own sampling at texel (row, col). */
-INLINE float env_texel_pdf_w(const SceneView *sc, int row, int col, float sin_theta)
-{
-	int w = sc->params->env_width, h = sc->params->env_height;
-	if (!(sin_theta > 0.0f))
-		return 0.0f;
-	GLOBAL const float *marg = sc->env + ENV_MARGINAL(w, h);
-	GLOBAL const float *cond = sc->env + ENV_CONDITIONAL(w, h) + row * (w + 1);
-	float p_uv = (marg[row + 1] - marg[row]) * (cond[col + 1] - cond[col]) * (float)(w * h);
-	return p_uv / (2.0f * AJAR_PI * AJAR_PI * sin_theta);
-}
-
-/* Radiance arriving from the sky along -d (d points to the sky). */
-INLINE V3 env_radiance(const SceneView *sc, V3 d)
-{
-	GLOBAL const Params *prm = sc->params;
-	if (prm->env_type == ENV_COLOR)
-		return prm->env_color;
-	if (prm->env_type != ENV_IMAGE)
-		return v3(0.0f, 0.0f, 0.0f);
-	int row, col;
-	env_texel(prm, d, &row, &col);
-	return env_pixel(sc, row, col);
-}
-
-/* Samples a sky direction *d by the environment's own distribution and
- * returns its radiance; *pdf_w = 0 (and black) if there is none, or, very
- * rarely, if rounding carried the sample into a texel that has none. */
-INLINE V3 env_sample(const SceneView *sc, float u1, float u2, V3 *d, float *pdf_w)
-{
-	GLOBAL const Params *prm = sc->params;
-	*pdf_w = 0.0f;
-	*d = v3(0.0f, 1.0f, 0.0f);
-	if (prm->env_type == ENV_COLOR) {
-		*d = sample_uniform_sphere(u1, u2);
-		*pdf_w = pdf_uniform_sphere_w();
-		return prm->env_color;
-	}
-	if (prm->env_type != ENV_IMAGE)
-		return v3(0.0f, 0.0f, 0.0f);
-	int w = prm->env_width, h = prm->env_height;
-	float p_row, p_col, ur, uc;
-	int row = sample_cdf(sc->env + ENV_MARGINAL(w, h), h, u1, &p_row, &ur);
-	if (row < 0)
-		return v3(0.0f, 0.0f, 0.0f);
-	int col = sample_cdf(sc->env + ENV_CONDITIONAL(w, h) + row * (w + 1), w, u2, &p_col, &uc);
-	if (col < 0)
-		return v3(0.0f, 0.0f, 0.0f);
-	*d = env_dir(((float)col + uc) / (float)w, ((float)row + ur) / (float)h);
-	/* Density and radiance from d's own texel, exactly what env_pdf_w
-	 * and env_radiance return for d, even where rounding put a sample on
-	 * a texel edge into the neighbour. */
-	float sin_theta = env_texel(prm, *d, &row, &col);
-	*pdf_w = env_texel_pdf_w(sc, row, col, sin_theta);
-	return *pdf_w > 0.0f ? env_pixel(sc, row, col) : v3(0.0f, 0.0f, 0.0f);
-}
-
-/* Solid-angle density with which env_sample returns direction d. */
-INLINE float env_pdf_w(const SceneView *sc, V3 d)
-{
-	GLOBAL const Params *prm = sc->params;
-	if (prm->env_type == ENV_COLOR)
-		return pdf_uniform_sphere_w();
-	if (prm->env_type != ENV_IMAGE)
-		return 0.0f;
-	int row, col;
-	float sin_theta = env_texel(prm, d, &row, &col);
-	return env_texel_pdf_w(sc, row, col, sin_theta);
-}
+#include "env_portal.h"
 
 /* Radiance leaving triangle `tri` in direction w (any length): the
  * material's emission on the front face, 0 behind it or if not emissive. */
@@ -167,8 +61,8 @@ typedef struct {
 } LightSample;
 
 /* Next-event estimation from shading point x: the environment with
- * probability Params.env_pdf_select, else an emitter by power and a
- * uniform point on it. Returns 0 when there is nothing to sample or the
+ * probability Params.env_pdf_select (through the portals that show x the
+ * sky, env_portal.h), else an emitter by power and a uniform point on it. Returns 0 when there is nothing to sample or the
  * sample cannot carry light (emitter seen from behind or edge-on, zero
  * distance, zero density); the caller then adds nothing. */
 INLINE int light_sample(const SceneView *sc, V3 x, float u_sel, float u1, float u2, LightSample *ls)
@@ -181,7 +75,7 @@ INLINE int light_sample(const SceneView *sc, V3 x, float u_sel, float u1, float 
 	if (u_sel < ps) {
 		float pdf_w;
 		V3 wi;
-		ls->Le = env_sample(sc, u1, u2, &wi, &pdf_w);
+		ls->Le = env_nee_sample(sc, x, u_sel / ps, u1, u2, &wi, &pdf_w);
 		if (!(pdf_w > 0.0f))
 			return 0;
 		ls->is_env = 1;
@@ -226,7 +120,7 @@ INLINE float light_pdf_w(const SceneView *sc, V3 x, V3 wi, int tri, float dist, 
 {
 	float ps = sc->params->env_pdf_select;
 	if (tri < 0)
-		return ps * env_pdf_w(sc, wi);
+		return ps * env_nee_pdf_w(sc, x, wi);
 	float pdf_a = emitter_pdf_a(sc, tri);
 	if (!(pdf_a > 0.0f) || !(cos_light > 0.0f))
 		return 0.0f;

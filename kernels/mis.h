@@ -8,7 +8,10 @@
  * (solid angle for a vertex at infinity). Strategy s takes x_0..x_{s-1} from
  * the light subpath and x_s..x_{k-1} from the eye subpath, so
  *     p_s = prod_{i<s} pf_i * prod_{i>=s} pr_i,
- *     p_{s+1} / p_s = pf_s / pr_s.
+ *     p_{s+1} / p_s = pf_s / pr_s,
+ * except that for s = 1 x_0 is a next-event sample from x_1, whose density
+ * pn_0 differs from the light subpath's pf_0 where next-event estimation
+ * aims through portals (env_portal.h).
  * Weights are computed from these ratios, never from raw products, which
  * overflow float. A density that involves a delta lobe is stored as 0 and
  * counts as 1 in the ratios: the same delta appears in every strategy that
@@ -40,6 +43,7 @@ INLINE float mis_balance(float a, float b)
 
 typedef struct {
 	float pf, pr;
+	float pn;     /* x_0 only: its density as a next-event sample from x_1 */
 	int delta;    /* scattered by a delta lobe: never a connection end */
 	int infinite; /* the environment: cannot connect to the camera */
 } MisVertex;
@@ -54,15 +58,23 @@ INLINE float mis_term(float r, int heuristic) { return heuristic == MIS_BALANCE 
  * x_{s'-1} and x_{s'}; s' = 0 means the eye subpath hit the light. */
 INLINE float mis_path_weight(const MisVertex *v, int k, int s, int heuristic)
 {
+	/* x_0's density is pn for s' = 1 and pf for s' >= 2. */
+	float pn_pf = mis_remap0(v[0].pn) / mis_remap0(v[0].pf);
 	float sum = 1.0f, r = 1.0f;
 	for (int i = s; i < k - 1; i++) { /* s' = i + 1: x_i moves to the light side */
-		r *= mis_remap0(v[i].pf) / mis_remap0(v[i].pr);
+		if (i == 0)
+			r *= mis_remap0(v[0].pn) / mis_remap0(v[0].pr);
+		else
+			r *= mis_remap0(v[i].pf) / mis_remap0(v[i].pr) / (i == 1 ? pn_pf : 1.0f);
 		if (!v[i].delta && !v[i + 1].delta && !(v[i].infinite && i + 1 == k - 1))
 			sum += mis_term(r, heuristic);
 	}
 	r = 1.0f;
 	for (int i = s - 1; i >= 0; i--) { /* s' = i: x_i moves to the eye side */
-		r *= mis_remap0(v[i].pr) / mis_remap0(v[i].pf);
+		if (i == 0)
+			r *= mis_remap0(v[0].pr) / mis_remap0(v[0].pn);
+		else
+			r *= mis_remap0(v[i].pr) / mis_remap0(v[i].pf) * (i == 1 ? pn_pf : 1.0f);
 		if (!v[i].delta && (i == 0 || !v[i - 1].delta))
 			sum += mis_term(r, heuristic);
 	}
@@ -117,7 +129,14 @@ INLINE void mis_prefix(const MisVertex *v, int k, float *PF, float *PR)
 	}
 }
 
-INLINE float mis_log_bdpt(const float *PF, const float *PR, int k, int s) { return PF[s] + PR[k] - PR[s]; }
+/* log of the light side's density of strategies with s light vertices:
+ * x_0 is a next-event sample (pn) when s = 1. */
+INLINE float mis_lpf(const float *PF, float lpn, int s) { return s == 1 ? lpn : PF[s]; }
+
+INLINE float mis_log_bdpt(const float *PF, float lpn, const float *PR, int k, int s)
+{
+	return mis_lpf(PF, lpn, s) + PR[k] - PR[s];
+}
 
 /* log(exp(a) + exp(b)) without overflow; -INF is the empty sum. */
 INLINE float mis_logadd(float a, float b)
@@ -141,13 +160,14 @@ INLINE float mis_union_weight(const MisVertex *v, int k, const int *cross, const
 	float PF[4 * 33 + 1], PR[4 * 33 + 1];
 	float beta = mis_beta(heuristic);
 	mis_prefix(v, k, PF, PR);
-	float lcur = cur.c == 1 ? mis_log_bdpt(PF, PR, k, cur.s)
-				: PF[cur.s] + (PR[cur.m] - PR[cur.s]) + lpair_cur + (PF[cur.m + cur.tp + 1] - PF[cur.m + 2]) +
-					  (PR[k] - PR[cur.m + cur.tp + 1]);
+	float lpn = log(mis_remap0(v[0].pn));
+	float lcur = cur.c == 1 ? mis_log_bdpt(PF, lpn, PR, k, cur.s)
+				: mis_lpf(PF, lpn, cur.s) + (PR[cur.m] - PR[cur.s]) + lpair_cur +
+					  (PF[cur.m + cur.tp + 1] - PF[cur.m + 2]) + (PR[k] - PR[cur.m + cur.tp + 1]);
 	float total = -AJAR_INF; /* log of sum of (p_j / p_cur)^beta */
 	for (int s = 0; s < k; s++)
 		if (mis_bdpt_valid(v, k, s))
-			total = mis_logadd(total, beta * (mis_log_bdpt(PF, PR, k, s) - lcur));
+			total = mis_logadd(total, beta * (mis_log_bdpt(PF, lpn, PR, k, s) - lcur));
 	for (int m = 0; m + 2 < k; m++) {
 		if (cross[m] <= 0)
 			continue;
@@ -155,7 +175,7 @@ INLINE float mis_union_weight(const MisVertex *v, int k, const int *cross, const
 		float left = -AJAR_INF, right = -AJAR_INF;
 		for (int s = max(0, m + 1 - set.sp_max); s <= m && s <= set.s_max; s++)
 			if (s == 0 || (!v[s - 1].delta && !v[s].delta))
-				left = mis_logadd(left, beta * (PF[s] + PR[m] - PR[s]));
+				left = mis_logadd(left, beta * (mis_lpf(PF, lpn, s) + PR[m] - PR[s]));
 		/* Right factor: t' >= 1 with m + t' <= k - 2 and a valid eye connection. */
 		for (int tp = 1; m + tp <= k - 2 && tp <= set.tp_max; tp++)
 			if (!v[m + tp].delta && !v[m + tp + 1].delta)

@@ -94,20 +94,31 @@ INLINE int path_edge_crossings(const SceneView *sc, const PathRef *P, int i)
 }
 
 /* The portal direction density, per projected solid angle about the
- * portal normal n_p, of the intermediate subpath whose <- half leaves
- * portal point w toward x_m (design.md; kernels/portal.h): a mixture of
- * the two-sided cosine (weight PORTAL_COSINE) and of a light sample from
- * w, which only counts when the <- half reaches the sampled light point:
- * x_m on an emitter's front face, or the environment. */
+ * normal of portal triangle pt, of the intermediate subpath whose <- half
+ * leaves portal point w toward x_m (kernels/portal.h): a mixture of
+ *   - PORTAL_COSINE: a side, +n with probability pt->side_plus, and a
+ *     cosine direction on it (side / pi per projected solid angle);
+ *   - the rest: a light sample from w, which only counts when the <- half
+ *     reaches the sampled light point: x_m on an emitter's front face, or
+ *     the environment, whose importance-sampled directions are folded
+ *     onto the portal's sky side (a direction and its mirror image in the
+ *     portal's plane both lead there). */
 #define PORTAL_COSINE 0.5f
 
-INLINE float portal_direction_psa(const SceneView *sc, const PathVertex *xm, V3 w, V3 n_p)
+INLINE V3 portal_mirror(V3 d, V3 n) { return v3_sub(d, v3_scale(n, 2.0f * v3_dot(d, n))); }
+
+INLINE float portal_direction_psa(const SceneView *sc, GLOBAL const PortalTri *pt, const PathVertex *xm, V3 w)
 {
+	float ps = sc->params->env_pdf_select;
 	V3 to_m; /* from w toward x_m */
 	float guided = 0.0f;
 	if (xm->type == VERTEX_ENV) {
 		to_m = xm->p;
-		guided = light_pdf_w(sc, w, to_m, -1, AJAR_INF, 1.0f);
+		float pe = env_pdf_w(sc, to_m);
+		if (pt->env_side != 0)
+			pe = (float)pt->env_side * v3_dot(to_m, pt->n) > 0.0f ? pe + env_pdf_w(sc, portal_mirror(to_m, pt->n))
+									 : 0.0f;
+		guided = ps * pe;
 	} else {
 		V3 d = v3_sub(xm->p, w);
 		float dist = v3_len(d);
@@ -116,20 +127,21 @@ INLINE float portal_direction_psa(const SceneView *sc, const PathVertex *xm, V3 
 		to_m = v3_scale(d, 1.0f / dist);
 		if (xm->tri >= 0 && sc->tris[xm->tri].emitter >= 0) {
 			float cos_l = -v3_dot(xm->ng, to_m); /* ng is the front face */
-			guided = light_pdf_w(sc, w, to_m, xm->tri, dist, cos_l);
+			guided = cos_l > 0.0f ? (1.0f - ps) * emitter_pdf_a(sc, xm->tri) * dist * dist / cos_l : 0.0f;
 		}
 	}
-	float c = fabs(v3_dot(to_m, n_p));
-	return PORTAL_COSINE * AJAR_INV_2PI + (c > 0.0f ? (1.0f - PORTAL_COSINE) * guided / c : 0.0f);
+	float cn = v3_dot(to_m, pt->n), c = fabs(cn);
+	float side = cn > 0.0f ? pt->side_plus : 1.0f - pt->side_plus;
+	return PORTAL_COSINE * side * AJAR_INV_PI + (c > 0.0f ? (1.0f - PORTAL_COSINE) * guided / c : 0.0f);
 }
 
 /* log p_pair = log(p_A q(w | portal point) G(x_m, x_{m+1})), geometric
- * normals, for the crossing of edge (a = x_m, b = x_{m+1}) at portal
- * point w of portal triangle normal n_p. */
-INLINE float portal_pair_log(const SceneView *sc, const PathVertex *a, const PathVertex *b, V3 w, V3 n_p)
+ * normals, for the crossing of edge (a = x_m, b = x_{m+1}) at point w of
+ * portal triangle pt, picked with probability pt->pdf_select. */
+INLINE float portal_pair_log(const SceneView *sc, GLOBAL const PortalTri *pt, const PathVertex *a,
+			     const PathVertex *b, V3 w)
 {
-	GLOBAL const PortalTri *pt = &sc->portals[0];
-	float pa = pt->pdf_select / pt->area; /* the same for every portal triangle */
+	float pa = pt->pdf_select / pt->area;
 	float g;
 	if (a->type == VERTEX_ENV) {
 		g = fabs(v3_dot(b->ng, a->p));
@@ -138,24 +150,7 @@ INLINE float portal_pair_log(const SceneView *sc, const PathVertex *a, const Pat
 		float d2 = v3_len2(d);
 		g = fabs(v3_dot(a->ng, d)) * fabs(v3_dot(b->ng, d)) / (d2 * d2);
 	}
-	return log(fmax(pa * portal_direction_psa(sc, a, w, n_p) * g, 1e-30f));
-}
-
-/* The normal of the portal triangle whose plane holds portal point w. */
-INLINE V3 portal_normal_at(const SceneView *sc, V3 w)
-{
-	V3 best_n = v3(0.0f, 0.0f, 1.0f);
-	float best = AJAR_INF;
-	for (int j = 0; j < sc->params->num_portals; j++) {
-		GLOBAL const PortalTri *pt = &sc->portals[j];
-		V3 n = v3_norm(v3_cross(v3_sub(pt->p1, pt->p0), v3_sub(pt->p2, pt->p0)));
-		float d = fabs(v3_dot(n, v3_sub(w, pt->p0)));
-		if (d < best) {
-			best = d;
-			best_n = n;
-		}
-	}
-	return best_n;
+	return log(fmax(pa * portal_direction_psa(sc, pt, a, w) * g, 1e-30f));
 }
 
 /* For edge (x_i, x_{i+1}): log of the sum over its portal crossings of
@@ -172,7 +167,7 @@ INLINE float path_pair_logsum(const SceneView *sc, const PathRef *P, int i, floa
 	float tmax = a->type == VERTEX_ENV ? AJAR_INF : 1.0f;
 	float sum = -AJAR_INF, hair2 = 1e-8f * sc->params->scene_radius * sc->params->scene_radius;
 	if (w0) {
-		*lcur = portal_pair_log(sc, a, b, *w0, portal_normal_at(sc, *w0));
+		*lcur = portal_pair_log(sc, &sc->portals[a->w0_tri], a, b, *w0);
 		sum = beta * *lcur;
 	}
 	for (int j = 0; j < sc->params->num_portals; j++) {
@@ -183,8 +178,7 @@ INLINE float path_pair_logsum(const SceneView *sc, const PathRef *P, int i, floa
 		V3 w = v3_add(o, v3_scale(d, t));
 		if (w0 && v3_len2(v3_sub(w, *w0)) < hair2)
 			continue;
-		V3 n_p = v3_norm(v3_cross(v3_sub(pt->p1, pt->p0), v3_sub(pt->p2, pt->p0)));
-		sum = mis_logadd(sum, beta * portal_pair_log(sc, a, b, w, n_p));
+		sum = mis_logadd(sum, beta * portal_pair_log(sc, pt, a, b, w));
 	}
 	return sum;
 }
@@ -210,11 +204,9 @@ INLINE void path_records(const SceneView *sc, const PathRef *P, int heuristic, M
 	if (P->c2 >= 0)
 		mv[P->c2].delta = mv[P->c2 + 1].delta = 0;
 	/* Densities the subpaths could not know. */
-	if (P->s == 0) {
-		mv[0].pf = path_pf(sc, P, mv, 0);
-		if (k > 2)
-			mv[1].pf = path_pf(sc, P, mv, 1);
-	}
+	bdpt_light_records(sc, mv, x[0], x[1], k);
+	if (P->s == 0 && k > 2)
+		mv[1].pf = path_pf(sc, P, mv, 1);
 	int conn[2] = {P->c1, P->c2};
 	for (int j = 0; j < 2; j++) {
 		int c = conn[j];

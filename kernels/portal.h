@@ -2,12 +2,13 @@
  * shared/seed, design.md "Path sampling and MIS"): every bdpt strategy plus
  * the strategies of one intermediate subpath per pixel sample.
  *
- * An intermediate subpath starts at a point w_0 on a portal (by area,
- * p_A = 1 / total portal area) with a direction w: with probability 1/2
- * from the two-sided cosine distribution (1 / 2 pi per projected solid
- * angle), else with -w toward a light sample from w_0, kept only if the
- * <- half reaches that light point (so the density of w is a function of
- * the path: path_mis.h, portal_direction_psa). The <- half traces -w
+ * An intermediate subpath starts at a point w_0 on a portal triangle,
+ * picked mostly by the direct light arriving through it (src/portal_flux.c;
+ * p_A = pdf_select / area), with a direction: with probability 1/2 a side,
+ * mostly the one the light comes from, and a cosine direction on it for
+ * the <- half, else the <- half toward a light sample from w_0, kept only
+ * if it reaches that light point (so the density is a function of the
+ * path: path_mis.h, portal_direction_psa). The <- half traces -w
  * toward the light, like an eye subpath, and its vertices connect to the
  * light subpath (s >= 2), to a fresh light sample (s = 1), or are the light
  * (s = 0). The -> half traces w, like a light subpath, and its vertices
@@ -32,6 +33,37 @@
 
 /* ---- The intermediate subpath -------------------------------------------- */
 
+/* A light sample from portal point w0 as the <- direction *wl: the
+ * environment by its importance, folded onto the portal's sky side, or an
+ * emitter point at distance *dist facing w0 (path_mis.h,
+ * portal_direction_psa). Returns 0 if there is none. */
+INLINE int portal_guided_sample(const SceneView *sc, GLOBAL const PortalTri *pt, V3 w0, float u_sel, float u1,
+				float u2, V3 *wl, int *is_env, float *dist)
+{
+	float ps = sc->params->env_pdf_select;
+	*is_env = u_sel < ps;
+	if (*is_env) {
+		float pdf_w;
+		env_sample(sc, u1, u2, wl, &pdf_w);
+		if (!(pdf_w > 0.0f))
+			return 0;
+		if (pt->env_side != 0 && (float)pt->env_side * v3_dot(*wl, pt->n) < 0.0f)
+			*wl = portal_mirror(*wl, pt->n);
+		return 1;
+	}
+	float u = fmin((u_sel - ps) / (1.0f - ps), 0.99999994f), pdf_a;
+	V3 p, nl;
+	if (emitter_sample(sc, u, u1, u2, &p, &nl, &pdf_a) < 0)
+		return 0;
+	V3 d = v3_sub(p, w0);
+	float d2 = v3_len2(d);
+	if (!(d2 > 0.0f))
+		return 0;
+	*dist = sqrt(d2);
+	*wl = v3_scale(d, 1.0f / *dist);
+	return -v3_dot(nl, *wl) > 0.0f;
+}
+
 /* Traces both halves; returns the vertex counts of R and F (each >= 2 when
  * the half has a first vertex, counting the copy at index 0), or 0 when
  * the sample is wasted. */
@@ -44,25 +76,23 @@ INLINE void portal_intermediate(const SceneView *sc, PathVertex *R, int *nR, Pat
 	V3 w0, n;
 	float pdf_a;
 	*nR = *nF = 0;
-	if (portal_sample(sc, u0, u1, u2, &w0, &n, &pdf_a) < 0 || !(pdf_a > 0.0f))
+	int j = portal_sample(sc, u0, u1, u2, &w0, &n, &pdf_a);
+	if (j < 0 || !(pdf_a > 0.0f))
 		return;
-	/* The direction: two-sided cosine, or the <- half toward a light
-	 * sample from w_0 (path_mis.h, portal_direction_psa). */
-	V3 w;
-	LightSample ls;
-	int guided = u_mix >= PORTAL_COSINE;
+	GLOBAL const PortalTri *pt = &sc->portals[j];
+	/* The <- direction wl: a side by what lies behind it and a cosine
+	 * direction on it, or toward a light sample from w_0. */
+	V3 wl;
+	int guided = u_mix >= PORTAL_COSINE, guided_env = 0;
+	float guided_dist = 0.0f;
 	if (!guided) {
-		V3 t, b;
-		v3_basis(n, &t, &b);
-		V3 lc = sample_cosine_hemisphere(u3, u4);
-		if (u5 < 0.5f)
-			lc.z = -lc.z;
-		w = v3_from_local(lc, t, b, n);
-	} else {
-		if (!light_sample(sc, w0, u3, u4, u5, &ls))
-			return;
-		w = v3_neg(ls.wi);
+		V3 ns = u5 < pt->side_plus ? pt->n : v3_neg(pt->n), t, b;
+		v3_basis(ns, &t, &b);
+		wl = v3_from_local(sample_cosine_hemisphere(u3, u4), t, b, ns);
+	} else if (!portal_guided_sample(sc, pt, w0, u5, u3, u4, &wl, &guided_env, &guided_dist)) {
+		return;
 	}
+	V3 w = v3_neg(wl);
 	/* The two first hits. The walks' "previous vertex" of each first hit
 	 * is the other one: the portal passes rays straight through. */
 	PathVertex origin;
@@ -78,9 +108,9 @@ INLINE void portal_intermediate(const SceneView *sc, PathVertex *R, int *nR, Pat
 		return; /* <- escaped and there is no environment */
 	PathVertex A = tmp[1];
 	if (guided) { /* counts only if the <- half reached the sampled light point */
-		int reached = ls.is_env ? A.type == VERTEX_ENV
-					: A.type == VERTEX_SURFACE && sc->tris[A.tri].emitter >= 0 &&
-						  fabs(v3_len(v3_sub(A.p, w0)) - ls.dist) <= 1e-3f * ls.dist + 1e-6f;
+		int reached = guided_env ? A.type == VERTEX_ENV
+					 : A.type == VERTEX_SURFACE && sc->tris[A.tri].emitter >= 0 &&
+						   fabs(v3_len(v3_sub(A.p, w0)) - guided_dist) <= 1e-3f * guided_dist + 1e-6f;
 		if (!reached)
 			return;
 	}
@@ -88,7 +118,8 @@ INLINE void portal_intermediate(const SceneView *sc, PathVertex *R, int *nR, Pat
 	A.cross = B.cross = cross_ab > 0 ? cross_ab : 1; /* w_0 lies on the edge */
 	A.pf = A.pr = B.pf = B.pr = 0.0f; /* the pair's own densities are p_pair */
 	A.w0 = B.w0 = w0;
-	float q = portal_direction_psa(sc, &A, w0, n);
+	A.w0_tri = B.w0_tri = j;
+	float q = portal_direction_psa(sc, pt, &A, w0);
 	if (!(q > 0.0f))
 		return;
 	float k = 1.0f / (pdf_a * q); /* f / p_pair = 1 / (p_A q): G cancels */

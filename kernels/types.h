@@ -67,13 +67,18 @@ typedef struct {
 	int pad0;
 } Emitter; /* 16 */
 
-/* Portal triangle: invisible to every ray, sampled by area (issue 4). */
+/* Portal triangle: invisible to every ray. The host measures the direct
+ * light arriving through it from each side (src/portal_flux.c): that picks
+ * the triangle for intermediate subpaths, the side their <- half leaves
+ * toward, and the side the environment is seen through. */
 typedef struct {
 	V3 p0, p1, p2;
+	V3 n;             /* unit, along (p1 - p0) x (p2 - p0) */
 	float area;
-	float pdf_select;
-	int pad0;
-} PortalTri; /* 48 */
+	float pdf_select; /* choice for intermediate subpaths: by flux, area as defence */
+	float side_plus;  /* probability that the <- half leaves toward +n */
+	int env_side;     /* +1 / -1: the side of n the environment lies behind; 0 none */
+} PortalTri; /* 64 */
 
 #define ENV_NONE 0
 #define ENV_COLOR 1

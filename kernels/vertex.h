@@ -39,6 +39,7 @@ typedef struct {
 	int tri;      /* hit triangle, -1 for camera, env */
 	int cross;    /* portal integrator: portal crossings of the edge to the previous vertex of this subpath */
 	V3 w0;        /* an intermediate subpath's first vertices: the portal point it started from */
+	int w0_tri;   /* and the portal triangle it lies on */
 } PathVertex;
 
 INLINE void vertex_bsdf(const SceneView *sc, const PathVertex *v, Bsdf *bs)
@@ -82,7 +83,7 @@ INLINE int vertex_trace(const SceneView *sc, PathVertex *path, int n, V3 o, V3 d
 			int parallel, int light_side, int escape_env)
 {
 	PathVertex *prev = &path[n - 1], *v = &path[n];
-	Hit h;
+	Hit h = {0.0f, 0.0f, 0.0f, -1}; /* gcc cannot see bvh_intersect set it */
 	int portals = sc->params->integrator == INTEGRATOR_PORTAL;
 	v->beta = beta;
 	v->wo = v3_neg(d);

@@ -17,10 +17,7 @@ static float tri_area(V3 p0, V3 p1, V3 p2)
 	return 0.5f * v3_len(v3_cross(v3_sub(p1, p0), v3_sub(p2, p0)));
 }
 
-/* cdf[0..n] from n non-negative weights (summed in double). With a zero
- * total the table is uniform if `uniform_if_empty`, else all zeros (which
- * sample_cdf treats as empty). Returns the total. */
-static double cdf_build(float *cdf, const double *w, uint32_t n, int uniform_if_empty)
+double cdf_build(float *cdf, const double *w, uint32_t n, int uniform_if_empty)
 {
 	double total = 0.0;
 	for (uint32_t i = 0; i < n; i++)
@@ -128,8 +125,11 @@ static ajar_status build_portals(PortalTri *portals, uint32_t n, LightTables *ou
 		area[i] = portals[i].area;
 	}
 	cdf_build(out->portal_cdf, area, n, 0);
-	for (uint32_t i = 0; i < n; i++)
+	for (uint32_t i = 0; i < n; i++) {
 		portals[i].pdf_select = out->portal_cdf[i + 1] - out->portal_cdf[i];
+		portals[i].side_plus = 0.5f; /* until src/portal_flux.c has looked */
+		portals[i].env_side = 0;
+	}
 	free(area);
 	return AJAR_OK;
 }

@@ -42,4 +42,9 @@ ajar_status lights_build(const Scene *s, Tri *tris, uint32_t ntris, const Materi
 			 LightTables *out);
 void lights_free(LightTables *t);
 
+/* cdf[0..n] from n non-negative weights (summed in double). With a zero
+ * total the table is uniform if `uniform_if_empty`, else all zeros (which
+ * sample_cdf treats as empty). Returns the total. */
+double cdf_build(float *cdf, const double *w, uint32_t n, int uniform_if_empty);
+
 #endif

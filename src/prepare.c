@@ -11,6 +11,7 @@
 #include <time.h>
 
 #include "error.h"
+#include "portal_flux.h"
 
 static double seconds(void)
 {
@@ -135,6 +136,16 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 		log_msg(AJAR_LOG_WARNING, "AJAR_PORTAL_SET='%s' is not three numbers s,s',t'; ignored", set);
 	p->emitter_power = d->lights.emitter_power;
 	p->env_power = d->lights.env_power;
+	/* What lies behind each side of the portals, with the kernels' own
+	 * tracing run here on the finished tables. */
+	SceneView view;
+#define PREPARE_VIEW(type, name) view.name = d->name;
+	AJAR_SCENE_BUFFERS(PREPARE_VIEW)
+#undef PREPARE_VIEW
+	if ((st = portal_flux_build(&view, d->portals, (uint32_t)d->n_portals, d->portal_cdf)) != AJAR_OK) {
+		prepare_free(d);
+		return st;
+	}
 	if (p->num_emitters == 0 && p->env_type == ENV_NONE)
 		log_msg(AJAR_LOG_WARNING, "%s: no emissive triangles and no environment: the image is black",
 			s->source);

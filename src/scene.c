@@ -267,8 +267,10 @@ ajar_status scene_add_portal(Scene *s, const char *what, const float *pos, uint3
 		p->p0 = load3(pos, k[0]);
 		p->p1 = load3(pos, k[1]);
 		p->p2 = load3(pos, k[2]);
-		p->area = 0.5f * v3_len(v3_cross(v3_sub(p->p1, p->p0), v3_sub(p->p2, p->p0)));
-		p->pdf_select = 0.0f;
+		V3 c = v3_cross(v3_sub(p->p1, p->p0), v3_sub(p->p2, p->p0));
+		p->area = 0.5f * v3_len(c);
+		p->n = p->area > 0.0f ? v3_norm(c) : v3(0.0f, 0.0f, 1.0f);
+		p->side_plus = 0.5f;
 	}
 	s->nportal_tris += ntris;
 	s->nportals++;

@@ -55,6 +55,11 @@ void oracle(const SceneView *sc, const PathVertex *x, const int *delta, int k, M
 			mv[i].pf = c > 0 ? oracle_convert(&x[0], &x[1], c / AJAR_PI) : 0;
 		} else
 			mv[i].pf = delta[i - 1] ? 0 : oracle_convert(&x[i - 1], &x[i], oracle_bsdf(sc, &x[i - 1], &x[i - 2], &x[i]));
+		/* pn: x_0 as a next-event sample from x_1 */
+		if (i == 0)
+			mv[0].pn = k < 3 ? mv[0].pf
+					 : x[0].type == VERTEX_ENV ? ps * env_nee_pdf_w(sc, x[1].p, x[0].p)
+								    : (1 - ps) * emitter_pdf_a(sc, x[0].tri);
 		/* pr */
 		if (i == k - 1)
 			mv[i].pr = 1;
@@ -125,9 +130,6 @@ static int crosses(const double *o, const double *d, double tmax, V3 a, V3 b, V3
 	return *th > 0 && *th < tmax;
 }
 
-/* Density per projected solid angle of the portal direction toward a
- * (x_m) from portal point w with portal normal n: half two-sided cosine,
- * half a light sample from w that reached a (design of kernels/portal.h). */
 /* The emitter triangle that point p lies on, found by geometry (not from
  * the vertex's own bookkeeping), or -1. */
 static int emitter_at(const SceneView *sc, V3 p)
@@ -147,12 +149,24 @@ static int emitter_at(const SceneView *sc, V3 p)
 	return -1;
 }
 
-static double direction_psa(const SceneView *sc, const PathVertex *a, const double *w, const double *n)
+/* Density per projected solid angle of the portal direction toward a
+ * (x_m) from point w of portal triangle pt (design of kernels/portal.h):
+ * half a side (+n with probability side_plus) and a cosine direction on
+ * it; half a light sample from w that reached a, environment directions
+ * folded onto the portal's sky side. */
+static double direction_psa(const SceneView *sc, GLOBAL const PortalTri *pt, const PathVertex *a, const double *w)
 {
-	double to[3], guided = 0;
+	double to[3], guided = 0, n[3] = {pt->n.x, pt->n.y, pt->n.z};
+	double ps = sc->params->env_pdf_select;
 	if (a->type == VERTEX_ENV) {
 		to[0] = a->p.x, to[1] = a->p.y, to[2] = a->p.z;
-		guided = sc->params->env_pdf_select * env_pdf_w(sc, a->p);
+		double pe = env_pdf_w(sc, a->p);
+		if (pt->env_side != 0) {
+			double dn = to[0] * n[0] + to[1] * n[1] + to[2] * n[2];
+			V3 mirror = v3((float)(to[0] - 2 * dn * n[0]), (float)(to[1] - 2 * dn * n[1]), (float)(to[2] - 2 * dn * n[2]));
+			pe = dn * pt->env_side > 0 ? pe + env_pdf_w(sc, mirror) : 0;
+		}
+		guided = ps * pe;
 	} else {
 		double d[3] = {a->p.x - w[0], a->p.y - w[1], a->p.z - w[2]};
 		double dist = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
@@ -163,11 +177,12 @@ static double direction_psa(const SceneView *sc, const PathVertex *a, const doub
 			V3 fn = v3_norm(tri_normal(&sc->tris[tri]));
 			double cos_l = -(fn.x * to[0] + fn.y * to[1] + fn.z * to[2]);
 			if (cos_l > 0)
-				guided = (1 - sc->params->env_pdf_select) * emitter_pdf_a(sc, tri) * dist * dist / cos_l;
+				guided = (1 - ps) * emitter_pdf_a(sc, tri) * dist * dist / cos_l;
 		}
 	}
-	double c = fabs(to[0] * n[0] + to[1] * n[1] + to[2] * n[2]);
-	return 0.5 / (2 * M_PI) + (c > 0 ? 0.5 * guided / c : 0);
+	double cn = to[0] * n[0] + to[1] * n[1] + to[2] * n[2], c = fabs(cn);
+	double side = cn > 0 ? pt->side_plus : 1 - pt->side_plus;
+	return 0.5 * side / M_PI + (c > 0 ? 0.5 * guided / c : 0);
 }
 
 int oracle_pair_logs(const SceneView *sc, const PathVertex *a, const PathVertex *b, double *lp, double (*pts)[3],
@@ -184,9 +199,6 @@ int oracle_pair_logs(const SceneView *sc, const PathVertex *a, const PathVertex 
 		o[0] = a->p.x, o[1] = a->p.y, o[2] = a->p.z;
 		d[0] = b->p.x - a->p.x, d[1] = b->p.y - a->p.y, d[2] = b->p.z - a->p.z;
 	}
-	double area = 0;
-	for (int i = 0; i < sc->params->num_portals; i++)
-		area += sc->portals[i].area;
 	double g;
 	if (a->type == VERTEX_ENV) {
 		g = fabs(v3_dot(b->ng, a->p));
@@ -202,10 +214,8 @@ int oracle_pair_logs(const SceneView *sc, const PathVertex *a, const PathVertex 
 		if (!crosses(o, d, tmax, t->p0, t->p1, t->p2, &th))
 			continue;
 		double w[3] = {o[0] + th * d[0], o[1] + th * d[1], o[2] + th * d[2]};
-		V3 nv = v3_norm(v3_cross(v3_sub(t->p1, t->p0), v3_sub(t->p2, t->p0)));
-		double nn[3] = {nv.x, nv.y, nv.z};
 		if (n < max) {
-			lp[n] = log(direction_psa(sc, a, w, nn) * g / area);
+			lp[n] = log(direction_psa(sc, t, a, w) * g * t->pdf_select / t->area);
 			if (pts)
 				for (int c = 0; c < 3; c++)
 					pts[n][c] = w[c];

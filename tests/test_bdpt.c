@@ -84,6 +84,8 @@ static int check_mis(HostScene *h, int nsamples)
 					if (i == k - 1 || (i == 0 && t == k))
 						continue; /* camera's pf, and pr of ... never used */
 					double diff = fmax(rel_diff(rec[i].pf, orc[i].pf), rel_diff(rec[i].pr, orc[i].pr));
+					if (i == 0)
+						diff = fmax(diff, rel_diff(rec[0].pn, orc[0].pn));
 					records++;
 					off += diff > 1e-2;
 					if ((diff > 0.1 && !near_contact(x, k, i, prm->scene_radius)) ||

@@ -55,15 +55,17 @@ static void check_path(const SceneView *sc, const PathRef *P, MisStats *st)
 		if (i == k - 1)
 			continue; /* the camera's pf is never used */
 		double diff = fmax(rel_diff(rec[i].pf, orc[i].pf), rel_diff(rec[i].pr, orc[i].pr));
+		if (i == 0)
+			diff = fmax(diff, rel_diff(rec[0].pn, orc[0].pn));
 		st->records++;
 		st->off += diff > 1e-2;
 		/* Narrow glossy lobes amplify the ray-offset direction change
 		 * (mis_oracle.h); bugs are systematic and fail the 1% count. */
 		if ((diff > 0.5 && !near_contact(x, k, i, sc->params->scene_radius)) || rec[i].delta != orc[i].delta)
-			fail_msg("path (s=%d, s'=%d, t'=%d, t=%d), vertex %d of %d: kernel pf %g pr %g delta %d, "
-				 "oracle pf %g pr %g delta %d",
-				 P->s, P->sp, P->tp, P->t, i, k, rec[i].pf, rec[i].pr, rec[i].delta, orc[i].pf, orc[i].pr,
-				 orc[i].delta);
+			fail_msg("path (s=%d, s'=%d, t'=%d, t=%d), vertex %d of %d: kernel pf %g pr %g pn %g delta %d, "
+				 "oracle pf %g pr %g pn %g delta %d",
+				 P->s, P->sp, P->tp, P->t, i, k, rec[i].pf, rec[i].pr, i ? 0 : rec[0].pn, rec[i].delta,
+				 orc[i].pf, orc[i].pr, i ? 0 : orc[0].pn, orc[i].delta);
 	}
 	/* Crossings and pair densities from the oracle; each crossing is a
 	 * strategy of its own. */

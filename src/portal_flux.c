@@ -1,0 +1,101 @@
+/* portal_flux.c — the direct light that arrives through each portal
+ * triangle from each of its sides, estimated at load time with the
+ * kernels' own code run on the host: from uniform points on the triangle,
+ * cosine-distributed rays toward the side find the environment where they
+ * escape, and next-event samples of the emitters (with shadow rays) find
+ * the emitters behind that side. Per side, the flux is
+ *     Phi = A (pi E[L_env escaping] + E[L_e cos cos' / (d^2 p_A)]).
+ * From it:
+ *   - env_side: the side the environment is seen through (next-event
+ *     estimation through portals, kernels/env_portal.h), 0 if neither;
+ *   - side_plus: the probability that an intermediate subpath's <- half
+ *     leaves toward +n, SIDE_FLOOR + (1 - 2 SIDE_FLOOR) Phi+ / (Phi+ + Phi-);
+ *   - pdf_select: the triangle choice, (1 - AREA_SHARE) by flux and
+ *     AREA_SHARE by area, a defence for what direct light misses (light
+ *     that arrives after a bounce).
+ * The kernels' densities read these numbers, so any values are unbiased;
+ * the estimate only decides how well the samples are spent. Fixed seeds:
+ * a scene always gets the same tables. */
+#include "portal_flux.h"
+
+#include <stdlib.h>
+
+#include "error.h"
+#include "lights.h"
+#include "../kernels/lights.h"
+#include "../kernels/rng.h"
+#include "../kernels/surface.h"
+
+#define FLUX_SAMPLES 2048
+#define SIDE_FLOOR 0.1f
+#define AREA_SHARE 0.25
+
+/* Direct light arriving at triangle pt from side `side` (+1 / -1): the
+ * environment's share in env[0], the emitters' in emit[0]. */
+static void side_flux(const SceneView *sc, const PortalTri *pt, uint32_t index, int side, double *env, double *emit)
+{
+	V3 n = v3_scale(pt->n, (float)side), t, b;
+	v3_basis(n, &t, &b);
+	double se = 0.0, sl = 0.0;
+	Rng rng = rng_init(0x9e3779b9u, index, side > 0 ? 1u : 2u, 7u);
+	for (int i = 0; i < FLUX_SAMPLES; i++) {
+		V3 p, ng;
+		sample_triangle_point(pt->p0, pt->p1, pt->p2, rng_f(&rng), rng_f(&rng), &p, &ng);
+		float u1 = rng_f(&rng), u2 = rng_f(&rng);
+		V3 d = v3_from_local(sample_cosine_hemisphere(u1, u2), t, b, n);
+		if (!bvh_occluded(sc, p, d, AJAR_INF))
+			se += v3_lum(env_radiance(sc, d));
+		/* The emitters: a point by power, seen from this side. */
+		float pdf_a;
+		V3 q, nq;
+		int tri = emitter_sample(sc, rng_f(&rng), rng_f(&rng), rng_f(&rng), &q, &nq, &pdf_a);
+		if (tri < 0 || !(pdf_a > 0.0f))
+			continue;
+		V3 to = v3_sub(q, p);
+		float d2 = v3_len2(to);
+		if (!(d2 > 0.0f))
+			continue;
+		V3 w = v3_scale(to, 1.0f / sqrt(d2));
+		float cos_p = v3_dot(w, n), cos_q = -v3_dot(w, nq);
+		if (!(cos_p > 0.0f) || !(cos_q > 0.0f) || !segment_clear(sc, p, n, q, nq))
+			continue;
+		sl += v3_lum(sc->materials[sc->tris[tri].material].emission) * cos_p * cos_q / (d2 * pdf_a);
+	}
+	*env = pt->area * AJAR_PI * se / FLUX_SAMPLES;
+	*emit = pt->area * sl / FLUX_SAMPLES;
+}
+
+ajar_status portal_flux_build(const SceneView *sc, PortalTri *portals, uint32_t n, float *portal_cdf)
+{
+	if (n == 0)
+		return AJAR_OK;
+	double *w = calloc(n, sizeof *w), *flux = calloc(n, sizeof *flux);
+	if (!w || !flux) {
+		free(w);
+		free(flux);
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "portals: out of memory for %u portal triangles", n);
+	}
+	double area_total = 0.0, flux_total = 0.0;
+	for (uint32_t j = 0; j < n; j++) {
+		PortalTri *pt = &portals[j];
+		double env_p, emit_p, env_m, emit_m;
+		side_flux(sc, pt, j, 1, &env_p, &emit_p);
+		side_flux(sc, pt, j, -1, &env_m, &emit_m);
+		pt->env_side = env_p > env_m ? 1 : (env_m > 0.0 ? -1 : 0);
+		double plus = env_p + emit_p, minus = env_m + emit_m;
+		pt->side_plus = plus + minus > 0.0 ? SIDE_FLOOR + (1.0f - 2.0f * SIDE_FLOOR) * (float)(plus / (plus + minus))
+						   : 0.5f;
+		flux[j] = plus + minus;
+		flux_total += flux[j];
+		area_total += pt->area;
+	}
+	for (uint32_t j = 0; j < n; j++)
+		w[j] = flux_total > 0.0 ? AREA_SHARE * portals[j].area / area_total + (1.0 - AREA_SHARE) * flux[j] / flux_total
+					: portals[j].area;
+	cdf_build(portal_cdf, w, n, 0);
+	for (uint32_t j = 0; j < n; j++)
+		portals[j].pdf_select = portal_cdf[j + 1] - portal_cdf[j];
+	free(w);
+	free(flux);
+	return AJAR_OK;
+}
