@@ -32,27 +32,37 @@ INLINE float sph_tri_solid_angle(V3 a, V3 b, V3 c)
 }
 
 /* A direction uniform within the spherical triangle (a, b, c) of solid
- * angle `omega` (Arvo 1995): u1 picks the sub-triangle (a, b, c') of solid
- * angle u1 omega, u2 the point on the arc from b to c'. */
+ * angle `omega` (after Arvo 1995): u1 picks the sub-triangle (a, b, c')
+ * of solid angle u1 omega, u2 the point on the arc from b to c'. Written
+ * with half-angle tangents and differences of nearby unit vectors rather
+ * than Arvo's cosines, which lose the sub-triangle's corner c' in float
+ * when it is thin (u1 near 0) or the arcs are short. The arc theta from
+ * a to c' follows from the excess of a triangle with sides theta and
+ * |ab| and angle alpha between them:
+ *   tan(E / 2) = tan(theta / 2) tan(|ab| / 2) sin(alpha) / (1 + tan(theta / 2) tan(|ab| / 2) cos(alpha)). */
 INLINE V3 sph_tri_sample(V3 a, V3 b, V3 c, float omega, float u1, float u2)
 {
 	V3 nab = v3_cross(a, b), nac = v3_cross(a, c);
-	float cos_alpha = v3_dot(nab, nac) / sqrt(v3_len2(nab) * v3_len2(nac));
-	cos_alpha = fmin(fmax(cos_alpha, -1.0f), 1.0f);
-	float alpha = acos(cos_alpha), sin_alpha = sin(alpha);
-	float sub = u1 * omega;
-	float s = sin(sub - alpha), t = cos(sub - alpha);
-	float u = t - cos_alpha, v = s + sin_alpha * v3_dot(a, b);
-	float q = ((v * t - u * s) * cos_alpha - v) / ((v * s + u * t) * sin_alpha);
-	q = fmin(fmax(q, -1.0f), 1.0f);
-	V3 c_perp = v3_sub(c, v3_scale(a, v3_dot(c, a)));
-	V3 cp = v3_add(v3_scale(a, q), v3_scale(v3_norm(c_perp), sqrt(fmax(0.0f, 1.0f - q * q))));
-	float z = 1.0f - u2 * (1.0f - v3_dot(cp, b));
-	V3 cp_perp = v3_sub(cp, v3_scale(b, v3_dot(cp, b)));
-	float len = v3_len(cp_perp);
+	float inv = 1.0f / sqrt(v3_len2(nab) * v3_len2(nac));
+	float cos_alpha = v3_dot(nab, nac) * inv, sin_alpha = v3_len(v3_cross(nab, nac)) * inv;
+	float k = v3_len(nab) / (1.0f + v3_dot(a, b)); /* tan(|ab| / 2) */
+	float te = tan(0.5f * u1 * omega);
+	float den = k * (sin_alpha - te * cos_alpha);
+	V3 cp = c;
+	if (den > 0.0f) {
+		float tt = te / den, tt2 = tt * tt; /* tan(theta / 2) */
+		V3 ca = v3_sub(c, a);
+		V3 c_perp = v3_norm(v3_add(ca, v3_scale(a, 0.5f * v3_len2(ca))));
+		cp = v3_add(v3_scale(a, (1.0f - tt2) / (1.0f + tt2)), v3_scale(c_perp, 2.0f * tt / (1.0f + tt2)));
+	}
+	/* 1 - cos of the arc from b: u2 times that of c', |c' - b|^2 / 2. */
+	V3 d = v3_sub(cp, b);
+	float d2 = v3_len2(d), h = u2 * 0.5f * d2;
+	V3 perp = v3_add(d, v3_scale(b, 0.5f * d2));
+	float len = v3_len(perp);
 	if (!(len > 0.0f))
 		return b;
-	return v3_add(v3_scale(b, z), v3_scale(cp_perp, sqrt(fmax(0.0f, 1.0f - z * z)) / len));
+	return v3_add(v3_scale(b, 1.0f - h), v3_scale(perp, sqrt(fmax(0.0f, h * (2.0f - h))) / len));
 }
 
 /* Solid angle of portal triangle pt seen from x when x lies on its room

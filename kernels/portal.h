@@ -64,6 +64,36 @@ INLINE int portal_guided_sample(const SceneView *sc, GLOBAL const PortalTri *pt,
 	return -v3_dot(nl, *wl) > 0.0f;
 }
 
+/* The <- direction *wl from point w0 of portal triangle pt (path_mis.h,
+ * portal_direction_psa): with probability PORTAL_COSINE a side, by what
+ * lies behind it, and a cosine direction on it; else toward a light
+ * sample (*guided_env, *guided_dist say which). Returns 0 if there is
+ * none, 1 for a cosine direction, 2 for a light sample, which counts only
+ * if the <- half reaches it (portal_guided_reached). */
+INLINE int portal_direction_sample(const SceneView *sc, GLOBAL const PortalTri *pt, V3 w0, float u_mix, float u1,
+				   float u2, float u3, V3 *wl, int *guided_env, float *guided_dist)
+{
+	*guided_env = 0;
+	*guided_dist = 0.0f;
+	if (u_mix < PORTAL_COSINE) {
+		V3 ns = u3 < pt->side_plus ? pt->n : v3_neg(pt->n), t, b;
+		v3_basis(ns, &t, &b);
+		*wl = v3_from_local(sample_cosine_hemisphere(u1, u2), t, b, ns);
+		return 1;
+	}
+	return portal_guided_sample(sc, pt, w0, u3, u1, u2, wl, guided_env, guided_dist) ? 2 : 0;
+}
+
+/* Whether the <- half's first vertex A is the light point a guided
+ * direction aimed at. */
+INLINE int portal_guided_reached(const SceneView *sc, const PathVertex *A, V3 w0, int guided_env, float guided_dist)
+{
+	if (guided_env)
+		return A->type == VERTEX_ENV;
+	return A->type == VERTEX_SURFACE && sc->tris[A->tri].emitter >= 0 &&
+	       fabs(v3_len(v3_sub(A->p, w0)) - guided_dist) <= 1e-3f * guided_dist + 1e-6f;
+}
+
 /* Traces both halves; returns the vertex counts of R and F (each >= 2 when
  * the half has a first vertex, counting the copy at index 0), or 0 when
  * the sample is wasted. */
@@ -80,18 +110,12 @@ INLINE void portal_intermediate(const SceneView *sc, PathVertex *R, int *nR, Pat
 	if (j < 0 || !(pdf_a > 0.0f))
 		return;
 	GLOBAL const PortalTri *pt = &sc->portals[j];
-	/* The <- direction wl: a side by what lies behind it and a cosine
-	 * direction on it, or toward a light sample from w_0. */
 	V3 wl;
-	int guided = u_mix >= PORTAL_COSINE, guided_env = 0;
-	float guided_dist = 0.0f;
-	if (!guided) {
-		V3 ns = u5 < pt->side_plus ? pt->n : v3_neg(pt->n), t, b;
-		v3_basis(ns, &t, &b);
-		wl = v3_from_local(sample_cosine_hemisphere(u3, u4), t, b, ns);
-	} else if (!portal_guided_sample(sc, pt, w0, u5, u3, u4, &wl, &guided_env, &guided_dist)) {
+	int guided_env;
+	float guided_dist;
+	int how = portal_direction_sample(sc, pt, w0, u_mix, u3, u4, u5, &wl, &guided_env, &guided_dist);
+	if (how == 0)
 		return;
-	}
 	V3 w = v3_neg(wl);
 	/* The two first hits. The walks' "previous vertex" of each first hit
 	 * is the other one: the portal passes rays straight through. */
@@ -107,13 +131,8 @@ INLINE void portal_intermediate(const SceneView *sc, PathVertex *R, int *nR, Pat
 	if (!vertex_trace(sc, tmp, 1, w0, v3_neg(w), v3(1.0f, 1.0f, 1.0f), 0.0f, 0, 0, 1))
 		return; /* <- escaped and there is no environment */
 	PathVertex A = tmp[1];
-	if (guided) { /* counts only if the <- half reached the sampled light point */
-		int reached = guided_env ? A.type == VERTEX_ENV
-					 : A.type == VERTEX_SURFACE && sc->tris[A.tri].emitter >= 0 &&
-						   fabs(v3_len(v3_sub(A.p, w0)) - guided_dist) <= 1e-3f * guided_dist + 1e-6f;
-		if (!reached)
-			return;
-	}
+	if (how == 2 && !portal_guided_reached(sc, &A, w0, guided_env, guided_dist))
+		return;
 	int cross_ab = A.type == VERTEX_ENV ? portal_crossings(sc, B.p, A.p, 1) : portal_crossings(sc, A.p, B.p, 0);
 	A.cross = B.cross = cross_ab > 0 ? cross_ab : 1; /* w_0 lies on the edge */
 	A.pf = A.pr = B.pf = B.pr = 0.0f; /* the pair's own densities are p_pair */
