@@ -7,7 +7,7 @@
 
 #define AJAR_LAYOUT_TYPES(X) \
 	X(BvhNode, 32) X(Tri, 48) X(TriShade, 64) X(Material, 64) X(Texture, 16) \
-	X(Emitter, 16) X(PortalTri, 64) X(Camera, 64) X(Params, 192)
+	X(Emitter, 16) X(PortalTri, 64) X(Camera, 64) X(Params, 208)
 
 #define AJAR_LAYOUT_FIELDS(X)                                                          \
 	X(BvhNode, bmin) X(BvhNode, index) X(BvhNode, bmax) X(BvhNode, count)          \
@@ -33,5 +33,6 @@
 	X(Params, env_power) X(Params, mis) X(Params, min_depth)                       \
 	X(Params, strategy_len) X(Params, strategy_unweighted) X(Params, cross_filter)  \
 	X(Params, cross_lo) X(Params, cross_hi) X(Params, portal_s_max)                   \
-	X(Params, portal_sp_max) X(Params, portal_tp_max)
+	X(Params, portal_sp_max) X(Params, portal_tp_max) X(Params, light_paths) \
+	X(Params, portal_t_max)
 #endif

@@ -103,10 +103,13 @@ typedef struct {
 } MisStrategy;
 
 /* Which intermediate strategies are in use: at most s_max light vertices,
- * sp_max <- vertices (s' = m - s + 1) and tp_max -> vertices. The weights
+ * sp_max <- vertices (s' = m - s + 1), tp_max -> vertices and t_max eye
+ * vertices. The weights
  * sum over exactly these, so any choice is unbiased. */
 typedef struct {
 	int s_max, sp_max, tp_max;
+	int t_max;       /* eye vertices, camera included */
+	int light_paths; /* 0: bdpt strategies only with s <= 1 and t >= 2 (no light subpaths) */
 } MisPortalSet;
 
 INLINE int mis_bdpt_valid(const MisVertex *v, int k, int s)
@@ -166,7 +169,7 @@ INLINE float mis_union_weight(const MisVertex *v, int k, const int *cross, const
 					  (PF[cur.m + cur.tp + 1] - PF[cur.m + 2]) + (PR[k] - PR[cur.m + cur.tp + 1]);
 	float total = -AJAR_INF; /* log of sum of (p_j / p_cur)^beta */
 	for (int s = 0; s < k; s++)
-		if (mis_bdpt_valid(v, k, s))
+		if (mis_bdpt_valid(v, k, s) && (set.light_paths || (s <= 1 && s < k - 1)))
 			total = mis_logadd(total, beta * (mis_log_bdpt(PF, lpn, PR, k, s) - lcur));
 	for (int m = 0; m + 2 < k; m++) {
 		if (cross[m] <= 0)
@@ -178,7 +181,7 @@ INLINE float mis_union_weight(const MisVertex *v, int k, const int *cross, const
 				left = mis_logadd(left, beta * (mis_lpf(PF, lpn, s) + PR[m] - PR[s]));
 		/* Right factor: t' >= 1 with m + t' <= k - 2 and a valid eye connection. */
 		for (int tp = 1; m + tp <= k - 2 && tp <= set.tp_max; tp++)
-			if (!v[m + tp].delta && !v[m + tp + 1].delta)
+			if (!v[m + tp].delta && !v[m + tp + 1].delta && k - m - tp - 1 <= set.t_max)
 				right = mis_logadd(right, beta * ((PF[m + tp + 1] - PF[m + 2]) + (PR[k] - PR[m + tp + 1])));
 		float term = left + right + lpsum[m] - beta * lcur;
 		total = mis_logadd(total, term);

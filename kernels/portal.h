@@ -193,7 +193,7 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 				PathVertex *F, BdptFilm *out, Rng *rng)
 {
 	int depth = sc->params->max_depth;
-	int nl = bdpt_light_subpath(sc, l, depth, rng);
+	int nl = sc->params->light_paths ? bdpt_light_subpath(sc, l, depth, rng) : 0;
 	int ne = bdpt_eye_subpath(sc, px, py, e, depth + 1, rng);
 	int nR, nF;
 	portal_intermediate(sc, R, &nR, F, &nF, rng);
@@ -207,7 +207,7 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 	while (nR >= 2 && nF >= 2 && b0 < nF) {
 		int nr = 0;
 		for (; b0 < nF && nr < PORTAL_RIGHT_MAX; b0++, t0 = 1) {
-			for (; t0 <= ne && nr < PORTAL_RIGHT_MAX; t0++) {
+			for (; t0 <= ne && t0 <= sc->params->portal_t_max && nr < PORTAL_RIGHT_MAX; t0++) {
 				if (b0 + t0 > depth) /* s = 0, s' = 1 is the shortest left end */
 					continue;
 				uint pix;
@@ -220,7 +220,7 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 				rpix[nr] = pix;
 				nr++;
 			}
-			if (t0 <= ne)
+			if (t0 <= ne && t0 <= sc->params->portal_t_max)
 				break; /* the chunk is full in the middle of b0 */
 		}
 		if (nr == 0)
@@ -229,7 +229,7 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 		 * light sample (s = 1), or meets light vertex l[s-1]. */
 		for (int a = 1; a < nR; a++) {
 			const PathVertex *z = &R[a];
-			for (int s = 0; s <= nl && s <= sc->params->portal_s_max; s++) {
+			for (int s = 0; s <= sc->params->portal_s_max && (s <= 1 || s <= nl); s++) {
 				V3 lcon = v3(0.0f, 0.0f, 0.0f);
 				PathVertex y; /* the light sample for s = 1 */
 				const PathVertex *lp = l;

@@ -131,7 +131,10 @@ typedef struct {
 	int portal_s_max;       /* intermediate strategies use at most this many light vertices, */
 	int portal_sp_max;      /* <- vertices and */
 	int portal_tp_max;      /* -> vertices (portal.h) */
-} Params; /* 192 */
+	int light_paths;        /* 192, portal: 0 = no light subpaths (bdpt's s >= 2 and t = 1 left out) */
+	int portal_t_max;       /* intermediate strategies use at most this many eye vertices */
+	int pad0, pad1;
+} Params; /* 208 */
 
 /* Layout of the float array `env`: for an ENV_IMAGE of W x H,
  *   [0, 3WH)                    linear RGB radiance, row-major, row 0 = top

@@ -126,14 +126,25 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	p->strategy_len = (int)o->strategy_len;
 	p->strategy_unweighted = o->strategy_unweighted;
 	/* The intermediate strategies in use (kernels/portal.h): chosen by
-	 * measurement (README, "Integrators"); AJAR_PORTAL_SET="s,s',t'"
-	 * overrides it for experiments, e.g. "32,32,32" for all of them. */
+	 * measurement (README, "Integrators"); AJAR_PORTAL_SET="s,s',t'[,t[,light paths]]"
+	 * overrides it for experiments, e.g. "32,32,32,33,1" for all of them. */
 	p->portal_s_max = 1;
 	p->portal_sp_max = 2;
 	p->portal_tp_max = 1;
+	p->portal_t_max = 3;
+	/* Light subpaths from an environment start on a disk as wide as the
+	 * scene and rarely find the way in through an opening; where the sky
+	 * is the only light, the intermediate subpaths (which start on the
+	 * portals) do their work, and the portal integrator leaves them out. */
+	p->light_paths = p->integrator != INTEGRATOR_PORTAL || p->num_emitters > 0;
 	const char *set = getenv("AJAR_PORTAL_SET");
-	if (set && sscanf(set, "%d,%d,%d", &p->portal_s_max, &p->portal_sp_max, &p->portal_tp_max) != 3)
-		log_msg(AJAR_LOG_WARNING, "AJAR_PORTAL_SET='%s' is not three numbers s,s',t'; ignored", set);
+	int nset = set ? sscanf(set, "%d,%d,%d,%d,%d", &p->portal_s_max, &p->portal_sp_max, &p->portal_tp_max,
+			     &p->portal_t_max, &p->light_paths)
+		    : 0;
+	if (set && (nset < 3 || nset > 5))
+		log_msg(AJAR_LOG_WARNING, "AJAR_PORTAL_SET='%s' is not s,s',t'[,t[,light paths]]; ignored", set);
+	if (!p->light_paths && p->portal_s_max > 1)
+		p->portal_s_max = 1; /* larger s needs light subpaths */
 	p->emitter_power = d->lights.emitter_power;
 	p->env_power = d->lights.env_power;
 	/* What lies behind each side of the portals, with the kernels' own
