@@ -49,7 +49,7 @@ DEPS_test_cli := $(BUILD)/libajar.a
 DEPS_test_multidevice := $(BUILD)/libajar.a
 DEPS_test_integrators := $(BUILD)/libajar.a
 
-.PHONY: all lib cli tests test test-unit asan demo bench install uninstall clean deps help
+.PHONY: all lib cli tests test test-unit asan demo bench bench-peers install uninstall clean deps help
 all: lib cli
 
 help:
@@ -57,6 +57,7 @@ help:
 	@echo "make test       install missing packages, build and run every test (cmocka)"
 	@echo "make asan       host unit tests under AddressSanitizer + UBSan"
 	@echo "make bench      BVH, traversal, samples/s, start-up figures"
+	@echo "make bench-peers  Cycles, Mitsuba 3, LuxCore vs Ajar at equal time (installs them; slow)"
 	@echo "make install    PREFIX=$(PREFIX): ajar, libajar.{a,so}, ajar.h, ajar.pc"
 	@echo "make all        library and CLI (MODE=release|debug|asan, V=1 for commands)"
 
@@ -145,6 +146,11 @@ demo:
 	$(Q)$(MAKE) --no-print-directory all
 	@mkdir -p out
 	build/ajar render scenes/cornell/cornell.gltf -o out/demo.exr --png out/demo.png --spp 64
+
+# Optional: installs Blender Cycles, Mitsuba 3 and LuxCore from PyPI into
+# build/peers/venv (tests/peers/README.md); never part of make test.
+bench-peers:
+	sh tests/peers/run.sh
 
 bench:
 	$(Q)$(MAKE) --no-print-directory deps

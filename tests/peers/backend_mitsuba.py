@@ -1,0 +1,113 @@
+"""backend_mitsuba.py — the scene in Mitsuba 3, `path` integrator.
+
+Variant llvm_ad_rgb (a JIT-compiled wavefront path tracer on the CPU; needs
+LLVM >= 16: DRJIT_LIBLLVM_PATH names Debian's libLLVM-19), else scalar_rgb.
+Each material's triangles are one PLY mesh with face normals (no shading
+normals); diffuse is wrapped in `twosided` (Mitsuba's is one-sided, Ajar's
+two-sided); area emitters are one-sided on the CCW front, as Ajar's. The
+camera is `perspective` with the vertical field of view, the film `hdrfilm`
+with the 1-pixel box filter. max_depth D counts segments from the camera,
+as Ajar's --max-depth does. Russian roulette is Mitsuba's default (unbiased).
+
+Equal time: the image is rendered in passes of a few samples per pixel
+with different seeds and averaged; passes run until the time is used up (the
+last pass may overshoot; the real time is reported). One warm-up pass,
+which pays the JIT compilation, is not counted.
+"""
+import math
+import os
+import struct
+import tempfile
+import time
+
+import numpy as np
+
+
+def write_ply(path, v, f):
+	with open(path, "wb") as fh:
+		fh.write((f"ply\nformat binary_little_endian 1.0\nelement vertex {len(v)}\n"
+			  "property float x\nproperty float y\nproperty float z\n"
+			  f"element face {len(f)}\nproperty list uchar int vertex_indices\nend_header\n").encode())
+		fh.write(np.ascontiguousarray(v, dtype="<f4").tobytes())
+		rec = np.zeros(len(f), dtype=[("n", "u1"), ("i", "<i4", 3)])
+		rec["n"] = 3
+		rec["i"] = f
+		fh.write(rec.tobytes())
+
+
+def set_variant(mi):
+	want = os.environ.get("PEERS_MITSUBA_VARIANT", "llvm_ad_rgb")
+	for v in (want, "scalar_rgb"):
+		try:
+			mi.set_variant(v)
+			return v
+		except Exception:
+			continue
+	raise RuntimeError("no usable Mitsuba variant")
+
+
+def build(mi, scene, a, tmp):
+	d = {"type": "scene", "integrator": {"type": "path", "max_depth": a.depth}}
+	c = scene.camera
+	origin = [float(x) for x in c["pos"]]
+	target = [float(x) for x in c["pos"] + c["forward"]]
+	up = [float(x) for x in c["up"]]
+	try:
+		to_world = mi.ScalarTransform4f().look_at(origin=origin, target=target, up=up)
+	except TypeError:
+		to_world = mi.ScalarTransform4f.look_at(origin=origin, target=target, up=up)
+	d["sensor"] = {
+		"type": "perspective", "fov_axis": "y", "fov": math.degrees(c["yfov"]), "to_world": to_world,
+		"near_clip": 1e-3, "far_clip": 1e5,
+		"film": {"type": "hdrfilm", "width": a.width, "height": a.height, "rfilter": {"type": "box"},
+			 "pixel_format": "rgb", "sample_border": False},
+		"sampler": {"type": "independent", "sample_count": 1},
+	}
+	for mi_index, (v, f) in scene.by_material().items():
+		m = scene.materials[mi_index]
+		path = os.path.join(tmp, f"mesh{mi_index}.ply")
+		write_ply(path, v, f)
+		shape = {"type": "ply", "filename": path, "face_normals": True,
+			 "bsdf": {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": {
+				 "type": "rgb", "value": [float(x) for x in m["base"]]}}}}
+		if m["emission"].max() > 0:
+			shape["emitter"] = {"type": "area", "radiance": {"type": "rgb", "value": [float(x) for x in m["emission"]]}}
+		d[f"mesh{mi_index}"] = shape
+	if scene.environment is not None:
+		d["env"] = {"type": "constant", "radiance": {"type": "rgb", "value": scene.environment}}
+	return mi.load_dict(d)
+
+
+def render(scene, a, t0):
+	import mitsuba as mi
+	import drjit as dr
+	variant = set_variant(mi)
+	try:
+		dr.set_thread_count(a.threads)
+	except Exception:
+		pass
+	with tempfile.TemporaryDirectory(prefix="peers-mi-") as tmp:
+		sc = build(mi, scene, a, tmp)
+	# Passes small enough for the wavefront to stay in memory (about 1M lanes).
+	per_pass = max(1, min(256, (1 << 20) // (a.width * a.height)))
+	if variant.startswith("scalar"):
+		per_pass = max(1, min(per_pass, 16))
+	if a.spp:
+		per_pass = min(per_pass, a.spp)
+	seed = a.seed * 100003
+	np.array(mi.render(sc, spp=per_pass, seed=seed))  # warm-up: JIT compilation, not counted
+	setup = time.perf_counter() - t0
+	acc = np.zeros((a.height, a.width, 3))
+	spp, k = 0, 0
+	start = time.perf_counter()
+	while True:
+		n = per_pass if not a.spp else min(per_pass, a.spp - spp)
+		k += 1
+		img = np.array(mi.render(sc, spp=n, seed=seed + k), dtype=np.float64)
+		acc += img[:, :, :3] * n
+		spp += n
+		el = time.perf_counter() - start
+		if (a.spp and spp >= a.spp) or (a.seconds and el >= a.seconds):
+			break
+	return acc / spp, {"renderer": "mitsuba", "variant": variant, "spp": spp, "render_seconds": round(el, 3),
+			   "setup_seconds": setup, "passes": k}

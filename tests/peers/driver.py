@@ -1,0 +1,294 @@
+"""driver.py — equal-time comparison of Ajar with Mitsuba 3, Blender Cycles
+and LuxCoreRender on Ajar's portal scenes (`make bench-peers`, tests/peers/run.sh).
+
+For each scene: a converged reference from two independent long halves
+(cached in build/peers/refs/), then every renderer for the same wall time,
+each in its own process; then the image mean against the reference's and
+the relative MSE against it, with the reference's own noise subtracted
+(relMSE(X, R) ~ relMSE_true(X) + relMSE(R)) and normalised to the nominal
+time (relMSE x t_actual / T: variance falls as 1/time for unbiased
+renderers). relMSE is tests/bench.c's formula (images.rel_mse).
+
+Environment: PEERS_SECONDS (20), PEERS_SCENES ("window-room living-room
+door-ajar"; cornell also works), PEERS_SIZE (image width, height from the
+camera's aspect ratio, or WxH; 128), PEERS_REF_SECONDS (each reference half;
+300), PEERS_DEPTH (32), PEERS_THREADS (all cores), PEERS_RENDERERS (default
+all: ajar-pt ajar-bdpt ajar-portal mitsuba cycles cycles-noportal
+luxcore-path luxcore-bidir), PEERS_REF_<SCENE> (reference renderer for a
+scene, e.g. PEERS_REF_DOOR_AJAR=mitsuba).
+"""
+import hashlib
+import json
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, HERE)
+
+import images  # noqa: E402
+from scene import Scene, image_size, write_lambert_variant  # noqa: E402
+
+OUT = os.path.join(ROOT, "build", "peers")
+AJAR = os.path.join(ROOT, "build", "release", "ajar")
+ALL = ["ajar-pt", "ajar-bdpt", "ajar-portal", "mitsuba", "cycles", "cycles-noportal", "luxcore-path", "luxcore-bidir"]
+# Fastest to converge, measured on this machine (see the README of tests/peers).
+DEFAULT_REF = {"window-room": "mitsuba", "living-room": "mitsuba", "door-ajar": "mitsuba", "cornell": "mitsuba"}
+
+
+def log(*a):
+	print(*a, flush=True)
+
+
+def env_threads():
+	return int(os.environ.get("PEERS_THREADS", os.cpu_count() or 1))
+
+
+def sub_env():
+	e = dict(os.environ)
+	llvm = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
+	if "DRJIT_LIBLLVM_PATH" not in e and os.path.exists(llvm):
+		e["DRJIT_LIBLLVM_PATH"] = llvm
+	if "PEERS_THREADS" in os.environ:
+		e["POCL_CPU_MAX_CU_NUM"] = str(env_threads())
+	return e
+
+
+def ensure_ajar():
+	"""An up-to-date build/release/ajar: `make` (not -j: the machine is
+	shared). The lead may be in the middle of an edit, so a failed build is
+	retried a few times; if it keeps failing, an existing binary is used."""
+	for attempt in range(4):
+		if subprocess.run(["make", "-s", "all"], cwd=ROOT).returncode == 0 and os.path.exists(AJAR):
+			return
+		log(f"peers: make failed (attempt {attempt + 1}); retrying in 30 s")
+		time.sleep(30)
+	if not os.path.exists(AJAR):
+		raise SystemExit("peers: build/release/ajar could not be built")
+	log("peers: warning: make keeps failing; using the existing build/release/ajar")
+
+
+def run_ajar(integrator, path, size, depth, out, seconds=0.0, spp=0, seed=7):
+	w, h = size
+	cmd = [AJAR, "render", path, "--integrator", integrator, "--size", f"{w}x{h}", "--max-depth", str(depth),
+	       "--seed", str(seed), "-o", out, "-q"]
+	if seconds:
+		cmd += ["--time", str(seconds)]
+	if spp:
+		cmd += ["--spp", str(spp)]
+	for attempt in range(4):
+		t = time.perf_counter()
+		r = subprocess.run(cmd, cwd=ROOT, env=sub_env(), capture_output=True, text=True)
+		wall = time.perf_counter() - t
+		if r.returncode == 0:
+			break
+		# Exit 3 (device: a kernel that does not build while the lead edits it) is retried.
+		log(f"peers: ajar failed (exit {r.returncode}): {r.stderr.strip()[-400:]}")
+		if r.returncode != 3:
+			return None, None
+		time.sleep(30)
+	else:
+		return None, None
+	rgb, meta = images.read_exr(out)
+	return rgb, {"spp": int(meta.get("ajar:spp", 0)), "render_seconds": float(meta.get("ajar:render_seconds", wall)),
+		     "setup_seconds": round(wall - float(meta.get("ajar:render_seconds", wall)), 3)}
+
+
+def run_peer(renderer, path, size, depth, out_base, seconds=0.0, spp=0, seed=7):
+	name, _, variant = renderer.partition("-")
+	w, h = size
+	npy = out_base + ".npy"
+	cmd = [os.path.join(OUT, "venv", "bin", "python"), os.path.join(HERE, "backend.py"), name, path, npy,
+	       "--size", f"{w}x{h}", "--depth", str(depth), "--seed", str(seed), "--threads", str(env_threads())]
+	if variant:
+		cmd += ["--integrator", variant]
+	cmd += ["--seconds", str(seconds)] if seconds else ["--spp", str(spp)]
+	env = sub_env()
+	if name == "luxcore":
+		libs = os.path.join(OUT, "venv", "lib", f"python{sys.version_info[0]}.{sys.version_info[1]}",
+				    "site-packages", "pyluxcore.libs")
+		pre = [os.path.join(libs, f) for f in sorted(os.listdir(libs)) if f.startswith("libtbbmalloc_proxy-")] \
+			if os.path.isdir(libs) else []
+		if pre:
+			env["LD_PRELOAD"] = pre[0]
+	limit = 600 + 4 * (seconds or 0)
+	try:
+		r = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True, timeout=limit)
+	except subprocess.TimeoutExpired:
+		log(f"peers: {renderer} timed out after {limit:.0f} s")
+		return None, None
+	info = None
+	for line in reversed(r.stdout.strip().splitlines()):
+		if line.startswith("{"):
+			info = json.loads(line)
+			break
+	if r.returncode != 0 or info is None or not os.path.exists(npy):
+		log(f"peers: {renderer} failed (exit {r.returncode}): {(r.stderr or r.stdout).strip()[-800:]}")
+		return None, None
+	rgb = np.load(npy).astype(np.float64)
+	images.write_exr(out_base + ".exr", rgb)
+	os.remove(npy)
+	return rgb, info
+
+
+def render(renderer, path, size, depth, out_base, seconds=0.0, spp=0, seed=7):
+	if renderer.startswith("ajar-"):
+		return run_ajar(renderer[5:], path, size, depth, out_base + ".exr", seconds, spp, seed)
+	return run_peer(renderer, path, size, depth, out_base, seconds, spp, seed)
+
+
+def file_hash(path):
+	h = hashlib.sha1()
+	g = json.load(open(path))
+	h.update(json.dumps(g, sort_keys=True).encode())
+	for b in g.get("buffers", []):
+		if "uri" in b and not b["uri"].startswith("data:"):
+			with open(os.path.join(os.path.dirname(path), b["uri"]), "rb") as f:
+				h.update(f.read())
+	return h.hexdigest()[:12]
+
+
+def reference(name, path, size, depth, ref_seconds):
+	"""Two independent halves by the scene's reference renderer, cached."""
+	key = name.upper().replace("-", "_")
+	rr = os.environ.get("PEERS_REF_" + key, DEFAULT_REF.get(name, "mitsuba"))
+	w, h = size
+	os.makedirs(os.path.join(OUT, "refs"), exist_ok=True)
+	cache = os.path.join(OUT, "refs", f"{name}-{w}x{h}-d{depth}-{rr}-{ref_seconds:g}s-{file_hash(path)}.npz")
+	if os.path.exists(cache):
+		z = np.load(cache)
+		log(f"  reference: {rr}, cached ({cache})")
+		return z["r1"], z["r2"], {"renderer": rr, "spp": [int(x) for x in z["spp"]],
+					  "seconds": [float(x) for x in z["seconds"]]}
+	halves, spp, secs = [], [], []
+	for k, seed in enumerate((1001, 1002)):
+		log(f"  reference half {k + 1}/2: {rr}, {ref_seconds:g} s")
+		img, info = render(rr, path, size, depth, os.path.join(OUT, f"{name}-ref{k + 1}"), seconds=ref_seconds,
+				   seed=seed)
+		if img is None:
+			raise SystemExit(f"peers: reference for {name} failed")
+		halves.append(img)
+		spp.append(info["spp"])
+		secs.append(info["render_seconds"])
+	np.savez(cache, r1=halves[0], r2=halves[1], spp=spp, seconds=secs)
+	return halves[0], halves[1], {"renderer": rr, "spp": spp, "seconds": secs}
+
+
+def scene_path(name):
+	"""The shipped scene, or its matched Lambertian variant when it is not
+	Lambertian already (living-room)."""
+	path = os.path.join(ROOT, "scenes", name, name + ".gltf")
+	s = Scene(path)
+	try:
+		s.check_lambertian()
+		return path, s, []
+	except ValueError:
+		pass
+	var = os.path.join(OUT, name + "-lambert.gltf")
+	notes = write_lambert_variant(s, var)
+	v = Scene(var)
+	v.check_lambertian()
+	return var, v, notes
+
+
+def bench_scene(name, seconds, size_spec, depth, ref_seconds, renderers, rows):
+	path, s, notes = scene_path(name)
+	size = image_size(s, size_spec)
+	log(f"\n== {name}: {os.path.relpath(path, ROOT)}, {size[0]}x{size[1]}, max depth {depth}, {seconds:g} s each")
+	for n in notes:
+		log("  variant: " + n)
+	r1, r2, rinfo = reference(name, path, size, depth, ref_seconds)
+	ref = 0.5 * (r1 + r2)
+	mean = float(ref.mean())
+	noise = images.reference_noise(r1, r2, mean)
+	log(f"  reference: {rinfo['renderer']} {rinfo['spp'][0]} + {rinfo['spp'][1]} spp, mean {mean:.5f}, "
+	    f"its relMSE {noise:.2e}")
+	exposure = images.auto_exposure(ref)
+	images.write_png(os.path.join(OUT, f"{name}-reference.png"), ref, exposure)
+	images.write_exr(os.path.join(OUT, f"{name}-reference.exr"), ref)
+	for integ in ("pt", "bdpt", "portal"):  # PoCL compiles each kernel on its first run
+		if "ajar-" + integ in renderers:
+			run_ajar(integ, path, size, depth, os.path.join(OUT, "warmup.exr"), spp=1)
+	tiles, labels, res = [ref], [f"reference ({rinfo['renderer']})"], {}
+	for r in renderers:
+		if r == "cycles-noportal" and not (s.portals and s.environment):
+			continue  # the same as "cycles" where no portal light is placed
+		img, info = render(r, path, size, depth, os.path.join(OUT, f"{name}-{r}"), seconds=seconds)
+		if img is None:
+			rows.append({"scene": name, "renderer": r, "failed": True})
+			continue
+		t = info["render_seconds"]
+		e = images.rel_mse(img, ref, mean) - noise
+		e_t = e * t / seconds
+		m = float(img.mean())
+		# Standard error of the image mean, from the per-pixel errors (channels averaged).
+		d = (img - ref).mean(axis=2)
+		se = float(np.sqrt(np.mean(d * d) / d.size)) / mean
+		dev = m / mean - 1
+		ok = abs(dev) <= 4 * se + 0.003
+		row = {"scene": name, "renderer": r, "spp": info["spp"], "seconds": t,
+		       "setup": info.get("setup_seconds", 0.0), "mean": m, "dev": dev, "se": se, "ok": ok,
+		       "relmse": e_t, "ref": rinfo["renderer"], "note": info.get("variant", "")}
+		rows.append(row)
+		res[r] = row
+		log(f"  {r:16s} {info['spp']:7d} spp {t:6.1f} s  mean {m:.5f} ({100 * dev:+.2f}% +- {100 * se:.2f}%,"
+		    f" {'ok' if ok else 'MISMATCH'})  relMSE at {seconds:g} s {e_t:.3e}")
+		images.write_png(os.path.join(OUT, f"{name}-{r}.png"), img, exposure)
+		tiles.append(img)
+		labels.append(r)
+	base = res.get("ajar-portal")
+	for row in rows:
+		if row["scene"] == name and not row.get("failed"):
+			row["ratio"] = row["relmse"] / base["relmse"] if base and base["relmse"] > 0 else float("nan")
+	images.montage(os.path.join(OUT, f"{name}-montage.png"), tiles, labels, exposure)
+	log(f"  montage: {os.path.relpath(os.path.join(OUT, name + '-montage.png'), ROOT)} (exposure {exposure:+g} EV)")
+	return rinfo
+
+
+def table(rows, seconds, size_spec, depth, refs):
+	out = [f"Equal time {seconds:g} s per render, image width {size_spec}, max depth {depth}, "
+	       f"{env_threads()} threads each. relMSE is tests/bench.c's (mean over pixels and channels of "
+	       "(x - r)^2 / (r^2 + (0.1 mean r)^2)), minus the reference's own noise, times t/T. "
+	       "ratio = relMSE / relMSE of ajar-portal (above 1: Ajar's portal integrator is better).", ""]
+	for name, ri in refs.items():
+		out.append(f"- {name}: reference by {ri['renderer']}, {ri['spp'][0]} + {ri['spp'][1]} spp in "
+			   f"{ri['seconds'][0]:.0f} + {ri['seconds'][1]:.0f} s")
+	out += ["", "| scene | renderer | spp | render s | mean vs reference | relMSE at T | ratio vs ajar-portal |",
+		"|---|---|---|---|---|---|---|"]
+	for r in rows:
+		if r.get("failed"):
+			out.append(f"| {r['scene']} | {r['renderer']} | failed | | | | |")
+			continue
+		check = f"{100 * r['dev']:+.2f}% ± {100 * r['se']:.2f}% {'ok' if r['ok'] else '**MISMATCH**'}"
+		out.append(f"| {r['scene']} | {r['renderer']} | {r['spp']} | {r['seconds']:.1f} | {check} | "
+			   f"{r['relmse']:.3e} | {r.get('ratio', float('nan')):.2f} |")
+	return "\n".join(out) + "\n"
+
+
+def main():
+	seconds = float(os.environ.get("PEERS_SECONDS", "20"))
+	scenes = os.environ.get("PEERS_SCENES", "window-room living-room door-ajar").split()
+	size_spec = os.environ.get("PEERS_SIZE", "128")
+	ref_seconds = float(os.environ.get("PEERS_REF_SECONDS", "300"))
+	depth = int(os.environ.get("PEERS_DEPTH", "32"))
+	renderers = os.environ.get("PEERS_RENDERERS", " ".join(ALL)).split()
+	os.makedirs(OUT, exist_ok=True)
+	if any(r.startswith("ajar-") for r in renderers) or any(DEFAULT_REF.get(s, "").startswith("ajar") for s in scenes):
+		ensure_ajar()
+	rows, refs = [], {}
+	for name in scenes:
+		refs[name] = bench_scene(name, seconds, size_spec, depth, ref_seconds, renderers, rows)
+	md = table(rows, seconds, size_spec, depth, refs)
+	with open(os.path.join(OUT, "results.md"), "w") as f:
+		f.write(md)
+	log("\n" + md)
+	log(f"peers: images, montages and results.md in {os.path.relpath(OUT, ROOT)}/")
+	return 1 if any(r.get("failed") or not r.get("ok", True) for r in rows) else 0
+
+
+if __name__ == "__main__":
+	sys.exit(main())
