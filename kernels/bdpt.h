@@ -3,8 +3,9 @@
  * sample, every (s, t) strategy evaluated and weighted by mis_path_weight.
  *
  *   s = 0   the eye subpath hits an emitter or escapes to the environment;
- *   s = 1   next-event estimation: a fresh light point (the same density as
- *           the light subpath's first vertex) connected to eye vertex t-1;
+ *   s = 1   next-event estimation: a fresh light point connected to eye
+ *           vertex t-1 (for the sky, aimed through portals: its density pn_0
+ *           differs from the light subpath's origin density, mis.h);
  *   t = 1   light vertex s-1 connected to the camera and splatted into the
  *           pixel it lands in (light tracing);
  *   others  light vertex s-1 connected to eye vertex t-1.
@@ -309,8 +310,10 @@ INLINE int bdpt_eye_subpath(const SceneView *sc, float px, float py, PathVertex 
 	return vertex_walk(sc, e, 1, max_verts, cam->pos, dir, z0->beta, camera_pdf_w(cam, cos_c), 0, 0, 1, rng);
 }
 
-/* The light vertex of a next-event sample (s = 1): its origin density
- * pf_0 is solid angle for the environment, area for emitters. */
+/* The light vertex of a next-event sample (s = 1). Its pf holds the
+ * sample's own density (solid angle for the environment, area for
+ * emitters); MIS records recompute pf_0 and pn_0 from the path
+ * (densities.h, bdpt_light_records). */
 INLINE void bdpt_light_vertex(PathVertex *y, const LightSample *ls)
 {
 	y->type = ls->is_env ? VERTEX_ENV : VERTEX_LIGHT;

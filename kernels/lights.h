@@ -60,6 +60,36 @@ typedef struct {
 	int tri;     /* the emitter triangle, -1 for the environment */
 } LightSample;
 
+/* The emitter half of light_sample: an emitter by power (u), a uniform
+ * point on it (u1, u2), chosen in all with probability p_emitters. */
+INLINE int light_sample_emitter(const SceneView *sc, V3 x, float u, float u1, float u2, float p_emitters,
+				LightSample *ls)
+{
+	float pdf_a;
+	V3 p, n;
+	int tri = emitter_sample(sc, u, u1, u2, &p, &n, &pdf_a);
+	if (tri < 0)
+		return 0;
+	V3 to = v3_sub(p, x);
+	float dist2 = v3_len2(to);
+	if (!(dist2 > 0.0f))
+		return 0;
+	float dist = sqrt(dist2);
+	V3 wi = v3_scale(to, 1.0f / dist);
+	float cos_light = -v3_dot(n, wi);
+	if (!(cos_light > 0.0f) || !(pdf_a > 0.0f))
+		return 0;
+	ls->is_env = 0;
+	ls->p = p;
+	ls->n = n;
+	ls->wi = wi;
+	ls->dist = dist;
+	ls->tri = tri;
+	ls->Le = sc->materials[sc->tris[tri].material].emission;
+	ls->pdf_w = p_emitters * pdf_a * dist2 / cos_light;
+	return 1;
+}
+
 /* Next-event estimation from shading point x: the environment with
  * probability Params.env_pdf_select (through the portals that show x the
  * sky, env_portal.h), else an emitter by power and a uniform point on it. Returns 0 when there is nothing to sample or the
@@ -87,29 +117,7 @@ INLINE int light_sample(const SceneView *sc, V3 x, float u_sel, float u1, float 
 		return 1;
 	}
 	/* u_sel in [ps, 1) stretched back to [0, 1) for the emitter choice. */
-	float u = fmin((u_sel - ps) / (1.0f - ps), 0.99999994f);
-	float pdf_a;
-	V3 p, n;
-	int tri = emitter_sample(sc, u, u1, u2, &p, &n, &pdf_a);
-	if (tri < 0)
-		return 0;
-	V3 to = v3_sub(p, x);
-	float dist2 = v3_len2(to);
-	if (!(dist2 > 0.0f))
-		return 0;
-	float dist = sqrt(dist2);
-	V3 wi = v3_scale(to, 1.0f / dist);
-	float cos_light = -v3_dot(n, wi);
-	if (!(cos_light > 0.0f) || !(pdf_a > 0.0f))
-		return 0;
-	ls->p = p;
-	ls->n = n;
-	ls->wi = wi;
-	ls->dist = dist;
-	ls->tri = tri;
-	ls->Le = sc->materials[sc->tris[tri].material].emission;
-	ls->pdf_w = (1.0f - ps) * pdf_a * dist2 / cos_light;
-	return 1;
+	return light_sample_emitter(sc, x, fmin((u_sel - ps) / (1.0f - ps), 0.99999994f), u1, u2, 1.0f - ps, ls);
 }
 
 /* Solid-angle density (selection included) with which light_sample from

@@ -51,17 +51,12 @@ INLINE int portal_guided_sample(const SceneView *sc, GLOBAL const PortalTri *pt,
 			*wl = portal_mirror(*wl, pt->n);
 		return 1;
 	}
-	float u = fmin((u_sel - ps) / (1.0f - ps), 0.99999994f), pdf_a;
-	V3 p, nl;
-	if (emitter_sample(sc, u, u1, u2, &p, &nl, &pdf_a) < 0)
+	LightSample ls;
+	if (!light_sample_emitter(sc, w0, fmin((u_sel - ps) / (1.0f - ps), 0.99999994f), u1, u2, 1.0f - ps, &ls))
 		return 0;
-	V3 d = v3_sub(p, w0);
-	float d2 = v3_len2(d);
-	if (!(d2 > 0.0f))
-		return 0;
-	*dist = sqrt(d2);
-	*wl = v3_scale(d, 1.0f / *dist);
-	return -v3_dot(nl, *wl) > 0.0f;
+	*wl = ls.wi;
+	*dist = ls.dist;
+	return 1;
 }
 
 /* The <- direction *wl from point w0 of portal triangle pt (path_mis.h,
