@@ -104,12 +104,16 @@ typedef struct {
 
 /* Which intermediate strategies are in use: at most s_max light vertices,
  * sp_max <- vertices (s' = m - s + 1), tp_max -> vertices and t_max eye
- * vertices. The weights
- * sum over exactly these, so any choice is unbiased. */
+ * vertices. The weights sum over exactly these, so any choice is unbiased.
+ * A pixel sample traces its intermediate subpath with probability `rate`:
+ * those strategies take rate samples per pixel sample, so their densities
+ * enter the heuristic as rate p (multi-sample MIS with sample counts) and
+ * their contributions are divided by rate. */
 typedef struct {
 	int s_max, sp_max, tp_max;
 	int t_max;       /* eye vertices, camera included */
 	int light_paths; /* 0: bdpt strategies only with s <= 1 and t >= 2 (no light subpaths) */
+	float lrate;     /* log of the rate */
 } MisPortalSet;
 
 INLINE int mis_bdpt_valid(const MisVertex *v, int k, int s)
@@ -166,7 +170,8 @@ INLINE float mis_union_weight(const MisVertex *v, int k, const int *cross, const
 	float lpn = log(mis_remap0(v[0].pn));
 	float lcur = cur.c == 1 ? mis_log_bdpt(PF, lpn, PR, k, cur.s)
 				: mis_lpf(PF, lpn, cur.s) + (PR[cur.m] - PR[cur.s]) + lpair_cur +
-					  (PF[cur.m + cur.tp + 1] - PF[cur.m + 2]) + (PR[k] - PR[cur.m + cur.tp + 1]);
+					  (PF[cur.m + cur.tp + 1] - PF[cur.m + 2]) + (PR[k] - PR[cur.m + cur.tp + 1]) +
+					  set.lrate;
 	float total = -AJAR_INF; /* log of sum of (p_j / p_cur)^beta */
 	for (int s = 0; s < k; s++)
 		if (mis_bdpt_valid(v, k, s) && (set.light_paths || (s <= 1 && s < k - 1)))
@@ -183,7 +188,7 @@ INLINE float mis_union_weight(const MisVertex *v, int k, const int *cross, const
 		for (int tp = 1; m + tp <= k - 2 && tp <= set.tp_max; tp++)
 			if (!v[m + tp].delta && !v[m + tp + 1].delta && k - m - tp - 1 <= set.t_max)
 				right = mis_logadd(right, beta * ((PF[m + tp + 1] - PF[m + 2]) + (PR[k] - PR[m + tp + 1])));
-		float term = left + right + lpsum[m] - beta * lcur;
+		float term = left + right + lpsum[m] + beta * (set.lrate - lcur);
 		total = mis_logadd(total, term);
 	}
 	return exp(-total);

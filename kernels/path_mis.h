@@ -258,7 +258,7 @@ INLINE void path_records(const SceneView *sc, const PathRef *P, int heuristic, M
 INLINE MisPortalSet path_portal_set(GLOBAL const Params *prm)
 {
 	MisPortalSet set = {prm->portal_s_max, prm->portal_sp_max, prm->portal_tp_max, prm->portal_t_max,
-			    prm->light_paths};
+			    prm->light_paths, log(prm->portal_rate)};
 	return set;
 }
 

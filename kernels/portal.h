@@ -159,7 +159,7 @@ INLINE void portal_add(const SceneView *sc, BdptFilm *out, int s, int sp, int tp
 {
 	int n = s + sp + tp + t - 1;
 	int layer = bdpt_layer_count(sc->params->strategy_len) + portal_layer(n, s, t);
-	bdpt_film_add(sc, out, n, layer, t == 1, c, w, pixel, rng);
+	bdpt_film_add(sc, out, n, layer, t == 1, v3_scale(c, 1.0f / sc->params->portal_rate), w, pixel, rng);
 }
 
 /* The eye-side end of portal strategies: -> vertex F[b] to eye vertex
@@ -190,8 +190,9 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 	int depth = sc->params->max_depth;
 	int nl = sc->params->light_paths ? bdpt_light_subpath(sc, l, depth, rng) : 0;
 	int ne = bdpt_eye_subpath(sc, px, py, e, depth + 1, rng);
-	int nR, nF;
-	portal_intermediate(sc, R, &nR, F, &nF, rng);
+	int nR = 0, nF = 0;
+	if (rng_f(rng) < sc->params->portal_rate)
+		portal_intermediate(sc, R, &nR, F, &nF, rng);
 	bdpt_strategies(sc, l, nl, e, ne, out, rng);
 
 	/* Eye-side ends, in chunks so any number of them is handled. */

@@ -133,7 +133,8 @@ typedef struct {
 	int portal_tp_max;      /* -> vertices (portal.h) */
 	int light_paths;        /* 192, portal: 0 = no light subpaths (bdpt's s >= 2 and t = 1 left out) */
 	int portal_t_max;       /* intermediate strategies use at most this many eye vertices */
-	int pad0, pad1;
+	float portal_rate;      /* 200, probability that a pixel sample traces an intermediate subpath */
+	int pad1;
 } Params; /* 208 */
 
 /* Layout of the float array `env`: for an ENV_IMAGE of W x H,

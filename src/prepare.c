@@ -149,6 +149,24 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 		log_msg(AJAR_LOG_WARNING, "AJAR_PORTAL_SET='%s' is not s,s',t'[,t[,light paths]]; ignored", set);
 	if (!p->light_paths && p->portal_s_max > 1)
 		p->portal_s_max = 1; /* larger s needs light subpaths */
+	/* How often a pixel sample traces an intermediate subpath (mis.h,
+	 * MisPortalSet), chosen by measurement at equal time (README,
+	 * Results): with next-event estimation through the portals, the sky
+	 * needs them seldom; light from emitters behind an opening more often.
+	 * AJAR_PORTAL_RATE in (0, 1] overrides it. Layers without MIS weights
+	 * (tests) take every intermediate subpath. */
+	p->portal_rate = p->light_paths ? 0.25f : 0.1f;
+	const char *rate = getenv("AJAR_PORTAL_RATE");
+	if (rate) {
+		char *end;
+		float r = strtof(rate, &end);
+		if (end != rate && *end == '\0' && r > 0.0f && r <= 1.0f)
+			p->portal_rate = r;
+		else
+			log_msg(AJAR_LOG_WARNING, "AJAR_PORTAL_RATE='%s' is not in (0, 1]; ignored", rate);
+	}
+	if (p->strategy_unweighted)
+		p->portal_rate = 1.0f;
 	p->emitter_power = d->lights.emitter_power;
 	p->env_power = d->lights.env_power;
 	/* What lies behind each side of the portals, with the kernels' own

@@ -7,7 +7,9 @@
  * within 5 combined standard errors. With 15 degrees of freedom a false
  * alarm is ~2e-4 per comparison. A bias of 1% is caught wherever the
  * standard error is below 0.2% of the mean, which the sample counts below
- * give on every scene (the printout shows it). */
+ * give on every scene but door-ajar (the printout shows it): there all
+ * light comes through the gap, pt is very noisy and the standard error is
+ * about 0.7%, so a bias of 4% is caught. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -95,6 +97,7 @@ static void test_cornell(void **state) { compare(SCENE("cornell/cornell.gltf"), 
 static void test_window_room(void **state) { compare(SCENE("window-room/window-room.gltf"), 32, 32, 64, 16); }
 static void test_living_room(void **state) { compare(SCENE("living-room/living-room.gltf"), 32, 18, 64, 16); }
 static void test_bathroom(void **state) { compare(SCENE("bathroom/bathroom.gltf"), 24, 24, 32, 8); }
+static void test_door_ajar(void **state) { compare(SCENE("door-ajar/door-ajar.gltf"), 24, 24, 512, 128); }
 
 int main(void)
 {
@@ -103,6 +106,7 @@ int main(void)
 		cmocka_unit_test(test_window_room),
 		cmocka_unit_test(test_living_room),
 		cmocka_unit_test(test_bathroom),
+		cmocka_unit_test(test_door_ajar),
 	};
 	return cmocka_run_group_tests_name("integrators", tests, NULL, NULL);
 }
