@@ -44,18 +44,23 @@ INLINE float sph_tri_solid_angle(V3 a, V3 b, V3 c)
  * when it is thin (u1 near 0) or the arcs are short. The arc theta from
  * a to c' follows from the excess of a triangle with sides theta and
  * |ab| and angle alpha between them:
- *   tan(E / 2) = tan(theta / 2) tan(|ab| / 2) sin(alpha) / (1 + tan(theta / 2) tan(|ab| / 2) cos(alpha)). */
+ *   tan(E / 2) = tan(theta / 2) tan(|ab| / 2) sin(alpha) / (1 + tan(theta / 2) tan(|ab| / 2) cos(alpha)),
+ * solved for tan(theta / 2) with both sides multiplied by cos(E / 2): the
+ * tangent itself passes infinity where a triangle seen from close by
+ * covers more than pi sr (that skewed the directions and darkened the
+ * living room by 0.5%), while sin(alpha - E / 2) stays positive, as
+ * E < 2 alpha in every spherical triangle. */
 INLINE V3 sph_tri_sample(V3 a, V3 b, V3 c, float omega, float u1, float u2)
 {
 	V3 nab = v3_cross(a, b), nac = v3_cross(a, c);
 	float inv = 1.0f / sqrt(v3_len2(nab) * v3_len2(nac));
 	float cos_alpha = v3_dot(nab, nac) * inv, sin_alpha = v3_len(v3_cross(nab, nac)) * inv;
 	float k = v3_len(nab) / (1.0f + v3_dot(a, b)); /* tan(|ab| / 2) */
-	float te = tan(0.5f * u1 * omega);
-	float den = k * (sin_alpha - te * cos_alpha);
+	float se = sin(0.5f * u1 * omega), ce = cos(0.5f * u1 * omega);
+	float den = k * (ce * sin_alpha - se * cos_alpha); /* k sin(alpha - E / 2) > 0 */
 	V3 cp = c;
 	if (den > 0.0f) {
-		float tt = te / den, tt2 = tt * tt; /* tan(theta / 2) */
+		float tt = se / den, tt2 = tt * tt; /* tan(theta / 2) */
 		V3 ca = v3_sub(c, a);
 		V3 c_perp = v3_norm(v3_add(ca, v3_scale(a, 0.5f * v3_len2(ca))));
 		cp = v3_add(v3_scale(a, (1.0f - tt2) / (1.0f + tt2)), v3_scale(c_perp, 2.0f * tt / (1.0f + tt2)));

@@ -633,6 +633,30 @@ static void test_light_sample_env_portals(void **state)
 	lit_free(&l);
 }
 
+/* A shading point close to a window, off its centre: one portal triangle
+ * covers more than pi sr, where the half-angle tangent of the sampler's
+ * sub-triangle area passes infinity (a bug that darkened the living room,
+ * whose window frames are near its portals, by 0.5%). */
+static void test_light_sample_env_portal_near(void **state)
+{
+	rng_state = 23;
+	Lit l;
+	build_light_scene(&l);
+	assert_int_equal(scene_set_env_image(l.s, 40, 20, synthetic_sky(40, 20), 0.02f), AJAR_OK);
+	float pos[] = {-0.8f, -0.4f, 1, 0.8f, -0.4f, 1, 0.8f, 0.8f, 1, -0.8f, 0.8f, 1};
+	uint32_t idx[] = {0, 1, 2, 0, 2, 3};
+	assert_int_equal(scene_add_portal(l.s, "window", pos, 4, idx, 2), AJAR_OK);
+	lit_build(&l);
+	V3 x = v3(0.35f, -0.1f, 0.93f);
+	for (int j = 0; j < 2; j++)
+		l.s->portals[j].env_side = v3_dot(v3_sub(x, l.s->portals[j].p0), l.s->portals[j].n) > 0 ? -1 : 1;
+	float om0 = portal_env_solid_angle(&l.s->portals[0], x), om1 = portal_env_solid_angle(&l.s->portals[1], x);
+	printf("  solid angles from x: %.3f and %.3f sr\n", om0, om1);
+	assert_true(fmaxf(om0, om1) > 1.2f * AJAR_PI);
+	check_light_sample(&l, x, "+ near portal");
+	lit_free(&l);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -645,6 +669,7 @@ int main(void)
 		cmocka_unit_test(test_light_sample_env_color),
 		cmocka_unit_test(test_light_sample_env_image),
 		cmocka_unit_test(test_light_sample_env_portals),
+		cmocka_unit_test(test_light_sample_env_portal_near),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
