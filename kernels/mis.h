@@ -149,7 +149,7 @@ INLINE float mis_log_bdpt(const float *PF, float lpn, const float *PR, int k, in
 INLINE float mis_logadd(float a, float b)
 {
 	float hi = fmax(a, b), lo = fmin(a, b);
-	if (hi == -AJAR_INF)
+	if (lo == -AJAR_INF) /* also the empty sum; exp(-inf) takes libm's slow path */
 		return hi;
 	return hi + log(1.0f + exp(lo - hi));
 }
