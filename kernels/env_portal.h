@@ -182,9 +182,10 @@ INLINE V3 env_nee_sample(const SceneView *sc, V3 x, float u_mix, float u1, float
 	if (j < 0)
 		return black;
 	GLOBAL const PortalTri *pt = &sc->portals[j];
-	float omega = portal_env_solid_angle(pt, x), own; /* own: the picked triangle's term */
+	/* x is on its room side (w > 0): the solid angle from the corners. */
+	V3 a = v3_norm(v3_sub(pt->p0, x)), b = v3_norm(v3_sub(pt->p1, x)), c = v3_norm(v3_sub(pt->p2, x));
+	float omega = sph_tri_solid_angle(a, b, c), own; /* own: the picked triangle's term */
 	if (omega >= PORTAL_SA_MIN) {
-		V3 a = v3_norm(v3_sub(pt->p0, x)), b = v3_norm(v3_sub(pt->p1, x)), c = v3_norm(v3_sub(pt->p2, x));
 		*wi = sph_tri_sample(a, b, c, omega, u1, u2);
 		own = w / total / omega;
 	} else {
