@@ -574,6 +574,31 @@ static void check_wasted(const char *path, const char *name)
 	host_scene_close(&h);
 }
 
+/* The rate of intermediate subpaths: 0.1 where the sky is the only light,
+ * 0.25 with emitters, AJAR_PORTAL_RATE in (0, 1] overriding it, anything
+ * else ignored with a warning. */
+static void test_portal_rate(void **state)
+{
+	HostScene h;
+	host_scene_open(&h, SCENE("window-room/window-room.gltf"), NULL, 8, 8, INTEGRATOR_PORTAL, 8);
+	assert_float_equal(h.data.params->portal_rate, 0.1f, 0.0f);
+	host_scene_close(&h);
+	host_scene_open(&h, SCENE("door-ajar/door-ajar.gltf"), NULL, 8, 8, INTEGRATOR_PORTAL, 8);
+	assert_float_equal(h.data.params->portal_rate, 0.25f, 0.0f);
+	host_scene_close(&h);
+	const char *rates[] = {"0.5", "1", "0", "1.5", "0.3x", ""};
+	const float expect[] = {0.5f, 1.0f, 0.1f, 0.1f, 0.1f, 0.1f};
+	for (int i = 0; i < 6; i++) {
+		setenv("AJAR_PORTAL_RATE", rates[i], 1);
+		host_scene_open(&h, SCENE("window-room/window-room.gltf"), NULL, 8, 8, INTEGRATOR_PORTAL, 8);
+		if (h.data.params->portal_rate != expect[i])
+			fail_msg("AJAR_PORTAL_RATE='%s': rate %g, expected %g", rates[i], h.data.params->portal_rate,
+				 expect[i]);
+		host_scene_close(&h);
+	}
+	unsetenv("AJAR_PORTAL_RATE");
+}
+
 static void test_wasted_fewer(void **state)
 {
 	(void)state;
@@ -595,6 +620,7 @@ int main(void)
 		cmocka_unit_test(test_directions_window_room),
 		cmocka_unit_test(test_directions_door_ajar),
 		cmocka_unit_test(test_wasted_fewer),
+		cmocka_unit_test(test_portal_rate),
 	};
 	return cmocka_run_group_tests_name("portal", tests, NULL, NULL);
 }
