@@ -63,17 +63,20 @@ def reference_noise(r1, r2, mean):
 	return float(np.mean((r2 - r1) ** 2 / 4.0 / (r * r + 0.01 * mean * mean)))
 
 
-def montage(path, images, labels, exposure):
-	"""Images side by side, each with its label above, one PNG."""
+def montage(path, images, labels, exposure, columns=5):
+	"""Images in rows of `columns`, each with its label above, one PNG
+	(what README shows as scenes/<scene>/peers.png)."""
 	from PIL import Image, ImageDraw
 	h, w = images[0].shape[:2]
-	scale = max(1, 256 // max(w, h))
-	pad = 14
-	out = Image.new("RGB", (len(images) * (w * scale + 4), h * scale + pad), (0, 0, 0))
+	scale = max(1, 128 // max(w, h))
+	tw, th, pad = w * scale, h * scale, 14
+	cols = min(columns, len(images))
+	rows = (len(images) + cols - 1) // cols
+	out = Image.new("RGB", (cols * (tw + 4), rows * (th + pad)), (0, 0, 0))
 	d = ImageDraw.Draw(out)
 	for k, (im, lab) in enumerate(zip(images, labels)):
-		tile = Image.fromarray(to_srgb8(im, exposure)).resize((w * scale, h * scale), Image.NEAREST)
-		x = k * (w * scale + 4)
-		out.paste(tile, (x, pad))
-		d.text((x + 2, 1), lab, fill=(255, 255, 255))
-	out.save(path)
+		tile = Image.fromarray(to_srgb8(im, exposure)).resize((tw, th), Image.NEAREST)
+		x, y = (k % cols) * (tw + 4), (k // cols) * (th + pad)
+		out.paste(tile, (x, y + pad))
+		d.text((x + 2, y + 1), lab, fill=(255, 255, 255))
+	out.save(path, optimize=True)
