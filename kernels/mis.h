@@ -92,8 +92,7 @@ INLINE float mis_path_weight(const MisVertex *v, int k, int s, int heuristic)
  * with p_pair(m) = p_A(w_0) / (2 pi) G(x_m, x_{m+1}). Every crossing of
  * edge m with a portal triangle is a separate strategy of the same
  * density, so the strategies of edge m count cross[m] times. Densities are
- * summed in log space from prefix sums, and for one edge the sum over
- * (s, t') is a product of a sum over s and a sum over t'. */
+ * multiplied in log space, from prefix sums of their logs. */
 
 typedef struct {
 	int c;  /* 1: bdpt (s, t = k - s); 2: portal (s, m, t') */
@@ -125,14 +124,59 @@ INLINE int mis_bdpt_valid(const MisVertex *v, int k, int s)
 	return !(v[s - 1].infinite && s == k - 1);
 }
 
+/* Natural log and exp for MIS weights: a fixed polynomial, the same on the
+ * host and every device. A weight only needs every strategy's sum to see
+ * the same value for the same density, so a few ulps do not matter, while
+ * PoCL's libm log (SLEEF) took 15% of a portal sample. mis_log: x > 0
+ * (remapped densities), -AJAR_INF for 0; mis_exp: 0 below -87. */
+INLINE float mis_log(float x)
+{
+	if (!(x > 0.0f))
+		return -AJAR_INF;
+	uint b = f2u(x);
+	if (b >= 0x7f800000u) /* +inf */
+		return AJAR_INF;
+	float e = 0.0f;
+	if (b < 0x00800000u) { /* subnormal: scale by 2^23 */
+		b = f2u(x * 8388608.0f);
+		e = -23.0f;
+	}
+	e += (float)((int)(b >> 23) - 127);
+	float m = u2f((b & 0x007fffffu) | 0x3f800000u); /* [1, 2) */
+	if (m > 1.41421356f) {
+		m *= 0.5f;
+		e += 1.0f;
+	}
+	/* ln m = 2 atanh t, t = (m - 1) / (m + 1), |t| < 0.172: five terms
+	 * leave an error below 1e-9. */
+	float t = (m - 1.0f) / (m + 1.0f), t2 = t * t;
+	float s = 2.0f * t * (1.0f + t2 * (0.33333333f + t2 * (0.2f + t2 * (0.14285714f + t2 * 0.11111111f))));
+	return e * 0.69314718f + s;
+}
+
+INLINE float mis_exp(float x)
+{
+	if (!(x > -87.0f)) /* also NaN */
+		return 0.0f;
+	if (x > 88.0f)
+		return AJAR_INF;
+	/* e^x = 2^n e^g with |g| <= ln2 / 2: Taylor to g^7, error below 1e-8.
+	 * ln2 in two parts (Cody and Waite): n times the first is exact. */
+	float n = floor(x * 1.44269504f + 0.5f);
+	float g = (x - n * 0.693145751953125f) - n * 1.428606765330187e-6f;
+	float p = 1.0f + g * (1.0f + g * (0.5f + g * (0.16666667f + g * (0.041666667f + g * (0.0083333333f +
+		g * (0.0013888889f + g * 0.00019841270f))))));
+	return p * u2f((uint)((int)n + 127) << 23);
+}
+
 /* Logs of the remapped densities and their prefix sums: PF[j] = sum of
  * log pf_i for i < j, PR likewise; arrays of k + 1. */
 INLINE void mis_prefix(const MisVertex *v, int k, float *PF, float *PR)
 {
 	PF[0] = PR[0] = 0.0f;
 	for (int i = 0; i < k; i++) {
-		PF[i + 1] = PF[i] + log(mis_remap0(v[i].pf));
-		PR[i + 1] = PR[i] + log(mis_remap0(v[i].pr));
+		PF[i + 1] = PF[i] + mis_log(mis_remap0(v[i].pf));
+		PR[i + 1] = PR[i] + mis_log(mis_remap0(v[i].pr));
 	}
 }
 
@@ -149,9 +193,9 @@ INLINE float mis_log_bdpt(const float *PF, float lpn, const float *PR, int k, in
 INLINE float mis_logadd(float a, float b)
 {
 	float hi = fmax(a, b), lo = fmin(a, b);
-	if (lo == -AJAR_INF) /* also the empty sum; exp(-inf) takes libm's slow path */
+	if (lo == -AJAR_INF) /* the empty sum */
 		return hi;
-	return hi + log(1.0f + exp(lo - hi));
+	return hi + mis_log(1.0f + mis_exp(lo - hi));
 }
 
 INLINE float mis_beta(int heuristic) { return heuristic == MIS_BALANCE ? 1.0f : 2.0f; }
@@ -167,30 +211,35 @@ INLINE float mis_union_weight(const MisVertex *v, int k, const int *cross, const
 	float PF[4 * 33 + 1], PR[4 * 33 + 1];
 	float beta = mis_beta(heuristic);
 	mis_prefix(v, k, PF, PR);
-	float lpn = log(mis_remap0(v[0].pn));
+	float lpn = mis_log(mis_remap0(v[0].pn));
 	float lcur = cur.c == 1 ? mis_log_bdpt(PF, lpn, PR, k, cur.s)
 				: mis_lpf(PF, lpn, cur.s) + (PR[cur.m] - PR[cur.s]) + lpair_cur +
 					  (PF[cur.m + cur.tp + 1] - PF[cur.m + 2]) + (PR[k] - PR[cur.m + cur.tp + 1]) +
 					  set.lrate;
-	float total = -AJAR_INF; /* log of sum of (p_j / p_cur)^beta */
+	/* Sum of (p_j / p_cur)^beta, each ratio from its log: one that
+	 * overflows makes the sum FLT_MAX or inf, and the weight 0, its limit. */
+	float total = 0.0f;
 	for (int s = 0; s < k; s++)
 		if (mis_bdpt_valid(v, k, s) && (set.light_paths || (s <= 1 && s < k - 1)))
-			total = mis_logadd(total, beta * (mis_log_bdpt(PF, lpn, PR, k, s) - lcur));
-	for (int m = 0; m + 2 < k; m++) {
+			total += mis_exp(beta * (mis_log_bdpt(PF, lpn, PR, k, s) - lcur));
+	/* Intermediate strategies of edge m: s <= s_max light vertices and
+	 * s' = m - s + 1 <= sp_max of the <- half, so m < s_max + sp_max. */
+	for (int m = 0; m + 2 < k && m - set.sp_max < set.s_max; m++) {
 		if (cross[m] <= 0)
 			continue;
-		/* Left factor: s in [0, m] with a valid light connection. */
-		float left = -AJAR_INF, right = -AJAR_INF;
-		for (int s = max(0, m + 1 - set.sp_max); s <= m && s <= set.s_max; s++)
-			if (s == 0 || (!v[s - 1].delta && !v[s].delta))
-				left = mis_logadd(left, beta * (mis_lpf(PF, lpn, s) + PR[m] - PR[s]));
-		/* Right factor: t' >= 1 with m + t' <= k - 2 and a valid eye connection. */
-		for (int tp = 1; m + tp <= k - 2 && tp <= set.tp_max; tp++)
-			if (!v[m + tp].delta && !v[m + tp + 1].delta && k - m - tp - 1 <= set.t_max)
-				right = mis_logadd(right, beta * ((PF[m + tp + 1] - PF[m + 2]) + (PR[k] - PR[m + tp + 1])));
-		float term = left + right + lpsum[m] + beta * (set.lrate - lcur);
-		total = mis_logadd(total, term);
+		float base = lpsum[m] + beta * (set.lrate - lcur);
+		/* s in [0, m] with a valid light connection ... */
+		for (int s = max(0, m + 1 - set.sp_max); s <= m && s <= set.s_max; s++) {
+			if (s > 0 && (v[s - 1].delta || v[s].delta))
+				continue;
+			float left = base + beta * (mis_lpf(PF, lpn, s) + PR[m] - PR[s]);
+			/* ... and t' >= 1 with m + t' <= k - 2 and a valid eye connection. */
+			for (int tp = 1; m + tp <= k - 2 && tp <= set.tp_max; tp++)
+				if (!v[m + tp].delta && !v[m + tp + 1].delta && k - m - tp - 1 <= set.t_max)
+					total += mis_exp(left + beta * ((PF[m + tp + 1] - PF[m + 2]) +
+									 (PR[k] - PR[m + tp + 1])));
+		}
 	}
-	return exp(-total);
+	return 1.0f / total;
 }
 #endif
