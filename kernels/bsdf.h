@@ -180,8 +180,9 @@ INLINE V3 ggx_sample_visible(V3 wo, float alpha, float u1, float u2)
 	float len2 = vh.x * vh.x + vh.y * vh.y;
 	V3 t1 = len2 > 1e-14f ? v3_scale(v3(-vh.y, vh.x, 0.0f), 1.0f / sqrt(len2)) : v3(1.0f, 0.0f, 0.0f);
 	V3 t2 = v3_cross(vh, t1);
-	float r = sqrt(u1), phi = 2.0f * AJAR_PI * u2;
-	float p1 = r * cos(phi), p2 = r * sin(phi);
+	float r = sqrt(u1), sp, cp;
+	fast_sincos(AJAR_PI * (2.0f * u2 - 1.0f), &sp, &cp);
+	float p1 = r * cp, p2 = r * sp;
 	float s = 0.5f * (1.0f + vh.z);
 	p2 = (1.0f - s) * sqrt(fmax(0.0f, 1.0f - p1 * p1)) + s * p2;
 	V3 nh = v3_add(v3_add(v3_scale(t1, p1), v3_scale(t2, p2)),
@@ -302,7 +303,12 @@ INLINE V3 bsdf_eval_local(const Bsdf *bs, V3 wo, V3 wi, float eta, int mode, flo
 		V3 h;
 		if (bsdf_half_refract(wo, wi, eta, &h)) {
 			float cos_oh = v3_dot(wo, h), cos_ih = v3_dot(wi, h);
-			float fr = bsdf_fresnel_dielectric(cos_oh, eta);
+			/* Fresnel from the rarer medium's side (F(theta_i, eta) =
+			 * F(theta_t, 1 / eta)): the same value whichever way the
+			 * pair is evaluated, and accurate near the critical angle,
+			 * where the denser side's cos_t is a steep square root. */
+			float fr = eta >= 1.0f ? bsdf_fresnel_dielectric(cos_oh, eta)
+					       : bsdf_fresnel_dielectric(-cos_ih, 1.0f / eta);
 			float denom = cos_ih + cos_oh / eta;
 			denom *= denom;
 			float t = ggx_d(h, bs->alpha) * ggx_g2(wo, wi, bs->alpha) * (1.0f - fr) *

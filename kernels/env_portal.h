@@ -33,7 +33,7 @@ INLINE float sph_tri_solid_angle(V3 a, V3 b, V3 c)
 {
 	float num = fabs(v3_dot(a, v3_cross(b, c)));
 	float den = 1.0f + v3_dot(a, b) + v3_dot(b, c) + v3_dot(c, a);
-	return 2.0f * atan2(num, den);
+	return 2.0f * fast_atan2(num, den);
 }
 
 /* A direction uniform within the spherical triangle (a, b, c) of solid
@@ -56,7 +56,8 @@ INLINE V3 sph_tri_sample(V3 a, V3 b, V3 c, float omega, float u1, float u2)
 	float inv = 1.0f / sqrt(v3_len2(nab) * v3_len2(nac));
 	float cos_alpha = v3_dot(nab, nac) * inv, sin_alpha = v3_len(v3_cross(nab, nac)) * inv;
 	float k = v3_len(nab) / (1.0f + v3_dot(a, b)); /* tan(|ab| / 2) */
-	float se = sin(0.5f * u1 * omega), ce = cos(0.5f * u1 * omega);
+	float se, ce; /* of E / 2 in [0, pi] */
+	fast_sincos(0.5f * u1 * omega, &se, &ce);
 	float den = k * (ce * sin_alpha - se * cos_alpha); /* k sin(alpha - E / 2) > 0 */
 	V3 cp = c;
 	if (den > 0.0f) {

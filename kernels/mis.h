@@ -19,7 +19,7 @@
  * are left out of the sum. */
 #ifndef AJAR_MIS_H
 #define AJAR_MIS_H
-#include "compat.h"
+#include "fastmath.h"
 
 #define MIS_BALANCE 1
 #define MIS_POWER 0
@@ -124,59 +124,14 @@ INLINE int mis_bdpt_valid(const MisVertex *v, int k, int s)
 	return !(v[s - 1].infinite && s == k - 1);
 }
 
-/* Natural log and exp for MIS weights: a fixed polynomial, the same on the
- * host and every device. A weight only needs every strategy's sum to see
- * the same value for the same density, so a few ulps do not matter, while
- * PoCL's libm log (SLEEF) took 15% of a portal sample. mis_log: x > 0
- * (remapped densities), -AJAR_INF for 0; mis_exp: 0 below -87. */
-INLINE float mis_log(float x)
-{
-	if (!(x > 0.0f))
-		return -AJAR_INF;
-	uint b = f2u(x);
-	if (b >= 0x7f800000u) /* +inf */
-		return AJAR_INF;
-	float e = 0.0f;
-	if (b < 0x00800000u) { /* subnormal: scale by 2^23 */
-		b = f2u(x * 8388608.0f);
-		e = -23.0f;
-	}
-	e += (float)((int)(b >> 23) - 127);
-	float m = u2f((b & 0x007fffffu) | 0x3f800000u); /* [1, 2) */
-	if (m > 1.41421356f) {
-		m *= 0.5f;
-		e += 1.0f;
-	}
-	/* ln m = 2 atanh t, t = (m - 1) / (m + 1), |t| < 0.172: five terms
-	 * leave an error below 1e-9. */
-	float t = (m - 1.0f) / (m + 1.0f), t2 = t * t;
-	float s = 2.0f * t * (1.0f + t2 * (0.33333333f + t2 * (0.2f + t2 * (0.14285714f + t2 * 0.11111111f))));
-	return e * 0.69314718f + s;
-}
-
-INLINE float mis_exp(float x)
-{
-	if (!(x > -87.0f)) /* also NaN */
-		return 0.0f;
-	if (x > 88.0f)
-		return AJAR_INF;
-	/* e^x = 2^n e^g with |g| <= ln2 / 2: Taylor to g^7, error below 1e-8.
-	 * ln2 in two parts (Cody and Waite): n times the first is exact. */
-	float n = floor(x * 1.44269504f + 0.5f);
-	float g = (x - n * 0.693145751953125f) - n * 1.428606765330187e-6f;
-	float p = 1.0f + g * (1.0f + g * (0.5f + g * (0.16666667f + g * (0.041666667f + g * (0.0083333333f +
-		g * (0.0013888889f + g * 0.00019841270f))))));
-	return p * u2f((uint)((int)n + 127) << 23);
-}
-
 /* Logs of the remapped densities and their prefix sums: PF[j] = sum of
  * log pf_i for i < j, PR likewise; arrays of k + 1. */
 INLINE void mis_prefix(const MisVertex *v, int k, float *PF, float *PR)
 {
 	PF[0] = PR[0] = 0.0f;
 	for (int i = 0; i < k; i++) {
-		PF[i + 1] = PF[i] + mis_log(mis_remap0(v[i].pf));
-		PR[i + 1] = PR[i] + mis_log(mis_remap0(v[i].pr));
+		PF[i + 1] = PF[i] + fast_log(mis_remap0(v[i].pf));
+		PR[i + 1] = PR[i] + fast_log(mis_remap0(v[i].pr));
 	}
 }
 
@@ -195,7 +150,7 @@ INLINE float mis_logadd(float a, float b)
 	float hi = fmax(a, b), lo = fmin(a, b);
 	if (lo == -AJAR_INF) /* the empty sum */
 		return hi;
-	return hi + mis_log(1.0f + mis_exp(lo - hi));
+	return hi + fast_log(1.0f + fast_exp(lo - hi));
 }
 
 INLINE float mis_beta(int heuristic) { return heuristic == MIS_BALANCE ? 1.0f : 2.0f; }
@@ -211,7 +166,7 @@ INLINE float mis_union_weight(const MisVertex *v, int k, const int *cross, const
 	float PF[4 * 33 + 1], PR[4 * 33 + 1];
 	float beta = mis_beta(heuristic);
 	mis_prefix(v, k, PF, PR);
-	float lpn = mis_log(mis_remap0(v[0].pn));
+	float lpn = fast_log(mis_remap0(v[0].pn));
 	float lcur = cur.c == 1 ? mis_log_bdpt(PF, lpn, PR, k, cur.s)
 				: mis_lpf(PF, lpn, cur.s) + (PR[cur.m] - PR[cur.s]) + lpair_cur +
 					  (PF[cur.m + cur.tp + 1] - PF[cur.m + 2]) + (PR[k] - PR[cur.m + cur.tp + 1]) +
@@ -221,7 +176,7 @@ INLINE float mis_union_weight(const MisVertex *v, int k, const int *cross, const
 	float total = 0.0f;
 	for (int s = 0; s < k; s++)
 		if (mis_bdpt_valid(v, k, s) && (set.light_paths || (s <= 1 && s < k - 1)))
-			total += mis_exp(beta * (mis_log_bdpt(PF, lpn, PR, k, s) - lcur));
+			total += fast_exp(beta * (mis_log_bdpt(PF, lpn, PR, k, s) - lcur));
 	/* Intermediate strategies of edge m: s <= s_max light vertices and
 	 * s' = m - s + 1 <= sp_max of the <- half, so m < s_max + sp_max. */
 	for (int m = 0; m + 2 < k && m - set.sp_max < set.s_max; m++) {
@@ -236,7 +191,7 @@ INLINE float mis_union_weight(const MisVertex *v, int k, const int *cross, const
 			/* ... and t' >= 1 with m + t' <= k - 2 and a valid eye connection. */
 			for (int tp = 1; m + tp <= k - 2 && tp <= set.tp_max; tp++)
 				if (!v[m + tp].delta && !v[m + tp + 1].delta && k - m - tp - 1 <= set.t_max)
-					total += mis_exp(left + beta * ((PF[m + tp + 1] - PF[m + 2]) +
+					total += fast_exp(left + beta * ((PF[m + tp + 1] - PF[m + 2]) +
 									 (PR[k] - PR[m + tp + 1])));
 		}
 	}

@@ -150,7 +150,7 @@ INLINE float portal_pair_log(const SceneView *sc, GLOBAL const PortalTri *pt, co
 		float d2 = v3_len2(d);
 		g = fabs(v3_dot(a->ng, d)) * fabs(v3_dot(b->ng, d)) / (d2 * d2);
 	}
-	return mis_log(fmax(pa * portal_direction_psa(sc, pt, a, w) * g, 1e-30f));
+	return fast_log(fmax(pa * portal_direction_psa(sc, pt, a, w) * g, 1e-30f));
 }
 
 /* For edge (x_i, x_{i+1}): log of the sum over its portal crossings of
@@ -258,7 +258,7 @@ INLINE void path_records(const SceneView *sc, const PathRef *P, int heuristic, M
 INLINE MisPortalSet path_portal_set(GLOBAL const Params *prm)
 {
 	MisPortalSet set = {prm->portal_s_max, prm->portal_sp_max, prm->portal_tp_max, prm->portal_t_max,
-			    prm->light_paths, mis_log(prm->portal_rate)};
+			    prm->light_paths, fast_log(prm->portal_rate)};
 	return set;
 }
 

@@ -6,6 +6,7 @@
  * chi-square tests in tests/test_sampling.c check every pair. */
 #ifndef AJAR_SAMPLING_H
 #define AJAR_SAMPLING_H
+#include "fastmath.h"
 #include "vec.h"
 
 /* Shirley–Chiu concentric map of the square onto the unit disk: uniform by
@@ -26,8 +27,10 @@ INLINE void sample_concentric_disk(float u1, float u2, float *x, float *y)
 		r = b;
 		phi = AJAR_PI * 0.5f - (AJAR_PI * 0.25f) * (a / b);
 	}
-	*x = r * cos(phi);
-	*y = r * sin(phi);
+	float c, s;
+	fast_sincos(phi, &s, &c);
+	*x = r * c;
+	*y = r * s;
 }
 
 /* Malley's method: project the disk up onto the hemisphere. */
@@ -44,8 +47,9 @@ INLINE V3 sample_uniform_sphere(float u1, float u2)
 {
 	float z = 1.0f - 2.0f * u1;
 	float r = sqrt(fmax(0.0f, 1.0f - z * z));
-	float phi = 2.0f * AJAR_PI * u2;
-	return v3(r * cos(phi), r * sin(phi), z);
+	float c, sn;
+	fast_sincos(AJAR_PI * (2.0f * u2 - 1.0f), &sn, &c); /* a uniform angle */
+	return v3(r * c, r * sn, z);
 }
 
 INLINE float pdf_uniform_sphere_w(void) { return 0.25f * AJAR_INV_PI; }
@@ -55,8 +59,9 @@ INLINE V3 sample_uniform_cone(float u1, float u2, float cos_max)
 {
 	float z = 1.0f - u1 * (1.0f - cos_max);
 	float r = sqrt(fmax(0.0f, 1.0f - z * z));
-	float phi = 2.0f * AJAR_PI * u2;
-	return v3(r * cos(phi), r * sin(phi), z);
+	float c, sn;
+	fast_sincos(AJAR_PI * (2.0f * u2 - 1.0f), &sn, &c); /* a uniform angle */
+	return v3(r * c, r * sn, z);
 }
 
 INLINE float pdf_uniform_cone_w(float cos_max)

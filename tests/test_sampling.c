@@ -3,13 +3,18 @@
  * Every warp is histogrammed and compared with its density by a chi-square
  * test (cells whose exact probability is known in closed form); sample_cdf
  * against its discrete probabilities, zero-width buckets included; the RNG
- * for determinism, range, uniformity and decorrelation of neighbours. */
+ * for determinism, range, uniformity and decorrelation of neighbours; the
+ * polynomial log, exp, atan2 and sin/cos of kernels/fastmath.h against
+ * double precision over the ranges they promise. */
 #include "testutil.h"
 
+#include <float.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "../kernels/fastmath.h"
 #include "../kernels/rng.h"
 #include "../kernels/sampling.h"
 
@@ -285,6 +290,57 @@ static void test_rng_uniform(void **state)
 	check_chi2("rng neighbours", pair, pair_exp, NP * NP);
 }
 
+/* fastmath.h against libm in double: log over every binade (subnormals
+ * included), exp over (-87, 88), atan2 around the circle at magnitudes from
+ * 1e-30 to 1e30, sin/cos over [-pi, pi]; and the limits. */
+static void test_fast_math(void **state)
+{
+	(void)state;
+	double e_log = 0.0, e_exp = 0.0, e_atan = 0.0, e_atan_rel = 0.0, e_sc = 0.0;
+	for (int i = 0; i < 300000; i++) {
+		float x = (float)exp2(-149.0 + 277.0 * (i + 0.5) / 300000.0); /* [2^-149, 2^128) */
+		if (!(x > 0.0f) || !(x < FLT_MAX))
+			continue;
+		double ref = log((double)x);
+		e_log = fmax(e_log, fabs(fast_log(x) - ref) / fmax(1.0, fabs(ref)));
+	}
+	for (int i = 0; i < 300000; i++) {
+		float x = -86.99f + 174.98f * (float)i / 300000.0f;
+		double ref = exp((double)x);
+		e_exp = fmax(e_exp, fabs(fast_exp(x) - ref) / ref);
+	}
+	for (int i = 0; i < 200000; i++) {
+		double a = -M_PI + 2.0 * M_PI * (i + 0.5) / 200000.0, r = pow(10.0, -30.0 + 60.0 * (i % 61) / 60.0);
+		float y = (float)(r * sin(a)), x = (float)(r * cos(a));
+		double ref = atan2((double)y, (double)x), got = fast_atan2(y, x);
+		e_atan = fmax(e_atan, fabs(got - ref));
+		if (fabs(ref) < 0.1) /* small angles (small solid angles): relative */
+			e_atan_rel = fmax(e_atan_rel, fabs(got - ref) / fmax(fabs(ref), 1e-30));
+		float s, c;
+		float t = (float)a;
+		fast_sincos(t, &s, &c);
+		e_sc = fmax(e_sc, fmax(fabs(s - sin((double)t)), fabs(c - cos((double)t))));
+	}
+	printf("fast_log %.2e, fast_exp %.2e (relative), fast_atan2 %.2e (%.2e relative below 0.1), fast_sincos %.2e\n",
+	       e_log, e_exp, e_atan, e_atan_rel, e_sc);
+	assert_true(e_log < 3e-7);
+	assert_true(e_exp < 3e-7);
+	assert_true(e_atan < 3e-7);
+	assert_true(e_atan_rel < 1e-6);
+	assert_true(e_sc < 3e-7);
+	/* Limits. */
+	assert_true(fast_log(0.0f) == -AJAR_INF && fast_log(-1.0f) == -AJAR_INF);
+	assert_true(fast_log(INFINITY) == AJAR_INF);
+	assert_true(fast_log(1.0f) == 0.0f);
+	assert_true(fast_exp(0.0f) == 1.0f && fast_exp(-100.0f) == 0.0f && fast_exp(NAN) == 0.0f);
+	assert_true(fast_exp(100.0f) == AJAR_INF);
+	assert_true(fast_atan2(0.0f, 0.0f) == 0.0f && fast_atan2(0.0f, -1.0f) == AJAR_PI);
+	assert_true(fabs(fast_atan2(1.0f, 0.0f) - M_PI / 2) < 1e-7 && fabs(fast_atan2(-1.0f, 0.0f) + M_PI / 2) < 1e-7);
+	float s, c;
+	fast_sincos(AJAR_PI, &s, &c);
+	assert_true(fabs(s) < 1e-6 && c == -1.0f);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -292,6 +348,7 @@ int main(void)
 		cmocka_unit_test(test_uniform_cone),      cmocka_unit_test(test_concentric_disk),
 		cmocka_unit_test(test_triangle),          cmocka_unit_test(test_cdf),
 		cmocka_unit_test(test_rng_deterministic), cmocka_unit_test(test_rng_uniform),
+		cmocka_unit_test(test_fast_math),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
