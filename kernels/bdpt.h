@@ -118,18 +118,25 @@ INLINE int bdpt_visible(const SceneView *sc, const PathVertex *a, const PathVert
 }
 
 /* f (with the shading-normal correction on light subpaths) times the
- * shading cosine toward `to`, at a surface vertex v whose subpath
- * predecessor lies along v->wo. */
-INLINE V3 bdpt_scatter(const SceneView *sc, const PathVertex *v, V3 wi, int mode)
+ * shading cosine toward wi, at a surface vertex v whose subpath
+ * predecessor lies along v->wo; and the solid-angle density *pdf_w of
+ * v's BSDF sampling wi. */
+INLINE V3 bdpt_scatter_pdf(const SceneView *sc, const PathVertex *v, V3 wi, int mode, float *pdf_w)
 {
 	Bsdf bs;
-	float pdf_w, pdf_rev_w;
+	float pdf_rev_w;
 	vertex_bsdf(sc, v, &bs);
-	V3 f = bsdf_eval(&bs, v->wo, wi, mode, &pdf_w, &pdf_rev_w);
+	V3 f = bsdf_eval(&bs, v->wo, wi, mode, pdf_w, &pdf_rev_w);
 	float k = fabs(v3_dot(v->ns, wi));
 	if (mode == BSDF_IMPORTANCE)
 		k *= vertex_shading_correction(v, v->wo, wi);
 	return v3_scale(f, k);
+}
+
+INLINE V3 bdpt_scatter(const SceneView *sc, const PathVertex *v, V3 wi, int mode)
+{
+	float pdf_w;
+	return bdpt_scatter_pdf(sc, v, wi, mode, &pdf_w);
 }
 
 /* Traces the light subpath into l[]; returns its vertex count (0 if the
@@ -337,6 +344,24 @@ INLINE int bdpt_nee_visible(const SceneView *sc, const PathVertex *z, const Ligh
 	return segment_clear(sc, z->p, z->ng, ls->p, ls->n);
 }
 
+/* Next-event estimation at eye-side surface vertex z: the light sample's
+ * vertex *y (with pr, z's density of sampling it, which MIS records need)
+ * and the contribution from z's throughput on, 0 if occluded. */
+INLINE V3 bdpt_nee(const SceneView *sc, const PathVertex *z, PathVertex *y, Rng *rng)
+{
+	LightSample ls;
+	float u0 = rng_f(rng), u1 = rng_f(rng), u2 = rng_f(rng), pdf_w;
+	V3 zero = v3(0.0f, 0.0f, 0.0f);
+	if (!light_sample(sc, z->p, u0, u1, u2, &ls) || v3_is_zero(ls.Le))
+		return zero;
+	bdpt_light_vertex(y, &ls);
+	V3 f = bdpt_scatter_pdf(sc, z, ls.wi, BSDF_RADIANCE, &pdf_w);
+	if (v3_is_zero(f) || !bdpt_nee_visible(sc, z, &ls))
+		return zero;
+	y->pr = vertex_density_a(z, y, pdf_w);
+	return v3_scale(v3_mul(v3_mul(z->beta, f), ls.Le), 1.0f / ls.pdf_w);
+}
+
 /* Every bdpt strategy of one light and one eye subpath: adds the eye
  * strategies to out->L and splats light tracing (t = 1). */
 INLINE void bdpt_strategies(const SceneView *sc, PathVertex *l, int nl, PathVertex *e, int ne, BdptFilm *out,
@@ -360,17 +385,10 @@ INLINE void bdpt_strategies(const SceneView *sc, PathVertex *l, int nl, PathVert
 			break;
 		/* s = 1: next-event estimation with a fresh light sample. */
 		if (t <= depth) {
-			LightSample ls;
-			float u0 = rng_f(rng), u1 = rng_f(rng), u2 = rng_f(rng);
-			if (light_sample(sc, z->p, u0, u1, u2, &ls) && !v3_is_zero(ls.Le)) {
-				PathVertex y;
-				bdpt_light_vertex(&y, &ls);
-				V3 f = bdpt_scatter(sc, z, ls.wi, BSDF_RADIANCE);
-				if (!v3_is_zero(f) && bdpt_nee_visible(sc, z, &ls)) {
-					V3 c = v3_scale(v3_mul(v3_mul(z->beta, f), ls.Le), 1.0f / ls.pdf_w);
-					bdpt_add(sc, out, 1, t, c, bdpt_weight(sc, &y, 1, e, t), out->pixel, rng);
-				}
-			}
+			PathVertex y;
+			V3 c = bdpt_nee(sc, z, &y, rng);
+			if (!v3_is_zero(c))
+				bdpt_add(sc, out, 1, t, c, bdpt_weight(sc, &y, 1, e, t), out->pixel, rng);
 		}
 		/* s >= 2: light vertex s-1 to eye vertex t-1. */
 		for (int s = 2; s <= nl && s + t - 1 <= depth; s++) {

@@ -124,24 +124,42 @@ INLINE int mis_bdpt_valid(const MisVertex *v, int k, int s)
 	return !(v[s - 1].infinite && s == k - 1);
 }
 
-/* Logs of the remapped densities and their prefix sums: PF[j] = sum of
- * log pf_i for i < j, PR likewise; arrays of k + 1. */
-INLINE void mis_prefix(const MisVertex *v, int k, float *PF, float *PR)
+/* Logs of the remapped densities of x_0 .. x_{n-1} and their prefix sums:
+ * PF[j] = sum of log pf_i for i < j, PR likewise; arrays of n + 1. PF stays
+ * 0 unless `need_pf` (mis_needs_pf). */
+INLINE void mis_prefix(const MisVertex *v, int n, int need_pf, float *PF, float *PR)
 {
 	PF[0] = PR[0] = 0.0f;
-	for (int i = 0; i < k; i++) {
-		PF[i + 1] = PF[i] + fast_log(mis_remap0(v[i].pf));
+	for (int i = 0; i < n; i++) {
+		PF[i + 1] = need_pf ? PF[i] + fast_log(mis_remap0(v[i].pf)) : 0.0f;
 		PR[i + 1] = PR[i] + fast_log(mis_remap0(v[i].pr));
 	}
+}
+
+/* Whether any strategy in use has eye-side vertices sampled from the
+ * light side: light subpaths, or -> halves of more than one vertex. Else
+ * only pn of x_0 and the pr enter the weights. */
+INLINE int mis_needs_pf(MisPortalSet set) { return set.light_paths || set.tp_max >= 2; }
+
+/* How many of the path's first vertices the weights read. All of them with
+ * light subpaths; without, bdpt strategies have s <= 1 and intermediate
+ * ones reach x_{s_max + sp_max + tp_max} at most, and every pr beyond is
+ * one factor common to all strategies, which cancels. */
+INLINE int mis_horizon(MisPortalSet set, int k)
+{
+	if (set.light_paths || set.s_max >= k || set.sp_max >= k || set.tp_max >= k)
+		return k;
+	return min(k, set.s_max + set.sp_max + set.tp_max + 1);
 }
 
 /* log of the light side's density of strategies with s light vertices:
  * x_0 is a next-event sample (pn) when s = 1. */
 INLINE float mis_lpf(const float *PF, float lpn, int s) { return s == 1 ? lpn : PF[s]; }
 
-INLINE float mis_log_bdpt(const float *PF, float lpn, const float *PR, int k, int s)
+/* log of the density of bdpt strategy s; PR[n] is the eye side's whole. */
+INLINE float mis_log_bdpt(const float *PF, float lpn, const float *PR, int n, int s)
 {
-	return mis_lpf(PF, lpn, s) + PR[k] - PR[s];
+	return mis_lpf(PF, lpn, s) + PR[n] - PR[s];
 }
 
 /* log(exp(a) + exp(b)) without overflow; -INF is the empty sum. */
@@ -156,27 +174,31 @@ INLINE float mis_logadd(float a, float b)
 INLINE float mis_beta(int heuristic) { return heuristic == MIS_BALANCE ? 1.0f : 2.0f; }
 
 /* Weight of strategy `cur` for the k-vertex path v among all BDPT and
- * portal strategies in use. cross[i] > 0 marks an edge (x_i, x_{i+1})
+ * portal strategies in use; v holds the records of the first n =
+ * mis_horizon(set, k) vertices. cross[i] > 0 marks an edge (x_i, x_{i+1})
  * that crosses portals; lpsum[i] = log sum over its crossings c of
  * p_pair_c^beta (each crossing is a strategy of its own, with its own
- * direction density); lpair_cur is log p_pair of cur's own crossing. */
-INLINE float mis_union_weight(const MisVertex *v, int k, const int *cross, const float *lpsum, float lpair_cur,
+ * direction density); lpair_cur is log p_pair of cur's own crossing. Both
+ * are read for edges m < s_max + sp_max only. */
+INLINE float mis_union_weight(const MisVertex *v, int k, int n, const int *cross, const float *lpsum, float lpair_cur,
 			      MisStrategy cur, MisPortalSet set, int heuristic)
 {
 	float PF[4 * 33 + 1], PR[4 * 33 + 1];
 	float beta = mis_beta(heuristic);
-	mis_prefix(v, k, PF, PR);
+	mis_prefix(v, n, mis_needs_pf(set), PF, PR);
 	float lpn = fast_log(mis_remap0(v[0].pn));
-	float lcur = cur.c == 1 ? mis_log_bdpt(PF, lpn, PR, k, cur.s)
+	/* PR[n] stands in for PR[k]: the pr of x_n .. x_{k-1} are a factor of
+	 * every strategy's density. */
+	float lcur = cur.c == 1 ? mis_log_bdpt(PF, lpn, PR, n, cur.s)
 				: mis_lpf(PF, lpn, cur.s) + (PR[cur.m] - PR[cur.s]) + lpair_cur +
-					  (PF[cur.m + cur.tp + 1] - PF[cur.m + 2]) + (PR[k] - PR[cur.m + cur.tp + 1]) +
+					  (PF[cur.m + cur.tp + 1] - PF[cur.m + 2]) + (PR[n] - PR[cur.m + cur.tp + 1]) +
 					  set.lrate;
 	/* Sum of (p_j / p_cur)^beta, each ratio from its log: one that
 	 * overflows makes the sum FLT_MAX or inf, and the weight 0, its limit. */
 	float total = 0.0f;
-	for (int s = 0; s < k; s++)
-		if (mis_bdpt_valid(v, k, s) && (set.light_paths || (s <= 1 && s < k - 1)))
-			total += fast_exp(beta * (mis_log_bdpt(PF, lpn, PR, k, s) - lcur));
+	for (int s = 0; s < (set.light_paths ? k : min(2, k - 1)); s++)
+		if (mis_bdpt_valid(v, k, s))
+			total += fast_exp(beta * (mis_log_bdpt(PF, lpn, PR, n, s) - lcur));
 	/* Intermediate strategies of edge m: s <= s_max light vertices and
 	 * s' = m - s + 1 <= sp_max of the <- half, so m < s_max + sp_max. */
 	for (int m = 0; m + 2 < k && m - set.sp_max < set.s_max; m++) {
@@ -192,7 +214,7 @@ INLINE float mis_union_weight(const MisVertex *v, int k, const int *cross, const
 			for (int tp = 1; m + tp <= k - 2 && tp <= set.tp_max; tp++)
 				if (!v[m + tp].delta && !v[m + tp + 1].delta && k - m - tp - 1 <= set.t_max)
 					total += fast_exp(left + beta * ((PF[m + tp + 1] - PF[m + 2]) +
-									 (PR[k] - PR[m + tp + 1])));
+									 (PR[n] - PR[m + tp + 1])));
 		}
 	}
 	return 1.0f / total;

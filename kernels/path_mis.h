@@ -183,14 +183,17 @@ INLINE float path_pair_logsum(const SceneView *sc, const PathRef *P, int i, floa
 	return sum;
 }
 
-/* MIS records, crossings and pair densities (lpsum, lpair_cur as in
- * mis_union_weight) of an assembled path. */
-INLINE void path_records(const SceneView *sc, const PathRef *P, int heuristic, MisVertex *mv, int *cross,
-			 float *lpsum, float *lpair_cur)
+/* MIS records of the first n vertices of an assembled path, and the
+ * crossings and pair densities (lpsum, lpair_cur as in mis_union_weight)
+ * of the edges the weights read: what mis_union_weight needs for the
+ * strategies in `set`. */
+INLINE void path_records(const SceneView *sc, const PathRef *P, int heuristic, MisPortalSet set, int n, MisVertex *mv,
+			 int *cross, float *lpsum, float *lpair_cur)
 {
 	const PathVertex *const *x = P->x;
-	int k = P->k;
-	for (int i = 0; i < k; i++) {
+	int k = P->k, need_pf = mis_needs_pf(set);
+	int nr = min(k, n + 1); /* x_n's delta flag is read too */
+	for (int i = 0; i < nr; i++) {
 		mv[i].pf = x[i]->pf;
 		mv[i].pr = x[i]->pr;
 		mv[i].delta = x[i]->delta;
@@ -198,36 +201,45 @@ INLINE void path_records(const SceneView *sc, const PathRef *P, int heuristic, M
 	}
 	/* Connection ends, the light and the camera scatter through non-delta
 	 * lobes on this path whatever their subpaths did next. */
-	mv[0].delta = mv[k - 1].delta = 0;
-	if (P->c1 >= 0)
-		mv[P->c1].delta = mv[P->c1 + 1].delta = 0;
-	if (P->c2 >= 0)
-		mv[P->c2].delta = mv[P->c2 + 1].delta = 0;
-	/* Densities the subpaths could not know. */
-	bdpt_light_records(sc, mv, x[0], x[1], k);
-	if (P->s == 0 && k > 2)
-		mv[1].pf = path_pf(sc, P, mv, 1);
 	int conn[2] = {P->c1, P->c2};
+	mv[0].delta = 0;
+	if (k - 1 < nr)
+		mv[k - 1].delta = 0;
+	for (int j = 0; j < 2; j++)
+		for (int i = conn[j]; conn[j] >= 0 && i <= conn[j] + 1 && i < nr; i++)
+			mv[i].delta = 0;
+	/* Densities the subpaths could not know. A next-event light vertex
+	 * (s = 1, t >= 2) carries its own sample density, which is pn, and
+	 * its pr when the caller stored it (bdpt_nee). */
+	mv[0].pf = bdpt_origin_pdf(sc, x[0]);
+	int nee = P->s == 1 && k >= 3; /* else a light subpath's origin (t = 1) */
+	mv[0].pn = k < 3 ? mv[0].pf : (nee ? x[0]->pf : bdpt_nee_pdf(sc, x[0], x[1]));
+	if (need_pf && P->s == 0 && k > 2)
+		mv[1].pf = path_pf(sc, P, mv, 1);
 	for (int j = 0; j < 2; j++) {
 		int c = conn[j];
 		if (c < 0)
 			continue;
-		mv[c].pr = path_pr(sc, P, mv, c);
-		if (c >= 1)
+		if (c < n && !(c == 0 && nee && x[0]->pr > 0.0f))
+			mv[c].pr = path_pr(sc, P, mv, c);
+		if (c >= 1 && c - 1 < n)
 			mv[c - 1].pr = path_pr(sc, P, mv, c - 1);
-		if (c + 1 <= k - 2)
+		if (need_pf && c + 1 <= k - 2 && c + 1 < n)
 			mv[c + 1].pf = path_pf(sc, P, mv, c + 1);
-		if (c + 2 <= k - 2)
+		if (need_pf && c + 2 <= k - 2 && c + 2 < n)
 			mv[c + 2].pf = path_pf(sc, P, mv, c + 2);
 	}
-	if (P->pair >= 0) {
-		mv[P->pair + 1].pf = path_pf(sc, P, mv, P->pair + 1);
+	if (P->pair >= 0 && P->pair < n) {
+		if (need_pf && P->pair + 1 < n)
+			mv[P->pair + 1].pf = path_pf(sc, P, mv, P->pair + 1);
 		mv[P->pair].pr = path_pr(sc, P, mv, P->pair);
 	}
-	/* Crossings: each subpath's vertices cached their edge to the previous
-	 * vertex of their own walk; connection edges are new. */
+	/* Crossings of the edges m < s_max + sp_max (mis_union_weight): each
+	 * subpath's vertices cached their edge to the previous vertex of their
+	 * own walk; connection edges are new. */
 	int s = P->s, m = P->pair, tp = P->tp;
-	for (int i = 0; i + 1 < k; i++) {
+	int edges = min(k - 1, min(n, set.s_max + set.sp_max));
+	for (int i = 0; i < edges; i++) {
 		int c;
 		if (i == P->c1 || i == P->c2)
 			c = path_edge_crossings(sc, P, i);
@@ -245,7 +257,7 @@ INLINE void path_records(const SceneView *sc, const PathRef *P, int heuristic, M
 	 * own crossing (its w_0, kept in the pair's vertices). */
 	float beta = mis_beta(heuristic);
 	*lpair_cur = 0.0f;
-	for (int i = 0; i + 1 < k; i++) {
+	for (int i = 0; i < edges; i++) {
 		lpsum[i] = -AJAR_INF;
 		if (cross[i] <= 0 && i != m)
 			continue;
@@ -268,8 +280,10 @@ INLINE float path_union_weight(const SceneView *sc, const PathRef *P, MisStrateg
 	int cross[4 * SUBPATH_MAX];
 	float lpsum[4 * SUBPATH_MAX], lpair_cur;
 	int heuristic = sc->params->mis;
-	path_records(sc, P, heuristic, mv, cross, lpsum, &lpair_cur);
-	return mis_union_weight(mv, P->k, cross, lpsum, lpair_cur, cur, path_portal_set(sc->params), heuristic);
+	MisPortalSet set = path_portal_set(sc->params);
+	int n = mis_horizon(set, P->k);
+	path_records(sc, P, heuristic, set, n, mv, cross, lpsum, &lpair_cur);
+	return mis_union_weight(mv, P->k, n, cross, lpsum, lpair_cur, cur, set, heuristic);
 }
 
 #endif

@@ -235,14 +235,7 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 				} else if (z->type != VERTEX_SURFACE) {
 					break;
 				} else if (s == 1) {
-					LightSample ls;
-					float v0 = rng_f(rng), v1 = rng_f(rng), v2 = rng_f(rng);
-					if (light_sample(sc, z->p, v0, v1, v2, &ls) && !v3_is_zero(ls.Le)) {
-						bdpt_light_vertex(&y, &ls);
-						V3 f = bdpt_scatter(sc, z, ls.wi, BSDF_RADIANCE);
-						if (!v3_is_zero(f) && bdpt_nee_visible(sc, z, &ls))
-							lcon = v3_scale(v3_mul(v3_mul(z->beta, f), ls.Le), 1.0f / ls.pdf_w);
-					}
+					lcon = bdpt_nee(sc, z, &y, rng);
 					lp = &y;
 				} else {
 					V3 c = bdpt_connect(sc, &l[s - 1], z);
