@@ -173,13 +173,23 @@ INLINE float mis_logadd(float a, float b)
 
 INLINE float mis_beta(int heuristic) { return heuristic == MIS_BALANCE ? 1.0f : 2.0f; }
 
+/* The edges [*lo, *hi) that intermediate strategies in use can pair on:
+ * m < s_max + sp_max (s <= s_max light vertices, s' = m - s + 1 <= sp_max),
+ * t = k - m - t' - 1 <= t_max for some t' <= tp_max, and within the
+ * records' horizon n. */
+INLINE void mis_pair_edges(MisPortalSet set, int k, int n, int *lo, int *hi)
+{
+	*lo = max(0, k - 1 - set.tp_max - set.t_max);
+	*hi = min(k - 1, min(n, set.s_max + set.sp_max));
+}
+
 /* Weight of strategy `cur` for the k-vertex path v among all BDPT and
  * portal strategies in use; v holds the records of the first n =
  * mis_horizon(set, k) vertices. cross[i] > 0 marks an edge (x_i, x_{i+1})
  * that crosses portals; lpsum[i] = log sum over its crossings c of
  * p_pair_c^beta (each crossing is a strategy of its own, with its own
  * direction density); lpair_cur is log p_pair of cur's own crossing. Both
- * are read for edges m < s_max + sp_max only. */
+ * are read for the edges of mis_pair_edges only. */
 INLINE float mis_union_weight(const MisVertex *v, int k, int n, const int *cross, const float *lpsum, float lpair_cur,
 			      MisStrategy cur, MisPortalSet set, int heuristic)
 {
@@ -201,7 +211,9 @@ INLINE float mis_union_weight(const MisVertex *v, int k, int n, const int *cross
 			total += fast_exp(beta * (mis_log_bdpt(PF, lpn, PR, n, s) - lcur));
 	/* Intermediate strategies of edge m: s <= s_max light vertices and
 	 * s' = m - s + 1 <= sp_max of the <- half, so m < s_max + sp_max. */
-	for (int m = 0; m + 2 < k && m - set.sp_max < set.s_max; m++) {
+	int m_lo, m_hi;
+	mis_pair_edges(set, k, n, &m_lo, &m_hi);
+	for (int m = m_lo; m < m_hi && m + 2 < k; m++) {
 		if (cross[m] <= 0)
 			continue;
 		float base = lpsum[m] + beta * (set.lrate - lcur);

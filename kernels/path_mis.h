@@ -84,15 +84,6 @@ INLINE float path_pr(const SceneView *sc, const PathRef *P, const MisVertex *mv,
 	return bdpt_pdf_a(sc, x[i + 1], x[i + 2], x[i], BSDF_RADIANCE);
 }
 
-/* Portal crossings of the edge (x_i, x_{i+1}) from the geometry. */
-INLINE int path_edge_crossings(const SceneView *sc, const PathRef *P, int i)
-{
-	const PathVertex *a = P->x[i], *b = P->x[i + 1];
-	if (a->type == VERTEX_ENV)
-		return portal_crossings(sc, b->p, a->p, 1);
-	return portal_crossings(sc, a->p, b->p, 0);
-}
-
 /* The portal direction density, per projected solid angle about the
  * normal of portal triangle pt, of the intermediate subpath whose <- half
  * leaves portal point w toward x_m (kernels/portal.h): a mixture of
@@ -154,18 +145,21 @@ INLINE float portal_pair_log(const SceneView *sc, GLOBAL const PortalTri *pt, co
 }
 
 /* For edge (x_i, x_{i+1}): log of the sum over its portal crossings of
- * p_pair^beta. With `w0` (the pair edge of the current portal strategy),
- * its own crossing is taken at the sampled w0, log p_pair in *lcur, and
- * geometric crossings within a hair of it are dropped: the crossing test
- * is not watertight, and at a portal quad's diagonal it can find the
- * sampled point twice or not at all. */
-INLINE float path_pair_logsum(const SceneView *sc, const PathRef *P, int i, float beta, const V3 *w0, float *lcur)
+ * p_pair^beta, and in *found how many the geometric test finds. With `w0`
+ * (the pair edge of the current portal strategy), its own crossing is
+ * taken at the sampled w0, log p_pair in *lcur, and geometric crossings
+ * within a hair of it are dropped: the crossing test is not watertight,
+ * and at a portal quad's diagonal it can find the sampled point twice or
+ * not at all. */
+INLINE float path_pair_logsum(const SceneView *sc, const PathRef *P, int i, float beta, const V3 *w0, float *lcur,
+			      int *found)
 {
 	const PathVertex *a = P->x[i], *b = P->x[i + 1];
 	V3 o = a->type == VERTEX_ENV ? b->p : a->p;
 	V3 d = a->type == VERTEX_ENV ? a->p : v3_sub(b->p, a->p);
 	float tmax = a->type == VERTEX_ENV ? AJAR_INF : 1.0f;
 	float sum = -AJAR_INF, hair2 = 1e-8f * sc->params->scene_radius * sc->params->scene_radius;
+	*found = 0;
 	if (w0) {
 		*lcur = portal_pair_log(sc, &sc->portals[a->w0_tri], a, b, *w0);
 		sum = beta * *lcur;
@@ -175,6 +169,7 @@ INLINE float path_pair_logsum(const SceneView *sc, const PathRef *P, int i, floa
 		float t;
 		if (!portal_tri_crossing(o, d, tmax, pt->p0, pt->p1, pt->p2, &t))
 			continue;
+		++*found;
 		V3 w = v3_add(o, v3_scale(d, t));
 		if (w0 && v3_len2(v3_sub(w, *w0)) < hair2)
 			continue;
@@ -234,15 +229,22 @@ INLINE void path_records(const SceneView *sc, const PathRef *P, int heuristic, M
 			mv[P->pair + 1].pf = path_pf(sc, P, mv, P->pair + 1);
 		mv[P->pair].pr = path_pr(sc, P, mv, P->pair);
 	}
-	/* Crossings of the edges m < s_max + sp_max (mis_union_weight): each
-	 * subpath's vertices cached their edge to the previous vertex of their
-	 * own walk; connection edges are new. */
-	int s = P->s, m = P->pair, tp = P->tp;
-	int edges = min(k - 1, min(n, set.s_max + set.sp_max));
-	for (int i = 0; i < edges; i++) {
-		int c;
-		if (i == P->c1 || i == P->c2)
-			c = path_edge_crossings(sc, P, i);
+	/* Crossings and pair densities of the edges intermediate strategies
+	 * can pair on (mis_pair_edges), and the current sample's own crossing
+	 * (its w_0, kept in the pair's vertices). Each subpath's vertices
+	 * cached the crossings of their edge to the previous vertex of their
+	 * own walk; connection edges are counted here. */
+	int s = P->s, m = P->pair, tp = P->tp, lo, hi;
+	float beta = mis_beta(heuristic);
+	mis_pair_edges(set, k, n, &lo, &hi);
+	*lpair_cur = 0.0f;
+	for (int i = 0; i < hi; i++) {
+		int conn = i == P->c1 || i == P->c2, c = 0, found;
+		lpsum[i] = -AJAR_INF;
+		if (i < lo && i != m)
+			c = 0;
+		else if (conn)
+			c = -1; /* below */
 		else if (i + 1 < s) /* light subpath: x_{i+1}'s predecessor is x_i */
 			c = x[i + 1]->cross;
 		else if (m >= 0 && i <= m) /* <- half (and the pair edge): x_i's predecessor is x_{i+1} */
@@ -251,19 +253,14 @@ INLINE void path_records(const SceneView *sc, const PathRef *P, int heuristic, M
 			c = x[i + 1]->cross;
 		else /* eye subpath */
 			c = x[i]->cross;
+		if (c != 0 || i == m) {
+			lpsum[i] = path_pair_logsum(sc, P, i, beta, i == m ? &x[i]->w0 : 0, lpair_cur, &found);
+			if (conn)
+				c = found;
+		}
+		if (i == m && c <= 0) /* the sampled crossing, whatever the test found */
+			c = 1;
 		cross[i] = c;
-	}
-	/* Pair densities: edges that cross portals, and the current sample's
-	 * own crossing (its w_0, kept in the pair's vertices). */
-	float beta = mis_beta(heuristic);
-	*lpair_cur = 0.0f;
-	for (int i = 0; i < edges; i++) {
-		lpsum[i] = -AJAR_INF;
-		if (cross[i] <= 0 && i != m)
-			continue;
-		lpsum[i] = path_pair_logsum(sc, P, i, beta, i == m ? &x[i]->w0 : 0, lpair_cur);
-		if (i == m && cross[i] <= 0) /* the sampled crossing, whatever the test found */
-			cross[i] = 1;
 	}
 }
 

@@ -53,7 +53,8 @@ static void check_path(const SceneView *sc, const PathRef *P, MisStats *st)
 	 * vertices, and the edges below s_max + sp_max. */
 	GLOBAL const Params *prm = sc->params;
 	MisPortalSet set = path_portal_set(prm);
-	int n = mis_horizon(set, k), edges = min(k - 1, min(n, set.s_max + set.sp_max));
+	int n = mis_horizon(set, k), elo, ehi;
+	mis_pair_edges(set, k, n, &elo, &ehi);
 	path_records(sc, P, MIS_POWER, set, n, rec, cross, lps, &lcur);
 	oracle(sc, x, dl, k, orc);
 	for (int i = 0; i < n; i++) {
@@ -101,7 +102,7 @@ static void check_path(const SceneView *sc, const PathRef *P, MisStats *st)
 				}
 			}
 		}
-		if (i < edges && ocross[i] != cross[i] && !near_contact(x, k, i, sc->params->scene_radius))
+		if (i >= elo && i < ehi && ocross[i] != cross[i] && !near_contact(x, k, i, sc->params->scene_radius))
 			fail_msg("path (s=%d, s'=%d, t'=%d, t=%d): edge %d crosses %d portals, kernel says %d", P->s, P->sp,
 				 P->tp, P->t, i, ocross[i], cross[i]);
 		any += ocross[i] > 0;
@@ -123,7 +124,7 @@ static void check_path(const SceneView *sc, const PathRef *P, MisStats *st)
 			int cr2[4 * SUBPATH_MAX];
 			float ks[4 * SUBPATH_MAX], kcur;
 			path_records(sc, P, heur, set, n, mv2, cr2, ks, &kcur);
-			for (int i = 0; i < edges; i++)
+			for (int i = elo; i < ehi; i++)
 				if (ocross[i] && ocross[i] == cr2[i] && fabs(ks[i] - lpsum[i]) > 1e-2 * fmax(1.0, fabs(lpsum[i])) &&
 				    !near_contact(x, k, i, prm->scene_radius))
 					fail_msg("edge %d: kernel log pair sum %g, oracle %g", i, ks[i], lpsum[i]);
