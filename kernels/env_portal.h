@@ -133,8 +133,9 @@ INLINE float env_portal_pdf_w(const SceneView *sc, V3 x, V3 wi, float total, int
 	for (int j = 0; j < sc->params->num_portals; j++) {
 		GLOBAL const PortalTri *pt = &sc->portals[j];
 		float w, t;
-		if (j == skip || !((w = portal_env_weight(pt, x)) > 0.0f) ||
-		    !portal_tri_crossing(x, wi, AJAR_INF, pt->p0, pt->p1, pt->p2, &t))
+		if (j == skip || !portal_env_facing(pt, x) ||
+		    !portal_tri_crossing(x, wi, AJAR_INF, pt->p0, pt->p1, pt->p2, &t) ||
+		    !((w = portal_env_weight(pt, x)) > 0.0f))
 			continue;
 		p += env_portal_term(pt, w / total, portal_env_solid_angle(pt, x), wi, t);
 	}
@@ -156,32 +157,39 @@ INLINE float env_nee_pdf_w(const SceneView *sc, V3 x, V3 wi)
 INLINE V3 env_nee_sample(const SceneView *sc, V3 x, float u_mix, float u1, float u2, V3 *wi, float *pdf_w)
 {
 	V3 black = v3(0.0f, 0.0f, 0.0f);
-	float total = env_portal_total(sc, x), pe;
+	float total = 0.0f, pe;
 	*pdf_w = 0.0f;
-	if (!(total > 0.0f))
-		return env_sample(sc, u1, u2, wi, pdf_w);
 	if (u_mix >= PORTAL_NEE_MIX) {
+		total = env_portal_total(sc, x);
+		if (!(total > 0.0f))
+			return env_sample(sc, u1, u2, wi, pdf_w);
 		V3 Le = env_sample(sc, u1, u2, wi, &pe);
 		if (!(pe > 0.0f))
 			return black;
 		*pdf_w = PORTAL_NEE_MIX * env_portal_pdf_w(sc, x, *wi, total, -1) + (1.0f - PORTAL_NEE_MIX) * pe;
 		return Le;
 	}
-	/* The triangle, by weight. */
-	float target = u_mix / PORTAL_NEE_MIX * total, acc = 0.0f, w = 0.0f;
+	/* The triangle, by weight, in one pass that also sums the weights: k
+	 * replaces the pick with probability w_k over the sum so far, and the
+	 * number is rescaled to what is left of its interval. */
+	float u = u_mix / PORTAL_NEE_MIX, w = 0.0f;
 	int j = -1;
 	for (int k = 0; k < sc->params->num_portals; k++) {
 		float wk = portal_env_weight(&sc->portals[k], x);
 		if (!(wk > 0.0f))
 			continue;
-		j = k;
-		w = wk;
-		acc += wk;
-		if (target < acc)
-			break;
+		total += wk;
+		float p = wk / total;
+		if (u < p) {
+			j = k;
+			w = wk;
+			u = u / p;
+		} else {
+			u = fmin((u - p) / (1.0f - p), 0.99999994f);
+		}
 	}
-	if (j < 0)
-		return black;
+	if (j < 0) /* no portal shows x the sky */
+		return env_sample(sc, u1, u2, wi, pdf_w);
 	GLOBAL const PortalTri *pt = &sc->portals[j];
 	/* x is on its room side (w > 0): the solid angle from the corners. */
 	V3 a = v3_norm(v3_sub(pt->p0, x)), b = v3_norm(v3_sub(pt->p1, x)), c = v3_norm(v3_sub(pt->p2, x));
