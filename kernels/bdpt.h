@@ -124,9 +124,8 @@ INLINE int bdpt_visible(const SceneView *sc, const PathVertex *a, const PathVert
 INLINE V3 bdpt_scatter_pdf(const SceneView *sc, const PathVertex *v, V3 wi, int mode, float *pdf_w)
 {
 	Bsdf bs;
-	float pdf_rev_w;
 	vertex_bsdf(sc, v, &bs);
-	V3 f = bsdf_eval(&bs, v->wo, wi, mode, pdf_w, &pdf_rev_w);
+	V3 f = bsdf_eval_fwd(&bs, v->wo, wi, mode, pdf_w);
 	float k = fabs(v3_dot(v->ns, wi));
 	if (mode == BSDF_IMPORTANCE)
 		k *= vertex_shading_correction(v, v->wo, wi);

@@ -345,8 +345,19 @@ INLINE int bsdf_pair(const Bsdf *bs, V3 wo, V3 wi, V3 *lo, V3 *li, float *eta)
 	return so == si ? li->z > 0.0f : li->z < 0.0f;
 }
 
-/* f without the cosine, of the non-delta lobes only; pdf_w of sampling wi
- * given wo, pdf_rev_w of sampling wo given wi (for BDPT). */
+/* f without the cosine, of the non-delta lobes only, and pdf_w of
+ * sampling wi given wo: what connections and next-event estimation need. */
+INLINE V3 bsdf_eval_fwd(const Bsdf *bs, V3 wo, V3 wi, int mode, float *pdf_w)
+{
+	V3 lo, li;
+	float eta;
+	*pdf_w = 0.0f;
+	if (!bsdf_pair(bs, wo, wi, &lo, &li, &eta))
+		return v3(0.0f, 0.0f, 0.0f);
+	return bsdf_eval_local(bs, lo, li, eta, mode, pdf_w);
+}
+
+/* bsdf_eval_fwd and pdf_rev_w of sampling wo given wi (for BDPT). */
 INLINE V3 bsdf_eval(const Bsdf *bs, V3 wo, V3 wi, int mode, float *pdf_w, float *pdf_rev_w)
 {
 	V3 lo, li;

@@ -89,8 +89,8 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 			LightSample ls;
 			float u0 = rng_f(rng), u1 = rng_f(rng), u2 = rng_f(rng);
 			if (light_sample(sc, s.p, u0, u1, u2, &ls) && ls.pdf_w > 0.0f && !v3_is_zero(ls.Le)) {
-				float pdf_bsdf_w, pdf_rev_w;
-				V3 f = bsdf_eval(&bs, wo, ls.wi, BSDF_RADIANCE, &pdf_bsdf_w, &pdf_rev_w);
+				float pdf_bsdf_w;
+				V3 f = bsdf_eval_fwd(&bs, wo, ls.wi, BSDF_RADIANCE, &pdf_bsdf_w);
 				if (!v3_is_zero(f)) {
 					int clear = ls.is_env ? !bvh_occluded(sc, ray_offset(s.p, s.ng, ls.wi), ls.wi, AJAR_INF)
 							      : segment_clear(sc, s.p, s.ng, ls.p, ls.n);
