@@ -41,6 +41,20 @@ static ajar_status setup_camera(const Scene *s, const PrepareOptions *o, Camera 
 	return AJAR_OK;
 }
 
+/* A rate in (0, 1] from the environment variable `name`, else `dflt`. */
+static float env_rate(const char *name, float dflt)
+{
+	const char *v = getenv(name);
+	if (!v)
+		return dflt;
+	char *end;
+	float r = strtof(v, &end);
+	if (end != v && *end == '\0' && r > 0.0f && r <= 1.0f)
+		return r;
+	log_msg(AJAR_LOG_WARNING, "%s='%s' is not in (0, 1]; ignored", name, v);
+	return dflt;
+}
+
 ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 {
 	ajar_status st;
@@ -155,18 +169,8 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	 * needs them seldom; light from emitters behind an opening more often.
 	 * AJAR_PORTAL_RATE in (0, 1] overrides it. Layers without MIS weights
 	 * (tests) take every intermediate subpath. */
-	p->portal_rate = p->light_paths ? 0.25f : 0.1f;
-	const char *rate = getenv("AJAR_PORTAL_RATE");
-	if (rate) {
-		char *end;
-		float r = strtof(rate, &end);
-		if (end != rate && *end == '\0' && r > 0.0f && r <= 1.0f)
-			p->portal_rate = r;
-		else
-			log_msg(AJAR_LOG_WARNING, "AJAR_PORTAL_RATE='%s' is not in (0, 1]; ignored", rate);
-	}
-	if (p->strategy_unweighted)
-		p->portal_rate = 1.0f;
+	float rate = p->light_paths ? PORTAL_RATE_EMITTERS : PORTAL_RATE_SKY;
+	p->portal_rate = p->strategy_unweighted ? 1.0f : env_rate("AJAR_PORTAL_RATE", rate);
 	p->emitter_power = d->lights.emitter_power;
 	p->env_power = d->lights.env_power;
 	/* What lies behind each side of the portals, with the kernels' own

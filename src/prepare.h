@@ -27,6 +27,12 @@ typedef struct {
 	int strategy_unweighted;
 } PrepareOptions;
 
+/* The portal integrator's default rates of intermediate subpaths, in
+ * scenes lit only by the sky and with emitters (README, Results);
+ * AJAR_PORTAL_RATE overrides them. */
+#define PORTAL_RATE_SKY 0.1f
+#define PORTAL_RATE_EMITTERS 0.25f
+
 ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *out);
 void prepare_free(SceneData *d);
 #endif
