@@ -139,28 +139,37 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	p->min_depth = (int)o->min_depth;
 	p->strategy_len = (int)o->strategy_len;
 	p->strategy_unweighted = o->strategy_unweighted;
-	/* The intermediate strategies in use (kernels/portal.h): chosen by
-	 * measurement (README, "Integrators"); AJAR_PORTAL_SET="s,s',t'[,t[,light paths]]"
-	 * overrides it for experiments, e.g. "32,32,32,33,1" for all of them. */
-	p->portal_s_max = 1;
-	p->portal_sp_max = 2;
-	p->portal_tp_max = 1;
 	/* Light subpaths from an environment start on a disk as wide as the
 	 * scene and rarely find the way in through an opening; where the sky
 	 * is the only light, the intermediate subpaths (which start on the
 	 * portals) do their work, and the portal integrator leaves them out. */
 	p->light_paths = p->integrator != INTEGRATOR_PORTAL || p->num_emitters > 0;
-	/* There, next-event estimation through the portals takes the direct
-	 * light, and intermediate strategies with long eye subpaths cost more
-	 * than they add; with emitters behind an opening (door-ajar) they
-	 * carry the indirect light and stay (README, Results). */
+	/* The intermediate strategies in use (kernels/portal.h), chosen by
+	 * measurement (README, "Integrators"). Where the sky is the only
+	 * light, next-event estimation through the portals takes the direct
+	 * light, and short halves and eye parts of at most 3 vertices do best;
+	 * with emitters behind an opening (door-ajar) the intermediate
+	 * subpaths carry the indirect light, with halves of up to 3 vertices
+	 * and any eye part. AJAR_PORTAL_SET="s,s',t'[,t[,light paths]]"
+	 * overrides it for experiments, e.g. "32,32,32,33,1" for all of them. */
+	p->portal_s_max = 1;
+	p->portal_sp_max = p->light_paths ? 3 : 2;
+	p->portal_tp_max = p->light_paths ? 3 : 1;
 	p->portal_t_max = p->light_paths ? 1 << 20 : 3; /* any t, or 3 */
 	const char *set = getenv("AJAR_PORTAL_SET");
-	int nset = set ? sscanf(set, "%d,%d,%d,%d,%d", &p->portal_s_max, &p->portal_sp_max, &p->portal_tp_max,
-			     &p->portal_t_max, &p->light_paths)
-		    : 0;
-	if (set && (nset < 3 || nset > 5))
-		log_msg(AJAR_LOG_WARNING, "AJAR_PORTAL_SET='%s' is not s,s',t'[,t[,light paths]]; ignored", set);
+	if (set) {
+		int v[5] = {p->portal_s_max, p->portal_sp_max, p->portal_tp_max, p->portal_t_max, p->light_paths};
+		int nset = sscanf(set, "%d,%d,%d,%d,%d", &v[0], &v[1], &v[2], &v[3], &v[4]);
+		if (nset >= 3 && v[0] >= 0 && v[1] >= 1 && v[2] >= 1 && v[3] >= 1) {
+			p->portal_s_max = v[0];
+			p->portal_sp_max = v[1];
+			p->portal_tp_max = v[2];
+			p->portal_t_max = v[3];
+			p->light_paths = v[4] != 0;
+		} else {
+			log_msg(AJAR_LOG_WARNING, "AJAR_PORTAL_SET='%s' is not s,s',t'[,t[,light paths]]; ignored", set);
+		}
+	}
 	if (!p->light_paths && p->portal_s_max > 1)
 		p->portal_s_max = 1; /* larger s needs light subpaths */
 	/* How often a pixel sample traces an intermediate subpath (mis.h,

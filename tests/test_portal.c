@@ -13,6 +13,8 @@
  *     eye vertices t), unweighted, converges to the path tracer's image of
  *     paths of n segments counted once per portal crossing on the edges
  *     those strategies can cross (Params.cross_filter).
+ *   - The default strategy sets and rates, and the environment variables
+ *     that override them (taken whole or not at all).
  * (That the portal integrator without portals is bdpt to the bit is
  * checked through the device in test_render.c.)
  * Statistics as in test_bdpt.c: batch means, 5 standard errors. */
@@ -604,6 +606,41 @@ static void check_wasted(const char *path, const char *name)
 /* The rate of intermediate subpaths: 0.1 where the sky is the only light,
  * 0.25 with emitters, AJAR_PORTAL_RATE in (0, 1] overriding it, anything
  * else ignored with a warning. */
+/* The default strategy sets, and AJAR_PORTAL_SET taken whole or not at all. */
+static void test_portal_set(void **state)
+{
+	HostScene h;
+	const struct {
+		const char *scene, *set;
+		int expect[5]; /* s, s', t', t, light paths */
+	} cases[] = {
+		{"window-room/window-room.gltf", NULL, {1, 2, 1, 3, 0}},
+		{"door-ajar/door-ajar.gltf", NULL, {1, 3, 3, 1 << 20, 1}},
+		{"door-ajar/door-ajar.gltf", "2,4,5", {2, 4, 5, 1 << 20, 1}},
+		{"door-ajar/door-ajar.gltf", "1,2,2,4,0", {1, 2, 2, 4, 0}},
+		{"door-ajar/door-ajar.gltf", "2", {1, 3, 3, 1 << 20, 1}},       /* too short: ignored */
+		{"door-ajar/door-ajar.gltf", "1,0,1", {1, 3, 3, 1 << 20, 1}},   /* s' = 0: ignored */
+		{"window-room/window-room.gltf", "3,2,1", {1, 2, 1, 3, 0}},     /* s > 1 needs light subpaths */
+	};
+	for (unsigned i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+		if (cases[i].set)
+			setenv("AJAR_PORTAL_SET", cases[i].set, 1);
+		else
+			unsetenv("AJAR_PORTAL_SET");
+		char path[256];
+		snprintf(path, sizeof path, SCENE("%s"), cases[i].scene);
+		host_scene_open(&h, path, NULL, 8, 8, INTEGRATOR_PORTAL, 8);
+		const Params *p = h.data.params;
+		int got[5] = {p->portal_s_max, p->portal_sp_max, p->portal_tp_max, p->portal_t_max, p->light_paths};
+		for (int j = 0; j < 5; j++)
+			if (got[j] != cases[i].expect[j])
+				fail_msg("%s, AJAR_PORTAL_SET=%s: field %d is %d, expected %d", cases[i].scene,
+					 cases[i].set ? cases[i].set : "(unset)", j, got[j], cases[i].expect[j]);
+		host_scene_close(&h);
+	}
+	unsetenv("AJAR_PORTAL_SET");
+}
+
 static void test_portal_rate(void **state)
 {
 	HostScene h;
@@ -647,6 +684,7 @@ int main(void)
 		cmocka_unit_test(test_directions_window_room),
 		cmocka_unit_test(test_directions_door_ajar),
 		cmocka_unit_test(test_wasted_fewer),
+		cmocka_unit_test(test_portal_set),
 		cmocka_unit_test(test_portal_rate),
 	};
 	return cmocka_run_group_tests_name("portal", tests, NULL, NULL);
