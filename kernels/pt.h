@@ -2,9 +2,9 @@
  * integrator is checked against.
  *
  * Next-event estimation to emitters and the environment, combined with BSDF
- * sampling by the power heuristic; Russian roulette after rr_depth segments
- * scales only the throughput, so it enters neither strategy's density and
- * the MIS weights stay consistent (design.md, Pitfalls). max_depth counts
+ * sampling by the power heuristic; Russian roulette (roulette.h) from vertex
+ * rr_depth on scales only the throughput, so it enters neither strategy's
+ * density and the MIS weights stay consistent (design.md, Pitfalls). max_depth counts
  * path segments, camera segment included (Mitsuba's max_depth); paths of
  * fewer than min_depth segments are left out, so max_depth = min_depth = k
  * gives the image of paths of exactly k segments, which each bidirectional
@@ -36,6 +36,7 @@ INLINE float pt_cross_weight(GLOBAL const Params *prm, const int *cnt, int n, in
 #include "mis.h"
 #include "portal_geometry.h"
 #include "rng.h"
+#include "roulette.h"
 #include "surface.h"
 
 INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
@@ -45,6 +46,7 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 	float prev_pdf_w = 0.0f;
 	int prev_delta = 1; /* the camera ray counts emission in full */
 	V3 prev_p = o;
+	float beta_ref = 1.0f;
 	int cnt[PT_CROSS_EDGES];
 	for (int depth = 0;; depth++) {
 		Hit h;
@@ -115,12 +117,10 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 		prev_p = s.p;
 		o = ray_offset(s.p, s.ng, bsm.wi);
 		d = bsm.wi;
-		if (depth + 1 >= prm->rr_depth) {
-			float q = fmin(v3_maxc(beta), 0.95f);
-			if (rng_f(rng) >= q)
-				break;
-			beta = v3_scale(beta, 1.0f / q);
-		}
+		if (depth == 0)
+			beta_ref = fmax(v3_maxc(beta), 1e-30f); /* roulette.h */
+		else if (depth + 1 >= prm->rr_depth && !rr_survive(&beta, beta_ref, rng))
+			break;
 		if (v3_is_zero(beta))
 			break;
 	}

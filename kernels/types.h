@@ -116,7 +116,7 @@ typedef struct {
 	V3 scene_center;        /* 112, bounding sphere, for light subpaths */
 	float scene_radius;
 	int max_depth;          /* 128, maximum number of path segments */
-	int rr_depth;           /* Russian roulette starts after this many */
+	int rr_depth;           /* Russian roulette from this vertex on (1: first hit) */
 	int integrator;         /* INTEGRATOR_* */
 	uint seed;
 	float emitter_power;    /* 144, total power of emissive triangles */

@@ -14,6 +14,7 @@
 #include "bvh.h"
 #include "lights.h"
 #include "rng.h"
+#include "roulette.h"
 #include "portal_geometry.h"
 #include "surface.h"
 
@@ -129,8 +130,9 @@ INLINE int vertex_trace(const SceneView *sc, PathVertex *path, int n, V3 o, V3 d
 /* Samples the BSDF at surface vertex path[n - 1] (its predecessor along
  * path[n - 1].wo is path[n - 2]): the next ray (*o, *d), its density *pdf_w
  * (0 after a delta lobe) and the new throughput *beta; sets the reverse
- * density of path[n - 2]. Russian roulette after rr_depth vertices, on the
- * throughput relative to beta_ref. Returns 0 if the subpath ends here. */
+ * density of path[n - 2]. Russian roulette (roulette.h) at path[rr_depth] and
+ * beyond, relative to beta_ref (none while beta_ref is 0). Returns 0 if the
+ * subpath ends here. */
 INLINE int vertex_scatter(const SceneView *sc, PathVertex *path, int n, int light_side, float beta_ref, V3 *beta,
 			  V3 *o, V3 *d, float *pdf_w, Rng *rng)
 {
@@ -155,12 +157,8 @@ INLINE int vertex_scatter(const SceneView *sc, PathVertex *path, int n, int ligh
 		prev->pr = rev_a;
 	else
 		prev->pf = rev_a;
-	if (n >= sc->params->rr_depth) {
-		float q = fmin(v3_maxc(*beta) / beta_ref, 0.95f);
-		if (!(rng_f(rng) < q))
-			return 0;
-		*beta = v3_scale(*beta, 1.0f / q);
-	}
+	if (n - 1 >= sc->params->rr_depth && beta_ref > 0.0f && !rr_survive(beta, beta_ref, rng))
+		return 0;
 	if (v3_is_zero(*beta))
 		return 0;
 	*o = ray_offset(v->p, v->ng, bsm.wi);
@@ -169,26 +167,34 @@ INLINE int vertex_scatter(const SceneView *sc, PathVertex *path, int n, int ligh
 }
 
 /* Extends a subpath from its last vertex path[n - 1] by BSDF sampling
- * until max_verts vertices, a miss, or Russian roulette. Returns the new
- * vertex count. */
+ * until max_verts vertices, a miss, or Russian roulette. beta_ref is the
+ * roulette's reference throughput; 0 takes the throughput after the first
+ * scattering (camera walks, roulette.h). Returns the new vertex count. */
 INLINE int vertex_extend(const SceneView *sc, PathVertex *path, int n, int max_verts, int light_side,
 			 int escape_env, float beta_ref, Rng *rng)
 {
 	V3 o, d, beta;
 	float pdf_w;
-	while (n < max_verts && vertex_scatter(sc, path, n, light_side, beta_ref, &beta, &o, &d, &pdf_w, rng) &&
-	       vertex_trace(sc, path, n, o, d, beta, pdf_w, 0, light_side, escape_env))
+	while (n < max_verts && vertex_scatter(sc, path, n, light_side, beta_ref, &beta, &o, &d, &pdf_w, rng)) {
+		if (!(beta_ref > 0.0f))
+			beta_ref = fmax(v3_maxc(beta), 1e-30f);
+		if (!vertex_trace(sc, path, n, o, d, beta, pdf_w, 0, light_side, escape_env))
+			break;
 		n++;
+	}
 	return n;
 }
 
 /* A subpath from path[n - 1] along the ray (o, d): the first hit, then
- * BSDF sampling (vertex_trace and vertex_extend). */
+ * BSDF sampling (vertex_trace and vertex_extend). The roulette of a light
+ * walk is relative to its starting throughput, that of a camera walk to the
+ * throughput after its first scattering. */
 INLINE int vertex_walk(const SceneView *sc, PathVertex *path, int n, int max_verts, V3 o, V3 d, V3 beta,
 		       float pdf_w, int parallel, int light_side, int escape_env, Rng *rng)
 {
 	if (n >= max_verts || !vertex_trace(sc, path, n, o, d, beta, pdf_w, parallel, light_side, escape_env))
 		return n;
-	return vertex_extend(sc, path, n + 1, max_verts, light_side, escape_env, fmax(v3_maxc(beta), 1e-30f), rng);
+	float beta_ref = light_side ? fmax(v3_maxc(beta), 1e-30f) : 0.0f;
+	return vertex_extend(sc, path, n + 1, max_verts, light_side, escape_env, beta_ref, rng);
 }
 #endif

@@ -131,7 +131,7 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	p->scene_center = center;
 	p->scene_radius = radius;
 	p->max_depth = (int)o->max_depth;
-	p->rr_depth = 3;
+	p->rr_depth = 2;
 	/* Without portals the portal integrator is bdpt, sample for sample. */
 	p->integrator = o->integrator == INTEGRATOR_PORTAL && s->nportal_tris == 0 ? INTEGRATOR_BDPT : o->integrator;
 	p->seed = o->seed;

@@ -5,7 +5,9 @@
  * against its discrete probabilities, zero-width buckets included; the RNG
  * for determinism, range, uniformity and decorrelation of neighbours; the
  * polynomial log, exp, atan2 and sin/cos of kernels/fastmath.h against
- * double precision over the ranges they promise. */
+ * double precision over the ranges they promise; Russian roulette
+ * (kernels/roulette.h) for its survival probability and an unchanged
+ * expected throughput. */
 #include "testutil.h"
 
 #include <float.h>
@@ -16,6 +18,7 @@
 
 #include "../kernels/fastmath.h"
 #include "../kernels/rng.h"
+#include "../kernels/roulette.h"
 #include "../kernels/sampling.h"
 
 #define N_SAMPLES 1000000
@@ -341,6 +344,50 @@ static void test_fast_math(void **state)
 	assert_true(fabs(s) < 1e-6 && c == -1.0f);
 }
 
+/* Survivors are counted against q = min(RR_BOOST max(beta) / beta_ref,
+ * RR_MAX_SURVIVAL) within 5 binomial standard errors, and the mean of the
+ * throughput afterwards (0 for a walk that ended) must equal beta: that
+ * is what keeps the estimate unbiased. */
+static void test_roulette(void **state)
+{
+	(void)state;
+	const struct {
+		V3 beta;
+		float ref;
+	} cases[] = {
+		{{0.05f, 0.02f, 0.01f}, 1.0f}, /* dark: mostly ends */
+		{{0.3f, 0.5f, 0.1f}, 1.2f},    /* relative to beta_ref, below the cap */
+		{{0.9f, 0.9f, 0.9f}, 1.0f},    /* bright: capped at RR_MAX_SURVIVAL */
+		{{1e-6f, 0.0f, 0.0f}, 1e-3f},
+	};
+	const int n = 400000;
+	for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+		Rng rng = rng_init(99, (uint)c, 0, 0);
+		double q = fmin(RR_BOOST * v3_maxc(cases[c].beta) / cases[c].ref, RR_MAX_SURVIVAL);
+		double alive = 0.0, sum[3] = {0.0, 0.0, 0.0};
+		for (int i = 0; i < n; i++) {
+			V3 b = cases[c].beta;
+			if (rr_survive(&b, cases[c].ref, &rng)) {
+				alive += 1.0;
+				sum[0] += b.x;
+				sum[1] += b.y;
+				sum[2] += b.z;
+			}
+		}
+		double se = sqrt(q * (1.0 - q) / n);
+		printf("roulette case %zu: survived %.5f, q %.5f (se %.1e)\n", c, alive / n, q, se);
+		assert_true(fabs(alive / n - q) < 5.0 * se + 1e-12);
+		const float *bc = &cases[c].beta.x;
+		for (int k = 0; k < 3; k++) {
+			double want = bc[k], got = sum[k] / n;
+			/* beta / q per survivor: relative standard error sqrt((1 - q) / (q n)) */
+			double tol = 5.0 * want * sqrt((1.0 - q) / (q * n)) + 1e-7 * want;
+			if (fabs(got - want) > tol)
+				fail_msg("roulette case %zu channel %d: mean %g, want %g", c, k, got, want);
+		}
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -348,7 +395,7 @@ int main(void)
 		cmocka_unit_test(test_uniform_cone),      cmocka_unit_test(test_concentric_disk),
 		cmocka_unit_test(test_triangle),          cmocka_unit_test(test_cdf),
 		cmocka_unit_test(test_rng_deterministic), cmocka_unit_test(test_rng_uniform),
-		cmocka_unit_test(test_fast_math),
+		cmocka_unit_test(test_fast_math),         cmocka_unit_test(test_roulette),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
