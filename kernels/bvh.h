@@ -3,16 +3,16 @@
  *
  * Triangles are tested with the watertight algorithm of Woop, Benthin and
  * Wald (JCGT 2013), two-sided, so a ray through a shared edge or vertex
- * cannot slip between neighbours. Traversal is iterative with a fixed stack
- * (the builder bounds the tree depth by BVH_MAX_DEPTH = BVH_STACK_SIZE),
- * visits the nearer child first, and widens box exits by 2 gamma(3) so the
+ * cannot slip between neighbours. Traversal of the four-wide tree is
+ * iterative with a fixed stack (the builder bounds its depth, src/bvh.c),
+ * visits children nearest first, and widens box exits by 2 gamma(3) so the
  * box test never rejects a triangle hit the exact test accepts (Ize 2013,
  * "Robust BVH ray traversal"). */
 #ifndef AJAR_KERNEL_BVH_H
 #define AJAR_KERNEL_BVH_H
 #include "types.h"
 
-#define BVH_STACK_SIZE 64
+#define BVH_STACK_SIZE 96
 
 typedef struct {
 	float t;
@@ -103,36 +103,107 @@ INLINE void box_slab(float lo, float hi, float o, float inv_d, float *tn, float 
 	*tf = b < *tf ? b : *tf;
 }
 
-/* Entry distance of the ray into the node's box within [0, tmax], or -1.
- * tmax is widened a little too: the triangle test and the slab test round
- * differently, and a triangle whose computed distance lies a few ulps below
- * the current closest hit must still be visited, or coplanar and touching
- * triangles could return a hit a few ulps farther than the closest. */
-INLINE float box_enter(const RayPre *r, GLOBAL const BvhNode *n, float tmax)
+/* Leaf slots: triangles [first, first + count), 1 <= count <= 4. */
+#define BVH_LEAF(first, count) (-1 - (4 * (first) + (count) - 1))
+#define BVH_EMPTY (-2147483647 - 1)
+#define BVH_LEAF_FIRST(c) ((-1 - (c)) >> 2)
+#define BVH_LEAF_COUNT(c) (((-1 - (c)) & 3) + 1)
+
+/* Enters the boxes of node n's four slots within [0, tlim]: returns the
+ * mask of the slots entered (bit i: slot i) and their entry distances in
+ * tn[]. The four slab tests are independent, so the compiler runs them
+ * side by side. An unused slot's box at +inf is never entered by a ray with
+ * finite origin and direction (bvh_traverse refuses any other) within a
+ * finite tlim. */
+INLINE int bvh_node_enter(const RayPre *r, GLOBAL const BvhNode *n, float tlim, float tn[4])
 {
-	float tn = 0.0f, tf = tmax * 1.00001f;
-	box_slab(n->bmin.x, n->bmax.x, r->o.x, r->inv_d.x, &tn, &tf);
-	box_slab(n->bmin.y, n->bmax.y, r->o.y, r->inv_d.y, &tn, &tf);
-	box_slab(n->bmin.z, n->bmax.z, r->o.z, r->inv_d.z, &tn, &tf);
-	return tn <= tf ? tn : -1.0f;
+	float tf[4];
+	for (int i = 0; i < 4; i++) {
+		tn[i] = 0.0f;
+		tf[i] = tlim;
+		box_slab(n->lo_x[i], n->hi_x[i], r->o.x, r->inv_d.x, &tn[i], &tf[i]);
+		box_slab(n->lo_y[i], n->hi_y[i], r->o.y, r->inv_d.y, &tn[i], &tf[i]);
+		box_slab(n->lo_z[i], n->hi_z[i], r->o.z, r->inv_d.z, &tn[i], &tf[i]);
+	}
+	return (tn[0] <= tf[0]) | (tn[1] <= tf[1]) << 1 | (tn[2] <= tf[2]) << 2 | (tn[3] <= tf[3]) << 3;
+}
+
+/* Index of the lowest set bit of a nonzero 4-bit mask. */
+INLINE int bvh_lowest(int m) { return (m & 1) ? 0 : (m & 2) ? 1 : (m & 4) ? 2 : 3; }
+
+INLINE int v3_finite(V3 a)
+{
+	return fabs(a.x) <= AJAR_INF && fabs(a.y) <= AJAR_INF && fabs(a.z) <= AJAR_INF;
 }
 
 /* Closest hit with 0 < t < tmax (any_hit = 0), or the first hit found
- * (any_hit = 1). Shared by the two queries so the kernel holds one copy. */
+ * (any_hit = 1). Shared by the two queries so the kernel holds one copy.
+ * Children are visited nearest first; a pushed child whose entry distance
+ * lies beyond the closest hit found since is skipped when popped. The
+ * limits are widened a little: the triangle test and the slab test round
+ * differently, and a triangle whose computed distance lies a few ulps below
+ * the current closest hit must still be visited, or coplanar and touching
+ * triangles could return a hit a few ulps farther than the closest. */
 INLINE int bvh_traverse(const SceneView *sc, V3 o, V3 d, float tmax, int any_hit, Hit *hit)
 {
+	if (!v3_finite(o) || !v3_finite(d))
+		return 0;
 	RayPre r = ray_pre(o, d);
 	int stack[BVH_STACK_SIZE];
+	float stack_t[BVH_STACK_SIZE];
 	int sp = 0;
 	int found = 0;
-	GLOBAL const BvhNode *nodes = sc->nodes;
-	if (box_enter(&r, &nodes[0], tmax) < 0.0f)
-		return 0;
-	int node = 0;
+	int entry = 0; /* the root */
 	for (;;) {
-		GLOBAL const BvhNode *n = &nodes[node];
-		if (n->count > 0) {
-			for (int i = n->index; i < n->index + n->count; i++) {
+		if (entry >= 0) {
+			GLOBAL const BvhNode *n = &sc->nodes[entry];
+			float tn[4];
+			int mask = bvh_node_enter(&r, n, fmin(tmax * 1.00001f, AJAR_INF), tn);
+			if (mask != 0) {
+				int i = bvh_lowest(mask);
+				mask &= mask - 1;
+				if (mask == 0) { /* one child: no stack */
+					entry = n->child[i];
+					continue;
+				}
+				int j = bvh_lowest(mask);
+				mask &= mask - 1;
+				if (mask == 0) { /* two: the farther waits */
+					int near_i = tn[i] <= tn[j];
+					entry = n->child[near_i ? i : j];
+					stack[sp] = n->child[near_i ? j : i];
+					stack_t[sp++] = tn[near_i ? j : i];
+					continue;
+				}
+				/* Three or four: push all, nearest on top, pop it. */
+				int base = sp;
+				stack[sp] = n->child[i];
+				stack_t[sp++] = tn[i];
+				stack[sp] = n->child[j];
+				stack_t[sp++] = tn[j];
+				while (mask != 0) {
+					int k = bvh_lowest(mask);
+					mask &= mask - 1;
+					stack[sp] = n->child[k];
+					stack_t[sp++] = tn[k];
+				}
+				for (int a = base + 1; a < sp; a++) {
+					int c = stack[a];
+					float t = stack_t[a];
+					int b = a;
+					for (; b > base && stack_t[b - 1] < t; b--) {
+						stack[b] = stack[b - 1];
+						stack_t[b] = stack_t[b - 1];
+					}
+					stack[b] = c;
+					stack_t[b] = t;
+				}
+				entry = stack[--sp];
+				continue;
+			}
+		} else {
+			int first = BVH_LEAF_FIRST(entry), last = first + BVH_LEAF_COUNT(entry);
+			for (int i = first; i < last; i++) {
 				float t, u, v;
 				if (tri_intersect(&r, &sc->tris[i], tmax, &t, &u, &v)) {
 					found = 1;
@@ -145,30 +216,14 @@ INLINE int bvh_traverse(const SceneView *sc, V3 o, V3 d, float tmax, int any_hit
 						return 1;
 				}
 			}
-		} else {
-			int left = node + 1, right = n->index;
-			float tl = box_enter(&r, &nodes[left], tmax);
-			float tr = box_enter(&r, &nodes[right], tmax);
-			if (tl >= 0.0f && tr >= 0.0f) {
-				int near_first = tl <= tr;
-				stack[sp++] = near_first ? right : left;
-				node = near_first ? left : right;
-				continue;
-			}
-			if (tl >= 0.0f) {
-				node = left;
-				continue;
-			}
-			if (tr >= 0.0f) {
-				node = right;
-				continue;
-			}
 		}
-		if (sp == 0)
-			break;
-		node = stack[--sp];
+		do {
+			if (sp == 0)
+				return found;
+			sp--;
+		} while (stack_t[sp] > tmax * 1.00001f);
+		entry = stack[sp];
 	}
-	return found;
 }
 
 /* Closest hit with 0 < t < tmax; returns 1 if there is one. */

@@ -6,11 +6,11 @@
 #include "types.h"
 
 #define AJAR_LAYOUT_TYPES(X) \
-	X(BvhNode, 32) X(Tri, 48) X(TriShade, 64) X(Material, 64) X(Texture, 16) \
+	X(BvhNode, 128) X(Tri, 48) X(TriShade, 64) X(Material, 64) X(Texture, 16) \
 	X(Emitter, 16) X(PortalTri, 64) X(Camera, 64) X(Params, 208)
 
 #define AJAR_LAYOUT_FIELDS(X)                                                          \
-	X(BvhNode, bmin) X(BvhNode, index) X(BvhNode, bmax) X(BvhNode, count)          \
+	X(BvhNode, lo_x) X(BvhNode, lo_z) X(BvhNode, hi_x) X(BvhNode, hi_z) X(BvhNode, child)\
 	X(Tri, p0) X(Tri, p1) X(Tri, p2) X(Tri, material) X(Tri, emitter)              \
 	X(TriShade, n0) X(TriShade, n2) X(TriShade, u0) X(TriShade, v2)                \
 	X(TriShade, has_normals)                                                        \

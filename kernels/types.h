@@ -8,15 +8,19 @@
 #define AJAR_TYPES_H
 #include "vec.h"
 
-/* Flattened BVH node, depth-first order. Interior (count == 0): the left
- * child is the next node, the right child is node `index`. Leaf (count > 0):
- * triangles [index, index + count) of the reordered triangle array. */
+/* Four-wide BVH node (src/bvh.c collapses its binary SAH tree into these).
+ * Slot i holds a child's box, one array per bound so the traversal tests
+ * the four boxes side by side, and child[i]: >= 0 an interior node; <= -1
+ * a leaf, -1 - (4 first + count - 1), for triangles [first, first + count)
+ * of the reordered triangle array, 1 <= count <= 4 (BVH_LEAF, kernels/bvh.h);
+ * BVH_EMPTY an unused slot, whose box is the point (+inf, +inf, +inf), which
+ * no ray from a finite origin enters. Node 0 is the root. */
 typedef struct {
-	V3 bmin;
-	int index;
-	V3 bmax;
-	int count;
-} BvhNode; /* 32 */
+	float lo_x[4], lo_y[4], lo_z[4];
+	float hi_x[4], hi_y[4], hi_z[4];
+	int child[4];
+	int pad[4];
+} BvhNode; /* 128 */
 
 /* Triangle as traversal sees it. `emitter` indexes Emitter (or -1). */
 typedef struct {

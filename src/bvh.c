@@ -7,8 +7,15 @@
  * construction of SAH-based bounding volume hierarchies"). Where SAH cannot
  * split (all centroids equal, or every centroid in one bin) or the tree is
  * getting deep, an object-median split halves the node instead, which keeps
- * the depth within BVH_MAX_DEPTH whatever the input. Nodes are written
- * depth-first: a node's left child is always the next node. */
+ * the depth within BVH_MAX_DEPTH whatever the input.
+ *
+ * The binary tree is then collapsed into four-wide nodes (Dammertz et al.
+ * 2008, "Shallow bounding volume hierarchies for fast SIMD ray tracing of
+ * incoherent rays"): a node takes its binary node's children, opens every
+ * interior one into its two children, and fills a slot still free by
+ * opening its largest interior child again. Every interior slot thus lies
+ * at least two binary levels down, which halves the depth the traversal
+ * stack must hold; the kernel tests a node's four boxes side by side. */
 #include "bvh.h"
 
 #include <float.h>
@@ -18,11 +25,13 @@
 #include "error.h"
 #include "../kernels/bvh.h"
 
-/* Traversal pushes at most one node per interior level. */
-_Static_assert(BVH_MAX_DEPTH <= BVH_STACK_SIZE, "kernels/bvh.h: traversal stack too small");
+/* Traversal pushes at most three entries per four-wide level, and a
+ * four-wide tree has at most BVH_MAX_DEPTH / 2 interior levels (bvh.h). */
+_Static_assert(3 * (BVH_MAX_DEPTH / 2) <= BVH_STACK_SIZE, "kernels/bvh.h: traversal stack too small");
 
 #define BVH_BINS 32
 #define BVH_MAX_LEAF 4
+_Static_assert(BVH_MAX_LEAF <= 4, "leaf slots encode at most 4 triangles");
 /* Traversal cost relative to one triangle test. */
 #define BVH_COST_TRAVERSE 1.0f
 /* From this depth on only median splits: each halves the node, so even
@@ -32,6 +41,15 @@ _Static_assert(BVH_MAX_DEPTH <= BVH_STACK_SIZE, "kernels/bvh.h: traversal stack 
 typedef struct {
 	float lo[3], hi[3];
 } Box;
+
+/* Node of the binary tree, depth-first: an interior node's left child is
+ * the next node, its right child node `index`; a leaf (count > 0) covers
+ * triangles [index, index + count). */
+typedef struct {
+	Box b;
+	int index;
+	int count;
+} BinNode;
 
 /* A triangle's bounds and where it came from; the build permutes these. */
 typedef struct {
@@ -217,10 +235,112 @@ static uint32_t split_node(Ref *refs, uint32_t n, const Box *box, const Box *cbo
 	return n / 2;
 }
 
-static void node_set_box(BvhNode *node, const Box *b)
+/* Slots of a four-wide node under construction: binary node ids. */
+typedef struct {
+	uint32_t bin[4];
+	int n;
+} Slots;
+
+static int bin_is_leaf(const BinNode *bn, uint32_t i) { return bn[i].count > 0; }
+
+/* Opens slot k (an interior binary node) into its two children. */
+static void slots_open(const BinNode *bn, Slots *s, int k)
 {
-	node->bmin = v3(b->lo[0], b->lo[1], b->lo[2]);
-	node->bmax = v3(b->hi[0], b->hi[1], b->hi[2]);
+	uint32_t i = s->bin[k];
+	s->bin[k] = i + 1;
+	s->bin[s->n++] = (uint32_t)bn[i].index;
+}
+
+/* The binary children of interior node i, each interior one opened, then
+ * while a slot is free the interior slot of largest box area opened. */
+static void slots_fill(const BinNode *bn, uint32_t i, Slots *s)
+{
+	s->n = 0;
+	s->bin[s->n++] = i + 1;
+	s->bin[s->n++] = (uint32_t)bn[i].index;
+	for (int k = 0, n0 = s->n; k < n0; k++)
+		if (!bin_is_leaf(bn, s->bin[k]))
+			slots_open(bn, s, k);
+	while (s->n < 4) {
+		int best = -1;
+		float best_area = -1.0f;
+		for (int k = 0; k < s->n; k++)
+			if (!bin_is_leaf(bn, s->bin[k]) && box_area(&bn[s->bin[k]].b) > best_area) {
+				best_area = box_area(&bn[s->bin[k]].b);
+				best = k;
+			}
+		if (best < 0)
+			break;
+		slots_open(bn, s, best);
+	}
+}
+
+static void wide_set_slot(BvhNode *w, int k, const Box *b, int child)
+{
+	w->lo_x[k] = b->lo[0];
+	w->lo_y[k] = b->lo[1];
+	w->lo_z[k] = b->lo[2];
+	w->hi_x[k] = b->hi[0];
+	w->hi_y[k] = b->hi[1];
+	w->hi_z[k] = b->hi[2];
+	w->child[k] = child;
+}
+
+/* Collapses the binary tree bn[0, nbin) into out->nodes. Children of a
+ * node get consecutive ids, handed out as the node is written. */
+static ajar_status collapse(const BinNode *bn, uint32_t nbin, Bvh *out)
+{
+	out->nodes = malloc(sizeof(BvhNode) * nbin); /* at most one per interior binary node */
+	if (!out->nodes)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for %u nodes", nbin);
+	memset(out->nodes, 0, sizeof(BvhNode) * nbin);
+	/* Pending (binary node, wide id) pairs: at most 3 per wide level plus
+	 * one; BVH_MAX_DEPTH bounds the levels. */
+	struct {
+		uint32_t bin, wide;
+	} stack[3 * BVH_MAX_DEPTH + 4];
+	int sp = 0;
+	uint32_t nwide = 1;
+	out->wide_depth = 1;
+	uint32_t depth_of[3 * BVH_MAX_DEPTH + 4];
+	stack[sp].bin = 0;
+	stack[sp].wide = 0;
+	depth_of[sp++] = 1;
+	while (sp > 0) {
+		sp--;
+		uint32_t i = stack[sp].bin, id = stack[sp].wide, depth = depth_of[sp];
+		if (depth > out->wide_depth)
+			out->wide_depth = depth;
+		Slots s;
+		if (bin_is_leaf(bn, i)) { /* only the root: a scene of at most 4 triangles */
+			s.n = 1;
+			s.bin[0] = i;
+		} else {
+			slots_fill(bn, i, &s);
+		}
+		BvhNode *w = &out->nodes[id];
+		for (int k = 0; k < 4; k++) {
+			if (k >= s.n) {
+				const Box none = {{INFINITY, INFINITY, INFINITY}, {INFINITY, INFINITY, INFINITY}};
+				wide_set_slot(w, k, &none, BVH_EMPTY);
+				continue;
+			}
+			const BinNode *c = &bn[s.bin[k]];
+			if (c->count > 0) {
+				wide_set_slot(w, k, &c->b, BVH_LEAF(c->index, c->count));
+			} else {
+				wide_set_slot(w, k, &c->b, (int)nwide);
+				stack[sp].bin = s.bin[k];
+				stack[sp].wide = nwide++;
+				depth_of[sp++] = depth + 1;
+			}
+		}
+	}
+	BvhNode *shrunk = realloc(out->nodes, sizeof(BvhNode) * nwide);
+	if (shrunk)
+		out->nodes = shrunk;
+	out->nnodes = nwide;
+	return AJAR_OK;
 }
 
 ajar_status bvh_build(const Tri *tris, uint32_t ntris, Bvh *out)
@@ -228,13 +348,17 @@ ajar_status bvh_build(const Tri *tris, uint32_t ntris, Bvh *out)
 	memset(out, 0, sizeof(*out));
 	if (ntris == 0)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "bvh_build: no triangles");
+	if (ntris > BVH_MAX_TRIS)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "bvh_build: %u triangles, at most %u supported",
+			       ntris, (unsigned)BVH_MAX_TRIS);
 
 	size_t max_nodes = 2 * (size_t)ntris - 1;
 	Ref *refs = malloc(sizeof(Ref) * ntris);
-	out->nodes = malloc(sizeof(BvhNode) * max_nodes);
+	BinNode *bn = malloc(sizeof(BinNode) * max_nodes);
 	out->order = malloc(sizeof(uint32_t) * ntris);
-	if (!refs || !out->nodes || !out->order) {
+	if (!refs || !bn || !out->order) {
 		free(refs);
+		free(bn);
 		bvh_free(out);
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for %u triangles",
 			       ntris);
@@ -262,7 +386,7 @@ ajar_status bvh_build(const Tri *tris, uint32_t ntris, Bvh *out)
 		Task task = stack[--sp];
 		uint32_t id = nnodes++;
 		if (task.parent != NO_PARENT)
-			out->nodes[task.parent].index = (int)id;
+			bn[task.parent].index = (int)id;
 		if (task.depth + 1 > max_depth)
 			max_depth = task.depth + 1;
 
@@ -280,8 +404,8 @@ ajar_status bvh_build(const Tri *tris, uint32_t ntris, Bvh *out)
 					cbox.hi[a] = k;
 			}
 		}
-		BvhNode *node = &out->nodes[id];
-		node_set_box(node, &box);
+		BinNode *node = &bn[id];
+		node->b = box;
 		uint32_t n = task.end - task.start;
 		uint32_t nleft = split_node(refs + task.start, n, &box, &cbox, task.depth);
 		if (nleft == 0) {
@@ -298,14 +422,13 @@ ajar_status bvh_build(const Tri *tris, uint32_t ntris, Bvh *out)
 	for (uint32_t i = 0; i < ntris; i++)
 		out->order[i] = refs[i].idx;
 	free(refs);
-
-	BvhNode *shrunk = realloc(out->nodes, sizeof(BvhNode) * nnodes);
-	if (shrunk)
-		out->nodes = shrunk;
-	out->nnodes = nnodes;
 	out->ntris = ntris;
 	out->depth = max_depth;
-	return AJAR_OK;
+	ajar_status st = collapse(bn, nnodes, out);
+	free(bn);
+	if (st != AJAR_OK)
+		bvh_free(out);
+	return st;
 }
 
 void bvh_free(Bvh *b)

@@ -86,8 +86,14 @@ static void built_make(const Tri *tris, uint32_t n, Built *b)
 		b->tris[i] = tris[b->bvh.order[i]];
 	b->sc.nodes = b->bvh.nodes;
 	b->sc.tris = b->tris;
-	b->lo = b->bvh.nodes[0].bmin;
-	b->hi = b->bvh.nodes[0].bmax;
+	b->lo = v3(INFINITY, INFINITY, INFINITY);
+	b->hi = v3(-INFINITY, -INFINITY, -INFINITY);
+	const BvhNode *root = &b->bvh.nodes[0];
+	for (int k = 0; k < 4; k++)
+		if (root->child[k] != BVH_EMPTY) {
+			b->lo = v3_min(b->lo, v3(root->lo_x[k], root->lo_y[k], root->lo_z[k]));
+			b->hi = v3_max(b->hi, v3(root->hi_x[k], root->hi_y[k], root->hi_z[k]));
+		}
 }
 
 static void built_free(Built *b)
@@ -96,23 +102,32 @@ static void built_free(Built *b)
 	free(b->tris);
 }
 
-static int box_contains(const BvhNode *outer, V3 lo, V3 hi)
+static V3 slot_lo(const BvhNode *n, int k) { return v3(n->lo_x[k], n->lo_y[k], n->lo_z[k]); }
+static V3 slot_hi(const BvhNode *n, int k) { return v3(n->hi_x[k], n->hi_y[k], n->hi_z[k]); }
+
+static int box_contains(V3 olo, V3 ohi, V3 lo, V3 hi)
 {
-	return outer->bmin.x <= lo.x && outer->bmin.y <= lo.y && outer->bmin.z <= lo.z &&
-	       outer->bmax.x >= hi.x && outer->bmax.y >= hi.y && outer->bmax.z >= hi.z;
+	return olo.x <= lo.x && olo.y <= lo.y && olo.z <= lo.z && ohi.x >= hi.x && ohi.y >= hi.y &&
+	       ohi.z >= hi.z;
 }
 
-/* Every triangle in exactly one leaf, boxes nested, depth bounded. */
+/* Every triangle in exactly one leaf slot of at most 4, every node but the
+ * root the child of exactly one slot, children after their parent, boxes
+ * nested, unused slots at (+inf, +inf, +inf), depth bounded. */
 static void check_structure(const Built *b, uint32_t n)
 {
 	const Bvh *bvh = &b->bvh;
-	assert_true(bvh->nnodes >= 1 && bvh->nnodes <= 2 * n - 1);
+	assert_true(bvh->nnodes >= 1 && bvh->nnodes <= n);
 	assert_true(bvh->depth >= 1 && bvh->depth <= BVH_MAX_DEPTH);
+	assert_true(bvh->wide_depth >= 1 && bvh->wide_depth <= BVH_MAX_DEPTH / 2);
+	assert_true(bvh->wide_depth <= (bvh->depth + 1) / 2 || bvh->depth == 1);
 	assert_int_equal(bvh_memory(bvh), bvh->nnodes * sizeof(BvhNode) + n * sizeof(uint32_t));
 	char *seen = calloc(n, 1);
 	uint32_t *covered = calloc(n, sizeof(uint32_t));
+	uint32_t *parents = calloc(bvh->nnodes, sizeof(uint32_t));
 	assert_non_null(seen);
 	assert_non_null(covered);
+	assert_non_null(parents);
 	for (uint32_t i = 0; i < n; i++) {
 		assert_true(bvh->order[i] < n);
 		assert_false(seen[bvh->order[i]]);
@@ -120,28 +135,47 @@ static void check_structure(const Built *b, uint32_t n)
 	}
 	for (uint32_t i = 0; i < bvh->nnodes; i++) {
 		const BvhNode *nd = &bvh->nodes[i];
-		if (nd->count > 0) {
-			assert_true(nd->count <= 8);
-			assert_true(nd->index >= 0 && (uint32_t)(nd->index + nd->count) <= n);
-			for (int k = nd->index; k < nd->index + nd->count; k++) {
-				const Tri *t = &b->tris[k];
-				assert_true(box_contains(nd, v3_min(t->p0, v3_min(t->p1, t->p2)),
-							 v3_max(t->p0, v3_max(t->p1, t->p2))));
-				covered[k]++;
+		int used = 0;
+		for (int k = 0; k < 4; k++) {
+			int c = nd->child[k];
+			V3 lo = slot_lo(nd, k), hi = slot_hi(nd, k);
+			if (c == BVH_EMPTY) {
+				assert_true(lo.x == INFINITY && lo.y == INFINITY && lo.z == INFINITY);
+				assert_true(hi.x == INFINITY && hi.y == INFINITY && hi.z == INFINITY);
+				continue;
 			}
-		} else {
-			assert_int_equal(nd->count, 0);
-			assert_true(i + 1 < bvh->nnodes);
-			assert_true(nd->index > (int)i + 1 && (uint32_t)nd->index < bvh->nnodes);
-			const BvhNode *l = &bvh->nodes[i + 1], *r = &bvh->nodes[nd->index];
-			assert_true(box_contains(nd, l->bmin, l->bmax));
-			assert_true(box_contains(nd, r->bmin, r->bmax));
+			used++;
+			if (c < 0) {
+				int first = BVH_LEAF_FIRST(c), count = BVH_LEAF_COUNT(c);
+				assert_true(c == BVH_LEAF(first, count));
+				assert_true(count >= 1 && count <= 4);
+				assert_true(first >= 0 && (uint32_t)(first + count) <= n);
+				for (int t = first; t < first + count; t++) {
+					const Tri *tr = &b->tris[t];
+					assert_true(box_contains(lo, hi, v3_min(tr->p0, v3_min(tr->p1, tr->p2)),
+								 v3_max(tr->p0, v3_max(tr->p1, tr->p2))));
+					covered[t]++;
+				}
+			} else {
+				assert_true((uint32_t)c > i && (uint32_t)c < bvh->nnodes);
+				parents[c]++;
+				const BvhNode *ch = &bvh->nodes[c];
+				for (int j = 0; j < 4; j++)
+					if (ch->child[j] != BVH_EMPTY)
+						assert_true(box_contains(lo, hi, slot_lo(ch, j), slot_hi(ch, j)));
+			}
 		}
+		/* Only a root over at most 4 triangles has a single slot. */
+		assert_true(used >= 2 || (i == 0 && bvh->nnodes == 1 && used == 1));
 	}
+	assert_int_equal(parents[0], 0);
+	for (uint32_t i = 1; i < bvh->nnodes; i++)
+		assert_int_equal(parents[i], 1);
 	for (uint32_t i = 0; i < n; i++)
 		assert_int_equal(covered[i], 1);
 	free(seen);
 	free(covered);
+	free(parents);
 }
 
 static int brute_closest(const Built *b, uint32_t n, V3 o, V3 d, float tmax, Hit *hit)
@@ -265,8 +299,8 @@ static void run_soup(const Tri *tris, uint32_t n, uint32_t nrays, const char *na
 	built_make(tris, n, &b);
 	check_structure(&b, n);
 	uint32_t hits = check_rays(&b, n, nrays);
-	printf("  %-12s %6u tris %6u nodes depth %2u: %u/%u rays hit\n", name, n, b.bvh.nnodes,
-	       b.bvh.depth, hits, nrays);
+	printf("  %-12s %6u tris %6u nodes depth %2u (4-wide %2u): %u/%u rays hit\n", name, n, b.bvh.nnodes,
+	       b.bvh.depth, b.bvh.wide_depth, hits, nrays);
 	/* The soups are built so a good share of rays hits; a BVH that
 	 * missed everything would agree with a broken brute force. */
 	if (n > 1)
@@ -351,7 +385,10 @@ static void test_single_triangle(void **state)
 	Built b;
 	built_make(&t, 1, &b);
 	assert_int_equal(b.bvh.nnodes, 1);
-	assert_int_equal(b.bvh.nodes[0].count, 1);
+	assert_int_equal(b.bvh.nodes[0].child[0], BVH_LEAF(0, 1));
+	for (int k = 1; k < 4; k++)
+		assert_int_equal(b.bvh.nodes[0].child[k], BVH_EMPTY);
+	check_structure(&b, 1);
 	check_rays(&b, 1, 20000);
 	/* Known hit, both faces (no culling), barycentrics of p1 and p2. */
 	Hit h;
@@ -364,6 +401,11 @@ static void test_single_triangle(void **state)
 	assert_float_equal(h.t, 2.0f, 1e-6f);
 	assert_false(bvh_intersect(&b.sc, v3(0.25f, 0.5f, -2), v3(0, 0, 1), 1.5f, &h));
 	assert_false(bvh_intersect(&b.sc, v3(0.75f, 0.5f, 1), v3(0, 0, -1), AJAR_INF, &h));
+	/* Rays with a non-finite origin or direction hit nothing (and never
+	 * enter an unused slot, whose box lies at +inf). */
+	assert_false(bvh_intersect(&b.sc, v3(0.25f, 0.5f, NAN), v3(0, 0, -1), AJAR_INF, &h));
+	assert_false(bvh_intersect(&b.sc, v3(0.25f, 0.5f, 1), v3(0, NAN, -1), AJAR_INF, &h));
+	assert_false(bvh_occluded(&b.sc, v3(0.25f, 0.5f, 1), v3(0, 0, -INFINITY), AJAR_INF));
 	/* The front face is CCW seen from +Z. */
 	V3 ng = tri_normal(&b.tris[0]);
 	assert_true(ng.z > 0.0f && ng.x == 0.0f && ng.y == 0.0f);
@@ -411,7 +453,8 @@ static void test_depth_bounded(void **state)
 	Built b;
 	built_make(t, n, &b);
 	check_structure(&b, n);
-	printf("  hostile      %6u tris %6u nodes depth %2u\n", n, b.bvh.nnodes, b.bvh.depth);
+	printf("  hostile      %6u tris %6u nodes depth %2u (4-wide %2u)\n", n, b.bvh.nnodes, b.bvh.depth,
+	       b.bvh.wide_depth);
 	assert_true(b.bvh.depth > BVH_MAX_DEPTH - 32); /* the cap was needed */
 	for (uint32_t i = 0; i < n; i++) {
 		const Tri *tri = &b.tris[i];
@@ -480,8 +523,9 @@ static void check_scene(const char *path)
 	uint32_t nrays = (uint32_t)(1e8 / n);
 	nrays = nrays > 2000 ? 2000 : (nrays < 150 ? 150 : nrays);
 	uint32_t hits = check_rays(&b, n, nrays);
-	printf("  %-40s %6u tris %6u nodes depth %2u, %.3f s, %.1f MB: %u/%u rays hit\n", path, n,
-	       b.bvh.nnodes, b.bvh.depth, secs, bvh_memory(&b.bvh) / 1048576.0, hits, nrays);
+	printf("  %-40s %6u tris %6u nodes depth %2u (4-wide %2u), %.3f s, %.1f MB: %u/%u rays hit\n", path,
+	       n, b.bvh.nnodes, b.bvh.depth, b.bvh.wide_depth, secs, bvh_memory(&b.bvh) / 1048576.0, hits,
+	       nrays);
 	assert_true(hits > nrays / 4);
 	built_free(&b);
 	scene_free(s);
