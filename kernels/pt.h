@@ -119,7 +119,7 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 		d = bsm.wi;
 		if (depth == 0)
 			beta_ref = fmax(v3_maxc(beta), 1e-30f); /* roulette.h */
-		else if (depth + 1 >= prm->rr_depth && !rr_survive(&beta, beta_ref, rng))
+		else if (depth + 1 >= prm->rr_depth && !rr_survive(&beta, beta_ref, RR_BOOST, rng))
 			break;
 		if (v3_is_zero(beta))
 			break;

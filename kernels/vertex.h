@@ -157,7 +157,8 @@ INLINE int vertex_scatter(const SceneView *sc, PathVertex *path, int n, int ligh
 		prev->pr = rev_a;
 	else
 		prev->pf = rev_a;
-	if (n - 1 >= sc->params->rr_depth && beta_ref > 0.0f && !rr_survive(beta, beta_ref, rng))
+	float boost = sc->params->light_paths ? RR_BOOST_CONNECTED : RR_BOOST;
+	if (n - 1 >= sc->params->rr_depth && beta_ref > 0.0f && !rr_survive(beta, beta_ref, boost, rng))
 		return 0;
 	if (v3_is_zero(*beta))
 		return 0;

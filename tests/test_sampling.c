@@ -344,7 +344,7 @@ static void test_fast_math(void **state)
 	assert_true(fabs(s) < 1e-6 && c == -1.0f);
 }
 
-/* Survivors are counted against q = min(RR_BOOST max(beta) / beta_ref,
+/* Survivors are counted against q = min(boost max(beta) / beta_ref,
  * RR_MAX_SURVIVAL) within 5 binomial standard errors, and the mean of the
  * throughput afterwards (0 for a walk that ended) must equal beta: that
  * is what keeps the estimate unbiased. */
@@ -353,21 +353,22 @@ static void test_roulette(void **state)
 	(void)state;
 	const struct {
 		V3 beta;
-		float ref;
+		float ref, boost;
 	} cases[] = {
-		{{0.05f, 0.02f, 0.01f}, 1.0f}, /* dark: mostly ends */
-		{{0.3f, 0.5f, 0.1f}, 1.2f},    /* relative to beta_ref, below the cap */
-		{{0.9f, 0.9f, 0.9f}, 1.0f},    /* bright: capped at RR_MAX_SURVIVAL */
-		{{1e-6f, 0.0f, 0.0f}, 1e-3f},
+		{{0.05f, 0.02f, 0.01f}, 1.0f, RR_BOOST},            /* dark: mostly ends */
+		{{0.3f, 0.5f, 0.1f}, 1.2f, RR_BOOST_CONNECTED},    /* relative to beta_ref, below the cap */
+		{{0.3f, 0.5f, 0.1f}, 1.2f, RR_BOOST},              /* the same, the larger boost */
+		{{0.9f, 0.9f, 0.9f}, 1.0f, RR_BOOST_CONNECTED},    /* bright: capped at RR_MAX_SURVIVAL */
+		{{1e-6f, 0.0f, 0.0f}, 1e-3f, RR_BOOST},
 	};
 	const int n = 400000;
 	for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
 		Rng rng = rng_init(99, (uint)c, 0, 0);
-		double q = fmin(RR_BOOST * v3_maxc(cases[c].beta) / cases[c].ref, RR_MAX_SURVIVAL);
+		double q = fmin(cases[c].boost * v3_maxc(cases[c].beta) / cases[c].ref, RR_MAX_SURVIVAL);
 		double alive = 0.0, sum[3] = {0.0, 0.0, 0.0};
 		for (int i = 0; i < n; i++) {
 			V3 b = cases[c].beta;
-			if (rr_survive(&b, cases[c].ref, &rng)) {
+			if (rr_survive(&b, cases[c].ref, cases[c].boost, &rng)) {
 				alive += 1.0;
 				sum[0] += b.x;
 				sum[1] += b.y;
