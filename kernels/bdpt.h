@@ -53,7 +53,10 @@ INLINE int bdpt_mis_path(const SceneView *sc, const PathVertex *l, int s, const 
 		mv[s - 1].delta = 0;
 	mv[s].delta = 0;
 	const PathVertex *x0 = s > 0 ? &l[0] : &e[t - 1];
-	bdpt_light_records(sc, mv, x0, s >= 2 ? &l[1] : (s == 1 ? &e[t - 1] : &e[t - 2]), k);
+	/* x_1 and x_2 (k >= 3 for the second): light vertices, then eye vertices. */
+	const PathVertex *x1 = s >= 2 ? &l[1] : (s == 1 ? &e[t - 1] : &e[t - 2]);
+	const PathVertex *x2 = s >= 3 ? &l[2] : &e[max(t + s - 3, 0)];
+	bdpt_light_records(sc, mv, x0, x1, x2, k);
 	if (s == 0) {
 		/* e[t-1] is the light: its emission density. */
 		const PathVertex *lt = &e[t - 1];
@@ -356,16 +359,17 @@ INLINE int bdpt_nee_visible(const SceneView *sc, const PathVertex *z, const Ligh
 	return segment_clear(sc, z->p, z->ng, ls->p, ls->n);
 }
 
-/* Next-event estimation at eye-side surface vertex z, whose BSDF is bz:
- * the light sample's vertex *y (with pr, z's density of sampling it,
- * which MIS records need) and the contribution from z's throughput on, 0
- * if occluded. */
-INLINE V3 bdpt_nee_bs(const SceneView *sc, const PathVertex *z, const Bsdf *bz, PathVertex *y, Rng *rng)
+/* Next-event estimation at eye-side surface vertex z, whose BSDF is bz
+ * and whose neighbour on the eye side is `from`: the light sample's vertex
+ * *y (with pr, z's density of sampling it, which MIS records need) and the
+ * contribution from z's throughput on, 0 if occluded. */
+INLINE V3 bdpt_nee_bs(const SceneView *sc, const PathVertex *z, const PathVertex *from, const Bsdf *bz,
+		      PathVertex *y, Rng *rng)
 {
 	LightSample ls;
 	float u0 = rng_f(rng), u1 = rng_f(rng), u2 = rng_f(rng), pdf_w;
 	V3 zero = v3(0.0f, 0.0f, 0.0f);
-	if (!light_sample(sc, z->p, u0, u1, u2, &ls) || v3_is_zero(ls.Le))
+	if (!light_sample(sc, z->p, vertex_nee_normal(z, from), u0, u1, u2, &ls) || v3_is_zero(ls.Le))
 		return zero;
 	bdpt_light_vertex(y, &ls);
 	V3 f = bdpt_scatter_bs(bz, z, ls.wi, BSDF_RADIANCE, &pdf_w);
@@ -375,11 +379,11 @@ INLINE V3 bdpt_nee_bs(const SceneView *sc, const PathVertex *z, const Bsdf *bz, 
 	return v3_scale(v3_mul(v3_mul(z->beta, f), ls.Le), 1.0f / ls.pdf_w);
 }
 
-INLINE V3 bdpt_nee(const SceneView *sc, const PathVertex *z, PathVertex *y, Rng *rng)
+INLINE V3 bdpt_nee(const SceneView *sc, const PathVertex *z, const PathVertex *from, PathVertex *y, Rng *rng)
 {
 	Bsdf bz;
 	vertex_bsdf(sc, z, &bz);
-	return bdpt_nee_bs(sc, z, &bz, y, rng);
+	return bdpt_nee_bs(sc, z, from, &bz, y, rng);
 }
 
 /* Every bdpt strategy of one light and one eye subpath: adds the eye
@@ -410,7 +414,7 @@ INLINE void bdpt_strategies(const SceneView *sc, PathVertex *l, int nl, PathVert
 		/* s = 1: next-event estimation with a fresh light sample. */
 		{
 			PathVertex y;
-			V3 c = bdpt_nee_bs(sc, z, &bz, &y, rng);
+			V3 c = bdpt_nee_bs(sc, z, &e[t - 2], &bz, &y, rng);
 			if (!v3_is_zero(c))
 				bdpt_add(sc, out, 1, t, c, bdpt_weight(sc, &y, 1, e, t), out->pixel, rng);
 		}

@@ -26,22 +26,24 @@ INLINE float bdpt_origin_pdf(const SceneView *sc, const PathVertex *l)
 	return (1.0f - ps) * emitter_pdf_a(sc, l->tri);
 }
 
-/* Density of the light vertex as a next-event sample from vertex x
- * (pn_0, the s = 1 strategy; lights.h, light_sample). */
-INLINE float bdpt_nee_pdf(const SceneView *sc, const PathVertex *l, const PathVertex *x)
+/* Density of the light vertex as a next-event sample from vertex x, seen
+ * from `from` (pn_0, the s = 1 strategy; lights.h, light_sample). */
+INLINE float bdpt_nee_pdf(const SceneView *sc, const PathVertex *l, const PathVertex *x, const PathVertex *from)
 {
 	float ps = sc->params->env_pdf_select;
 	if (l->type == VERTEX_ENV)
-		return ps * env_nee_pdf_w(sc, x->p, l->p);
+		return ps * env_nee_pdf_w(sc, x->p, vertex_nee_normal(x, from), l->p);
 	return (1.0f - ps) * emitter_pdf_a(sc, l->tri);
 }
 
 /* x_0's two densities in a path's MIS records: as the light subpath's
- * origin (pf) and as a next-event sample from x_1 (pn). */
-INLINE void bdpt_light_records(const SceneView *sc, MisVertex *mv, const PathVertex *x0, const PathVertex *x1, int k)
+ * origin (pf) and as a next-event sample from x_1 (pn), seen from x_2
+ * (read only when k >= 3). */
+INLINE void bdpt_light_records(const SceneView *sc, MisVertex *mv, const PathVertex *x0, const PathVertex *x1,
+			       const PathVertex *x2, int k)
 {
 	mv[0].pf = bdpt_origin_pdf(sc, x0);
-	mv[0].pn = k >= 3 ? bdpt_nee_pdf(sc, x0, x1) : mv[0].pf;
+	mv[0].pn = k >= 3 ? bdpt_nee_pdf(sc, x0, x1, x2) : mv[0].pf;
 }
 
 /* Density with which the light vertex's emission sampling produces `to`

@@ -90,12 +90,13 @@ INLINE int light_sample_emitter(const SceneView *sc, V3 x, float u, float u1, fl
 	return 1;
 }
 
-/* Next-event estimation from shading point x: the environment with
- * probability Params.env_pdf_select (through the portals that show x the
- * sky, env_portal.h), else an emitter by power and a uniform point on it. Returns 0 when there is nothing to sample or the
- * sample cannot carry light (emitter seen from behind or edge-on, zero
- * distance, zero density); the caller then adds nothing. */
-INLINE int light_sample(const SceneView *sc, V3 x, float u_sel, float u1, float u2, LightSample *ls)
+/* Next-event estimation from shading point x with normal n: the
+ * environment with probability Params.env_pdf_select (through the portals
+ * that show x the sky, weighed by n, env_portal.h), else an emitter by
+ * power and a uniform point on it. Returns 0 when there is nothing to
+ * sample or the sample cannot carry light (emitter seen from behind or
+ * edge-on, zero distance, zero density); the caller then adds nothing. */
+INLINE int light_sample(const SceneView *sc, V3 x, V3 n, float u_sel, float u1, float u2, LightSample *ls)
 {
 	float ps = sc->params->env_pdf_select;
 	ls->is_env = 0;
@@ -105,7 +106,7 @@ INLINE int light_sample(const SceneView *sc, V3 x, float u_sel, float u1, float 
 	if (u_sel < ps) {
 		float pdf_w;
 		V3 wi;
-		ls->Le = env_nee_sample(sc, x, u_sel / ps, u1, u2, &wi, &pdf_w);
+		ls->Le = env_nee_sample(sc, x, n, u_sel / ps, u1, u2, &wi, &pdf_w);
 		if (!(pdf_w > 0.0f))
 			return 0;
 		ls->is_env = 1;
@@ -121,14 +122,14 @@ INLINE int light_sample(const SceneView *sc, V3 x, float u_sel, float u1, float 
 }
 
 /* Solid-angle density (selection included) with which light_sample from
- * x yields direction wi toward emitter triangle `tri` hit at distance
+ * x with normal n yields direction wi toward emitter triangle `tri` hit at distance
  * `dist` where the light's cosine with -wi is cos_light, or toward the
  * environment when tri < 0. For MIS on BSDF-sampled hits. */
-INLINE float light_pdf_w(const SceneView *sc, V3 x, V3 wi, int tri, float dist, float cos_light)
+INLINE float light_pdf_w(const SceneView *sc, V3 x, V3 n, V3 wi, int tri, float dist, float cos_light)
 {
 	float ps = sc->params->env_pdf_select;
 	if (tri < 0)
-		return ps * env_nee_pdf_w(sc, x, wi);
+		return ps * env_nee_pdf_w(sc, x, n, wi);
 	float pdf_a = emitter_pdf_a(sc, tri);
 	if (!(pdf_a > 0.0f) || !(cos_light > 0.0f))
 		return 0.0f;

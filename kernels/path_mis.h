@@ -208,7 +208,7 @@ INLINE void path_records(const SceneView *sc, const PathRef *P, int heuristic, M
 	 * its pr when the caller stored it (bdpt_nee). */
 	mv[0].pf = bdpt_origin_pdf(sc, x[0]);
 	int nee = P->s == 1 && k >= 3; /* else a light subpath's origin (t = 1) */
-	mv[0].pn = k < 3 ? mv[0].pf : (nee ? x[0]->pf : bdpt_nee_pdf(sc, x[0], x[1]));
+	mv[0].pn = k < 3 ? mv[0].pf : (nee ? x[0]->pf : bdpt_nee_pdf(sc, x[0], x[1], x[2]));
 	if (need_pf && P->s == 0 && k > 2)
 		mv[1].pf = path_pf(sc, P, mv, 1);
 	for (int j = 0; j < 2; j++) {

@@ -241,7 +241,7 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 				} else if (z->type != VERTEX_SURFACE) {
 					break;
 				} else if (s == 1) {
-					lcon = bdpt_nee(sc, z, &y, rng);
+					lcon = bdpt_nee(sc, z, &R[a - 1], &y, rng);
 					lp = &y;
 				} else {
 					V3 c = bdpt_connect(sc, &l[s - 1], z);

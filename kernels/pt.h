@@ -45,7 +45,7 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 	V3 L = v3(0.0f, 0.0f, 0.0f), beta = v3(1.0f, 1.0f, 1.0f);
 	float prev_pdf_w = 0.0f;
 	int prev_delta = 1; /* the camera ray counts emission in full */
-	V3 prev_p = o;
+	V3 prev_p = o, prev_n = v3(0.0f, 0.0f, 0.0f); /* prev_n: vertex_nee_normal's */
 	float beta_ref = 1.0f;
 	int cnt[PT_CROSS_EDGES];
 	for (int depth = 0;; depth++) {
@@ -60,7 +60,7 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 			V3 Le = env_radiance(sc, d);
 			if (!v3_is_zero(Le)) {
 				float w = prev_delta ? 1.0f
-						     : mis_power(prev_pdf_w, light_pdf_w(sc, prev_p, d, -1, AJAR_INF, 1.0f));
+						     : mis_power(prev_pdf_w, light_pdf_w(sc, prev_p, prev_n, d, -1, AJAR_INF, 1.0f));
 				w *= pt_cross_weight(prm, cnt, depth + 1, c_edge);
 				if (depth + 1 >= prm->min_depth)
 					L = v3_add(L, v3_scale(v3_mul(beta, Le), w));
@@ -76,7 +76,7 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 				float w = 1.0f;
 				if (!prev_delta) {
 					float cos_l = fabs(v3_dot(s.ng, wo));
-					w = mis_power(prev_pdf_w, light_pdf_w(sc, prev_p, d, s.tri, h.t, cos_l));
+					w = mis_power(prev_pdf_w, light_pdf_w(sc, prev_p, prev_n, d, s.tri, h.t, cos_l));
 				}
 				w *= pt_cross_weight(prm, cnt, depth + 1, c_edge);
 				L = v3_add(L, v3_scale(v3_mul(beta, Le), w));
@@ -87,10 +87,11 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 			break;
 		Bsdf bs;
 		bsdf_setup(&bs, &sc->materials[s.material], surface_base_color(sc, &s), s.ns, s.ng);
+		V3 n_nee = v3_dot(s.ns, wo) < 0.0f ? v3_neg(s.ns) : s.ns; /* as vertex_nee_normal */
 		if (!bsdf_is_delta(&bs) && depth + 2 >= prm->min_depth) {
 			LightSample ls;
 			float u0 = rng_f(rng), u1 = rng_f(rng), u2 = rng_f(rng);
-			if (light_sample(sc, s.p, u0, u1, u2, &ls) && ls.pdf_w > 0.0f && !v3_is_zero(ls.Le)) {
+			if (light_sample(sc, s.p, n_nee, u0, u1, u2, &ls) && ls.pdf_w > 0.0f && !v3_is_zero(ls.Le)) {
 				float pdf_bsdf_w;
 				V3 f = bsdf_eval_fwd(&bs, wo, ls.wi, BSDF_RADIANCE, &pdf_bsdf_w);
 				if (!v3_is_zero(f)) {
@@ -115,6 +116,7 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 		prev_pdf_w = bsm.pdf_w;
 		prev_delta = bsm.delta;
 		prev_p = s.p;
+		prev_n = n_nee;
 		o = ray_offset(s.p, s.ng, bsm.wi);
 		d = bsm.wi;
 		if (depth == 0)

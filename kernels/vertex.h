@@ -61,6 +61,17 @@ INLINE float vertex_density_a(const PathVertex *from, const PathVertex *to, floa
 	return pdf_w * fabs(v3_dot(to->ng, d)) / (d2 * sqrt(d2));
 }
 
+/* The shading normal of x turned toward `from`, its neighbour on the eye
+ * side of the path: the normal that next-event samples from x are weighed
+ * by (env_portal.h). Taken from the two positions, never from x's wo, so
+ * that sampling and every MIS record of the same path agree bit for bit
+ * whichever walk made x. */
+INLINE V3 vertex_nee_normal(const PathVertex *x, const PathVertex *from)
+{
+	V3 w = from->type == VERTEX_ENV ? from->p : v3_sub(from->p, x->p);
+	return v3_dot(x->ns, w) < 0.0f ? v3_neg(x->ns) : x->ns;
+}
+
 /* pbrt's correction for shading normals in light transport (Veach 1997,
  * sec. 5.3): scattering toward wi at a light-subpath vertex whose previous
  * vertex lies along wo. */

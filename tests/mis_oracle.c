@@ -58,7 +58,7 @@ void oracle(const SceneView *sc, const PathVertex *x, const int *delta, int k, M
 		/* pn: x_0 as a next-event sample from x_1 */
 		if (i == 0)
 			mv[0].pn = k < 3 ? mv[0].pf
-					 : x[0].type == VERTEX_ENV ? ps * env_nee_pdf_w(sc, x[1].p, x[0].p)
+					 : x[0].type == VERTEX_ENV ? ps * env_nee_pdf_w(sc, x[1].p, vertex_nee_normal(&x[1], &x[2]), x[0].p)
 								    : (1 - ps) * emitter_pdf_a(sc, x[0].tri);
 		/* pr */
 		if (i == k - 1)

@@ -433,25 +433,25 @@ static void test_portal_sampling(void **state)
 /* Total solid-angle density of light_sample at x in direction wi: the
  * environment's share plus every emitter the ray crosses (light sampling
  * ignores occlusion, so overlapping emitters add up). */
-static double light_density(const Lit *l, V3 x, V3 wi)
+static double light_density(const Lit *l, V3 x, V3 n, V3 wi)
 {
-	double pdf = light_pdf_w(&l->sc, x, wi, -1, AJAR_INF, 1.0f);
+	double pdf = light_pdf_w(&l->sc, x, n, wi, -1, AJAR_INF, 1.0f);
 	RayPre r = ray_pre(x, wi);
 	for (uint32_t k = 0; k < l->lt.nemitters; k++) {
 		int tri = l->lt.emitters[k].tri;
 		float t, u, v;
 		if (!tri_intersect(&r, &l->tris[tri], AJAR_INF, &t, &u, &v))
 			continue;
-		V3 n = v3_norm(tri_normal(&l->tris[tri]));
-		pdf += light_pdf_w(&l->sc, x, wi, tri, t, -v3_dot(n, wi));
+		pdf += light_pdf_w(&l->sc, x, n, wi, tri, t, -v3_dot(v3_norm(tri_normal(&l->tris[tri])), wi));
 	}
 	return pdf;
 }
 
-/* Directions from x binned into equal-area cells (cos theta about +Y,
- * phi), expected counts from light_pdf_w integrated over each cell; one
- * more cell for samples light_sample refused (back-facing emitters). */
-static void check_light_sample(Lit *l, V3 x, const char *name)
+/* Directions from x (receiver normal n) binned into equal-area cells
+ * (cos theta about +Y, phi), expected counts from light_pdf_w integrated
+ * over each cell; one more cell for samples light_sample refused
+ * (back-facing emitters). */
+static void check_light_sample(Lit *l, V3 x, V3 n, const char *name)
 {
 	enum { CT = 24, CP = 48, SUB = 24, N = 300000, NC = CT * CP + 1 };
 	static double obs[NC], expct[NC];
@@ -465,7 +465,7 @@ static void check_light_sample(Lit *l, V3 x, const char *name)
 					float c = 1.0f - 2.0f * (ct + (j + 0.5f) / SUB) / CT;
 					float phi = 2.0f * AJAR_PI * (cp + (i + 0.5f) / SUB) / CP;
 					float s = sqrtf(fmaxf(0.0f, 1.0f - c * c));
-					sum += light_density(l, x, v3(s * cosf(phi), c, s * sinf(phi)));
+					sum += light_density(l, x, n, v3(s * cosf(phi), c, s * sinf(phi)));
 				}
 			double cell = sum * (4.0 * M_PI / (CT * CP)) / (SUB * SUB);
 			expct[ct * CP + cp] = cell * N;
@@ -475,7 +475,7 @@ static void check_light_sample(Lit *l, V3 x, const char *name)
 	int env_count = 0;
 	for (int k = 0; k < N; k++) {
 		LightSample ls;
-		if (!light_sample(&l->sc, x, rnd(), rnd(), rnd(), &ls)) {
+		if (!light_sample(&l->sc, x, n, rnd(), rnd(), rnd(), &ls)) {
 			obs[NC - 1] += 1.0;
 			continue;
 		}
@@ -487,7 +487,7 @@ static void check_light_sample(Lit *l, V3 x, const char *name)
 			/* Through portals the sample adds its own triangle's term
 			 * first, so the sum may round differently. */
 			assert_true(ls.dist == AJAR_INF);
-			assert_float_equal(light_pdf_w(&l->sc, x, ls.wi, -1, ls.dist, 1.0f), ls.pdf_w, 1e-5f * ls.pdf_w);
+			assert_float_equal(light_pdf_w(&l->sc, x, n, ls.wi, -1, ls.dist, 1.0f), ls.pdf_w, 1e-5f * ls.pdf_w);
 		} else {
 			assert_float_equal(ls.dist, v3_len(v3_sub(ls.p, x)), 1e-5f * ls.dist);
 			float cos_light = -v3_dot(ls.n, ls.wi);
@@ -501,7 +501,7 @@ static void check_light_sample(Lit *l, V3 x, const char *name)
 					tri = ti;
 			}
 			assert_true(tri >= 0);
-			assert_float_equal(light_pdf_w(&l->sc, x, ls.wi, tri, ls.dist, cos_light), ls.pdf_w,
+			assert_float_equal(light_pdf_w(&l->sc, x, n, ls.wi, tri, ls.dist, cos_light), ls.pdf_w,
 					   1e-4f * ls.pdf_w);
 			V3 Le = emitter_radiance(&l->sc, tri, v3_neg(ls.wi));
 			assert_true(Le.x == ls.Le.x && Le.y == ls.Le.y && Le.z == ls.Le.z);
@@ -554,7 +554,7 @@ static void test_light_sample_emitters(void **state)
 	lit_build(&l);
 	assert_int_equal(l.lt.nemitters, 5);
 	assert_float_equal(l.lt.env_pdf_select, 0.0f, 0.0f);
-	check_light_sample(&l, v3(0, 0, 0), "emitters");
+	check_light_sample(&l, v3(0, 0, 0), v3(0, 1, 0), "emitters");
 	lit_free(&l);
 }
 
@@ -566,7 +566,7 @@ static void test_light_sample_env_color(void **state)
 	scene_set_env_color(l.s, v3(0.02f, 0.03f, 0.05f));
 	lit_build(&l);
 	assert_true(l.lt.env_pdf_select > 0.2f && l.lt.env_pdf_select < 0.8f);
-	check_light_sample(&l, v3(0, 0, 0), "+ env colour");
+	check_light_sample(&l, v3(0, 0, 0), v3(0, 1, 0), "+ env colour");
 	lit_free(&l);
 }
 
@@ -578,7 +578,7 @@ static void test_light_sample_env_image(void **state)
 	assert_int_equal(scene_set_env_image(l.s, 40, 20, synthetic_sky(40, 20), 0.02f), AJAR_OK);
 	lit_build(&l);
 	assert_true(l.lt.env_pdf_select > 0.1f && l.lt.env_pdf_select < 0.9f);
-	check_light_sample(&l, v3(0.1f, 0.2f, 0.05f), "+ env image");
+	check_light_sample(&l, v3(0.1f, 0.2f, 0.05f), v3(0, 1, 0), "+ env image");
 	lit_free(&l);
 }
 
@@ -629,7 +629,12 @@ static void test_light_sample_env_portals(void **state)
 	double quad = 4 * M_PI * hits / 200000;
 	printf("  window solid angle %.4f sr, counted %.4f sr\n", om[0] + om[1], quad);
 	assert_true(fabs(om[0] + om[1] - quad) < 5 * sqrt(quad * 4 * M_PI / 200000));
-	check_light_sample(&l, x, "+ portals");
+	/* The receiver's normal weighs the portal triangles: sideways (one
+	 * window triangle behind x's horizon, at the floor weight, the others
+	 * at their cosines); tilted toward the window; and none. */
+	check_light_sample(&l, x, v3(1, 0, 0), "+ portals sideways");
+	check_light_sample(&l, x, v3_norm(v3(0.3f, -0.2f, 0.9f)), "+ portals");
+	check_light_sample(&l, x, v3(0, 0, 0), "+ portals, no n");
 	lit_free(&l);
 }
 
@@ -653,7 +658,7 @@ static void test_light_sample_env_portal_near(void **state)
 	float om0 = portal_env_solid_angle(&l.s->portals[0], x), om1 = portal_env_solid_angle(&l.s->portals[1], x);
 	printf("  solid angles from x: %.3f and %.3f sr\n", om0, om1);
 	assert_true(fmaxf(om0, om1) > 1.2f * AJAR_PI);
-	check_light_sample(&l, x, "+ near portal");
+	check_light_sample(&l, x, v3_norm(v3(-0.5f, 0.3f, 0.8f)), "+ near portal");
 	lit_free(&l);
 }
 

@@ -206,7 +206,7 @@ static MisStats check_scene_mis(HostScene *h, int nsamples)
 				PathVertex y;
 				const PathVertex *lp = l;
 				if (s == 1) { /* next-event estimation, as the kernel does it */
-					if (v3_is_zero(bdpt_nee(sc, z, &y, &rng)))
+					if (v3_is_zero(bdpt_nee(sc, z, &e[t - 2], &y, &rng)))
 						continue;
 					lp = &y;
 				}
@@ -238,7 +238,7 @@ static MisStats check_scene_mis(HostScene *h, int nsamples)
 				PathVertex y;
 				const PathVertex *lp = l;
 				if (s == 1) {
-					if (v3_is_zero(bdpt_nee(sc, z, &y, &rng)))
+					if (v3_is_zero(bdpt_nee(sc, z, &R[a - 1], &y, &rng)))
 						continue;
 					lp = &y;
 				}
