@@ -28,8 +28,9 @@ __kernel void render_pass(AJAR_SCENE_BUFFERS(AJAR_KERNEL_ARG) __global long *acc
 	long sum[3] = {0, 0, 0};
 	PathVertex light[SUBPATH_MAX], eye[SUBPATH_MAX], back[SUBPATH_MAX], fwd[SUBPATH_MAX];
 	for (uint i = 0; i < sample_count; i++) {
-		Rng rng = rng_init(params->seed, pixel, sample_first + i, 0u);
-		float jx = rng_f(&rng), jy = rng_f(&rng);
+		Rng rng = rng_init_pixel(params->seed, pixel, sample_first + i);
+		float jx, jy;
+		rng_pixel(&rng, &jx, &jy);
 		V3 L;
 		if (params->integrator != INTEGRATOR_PT) {
 			BdptFilm out = {splat, splat + 3 * (ulong)cam->width * cam->height, pixel,
@@ -42,9 +43,9 @@ __kernel void render_pass(AJAR_SCENE_BUFFERS(AJAR_KERNEL_ARG) __global long *acc
 		} else {
 			L = pt_radiance(&sc, cam->pos, camera_ray_dir(cam, x + jx, y + jy), &rng);
 		}
-		sum[0] += film_fixed(L.x, rng_f(&rng));
-		sum[1] += film_fixed(L.y, rng_f(&rng));
-		sum[2] += film_fixed(L.z, rng_f(&rng));
+		sum[0] += film_fixed(L.x, rng_pcg_f(&rng));
+		sum[1] += film_fixed(L.y, rng_pcg_f(&rng));
+		sum[2] += film_fixed(L.z, rng_pcg_f(&rng));
 	}
 	accum[3 * pixel + 0] += sum[0];
 	accum[3 * pixel + 1] += sum[1];

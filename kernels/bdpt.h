@@ -219,9 +219,9 @@ typedef struct {
 
 INLINE void film_add(GLOBAL long *film, uint pixel, V3 c, Rng *rng)
 {
-	atom_add(&film[3 * pixel + 0], film_fixed(c.x, rng_f(rng)));
-	atom_add(&film[3 * pixel + 1], film_fixed(c.y, rng_f(rng)));
-	atom_add(&film[3 * pixel + 2], film_fixed(c.z, rng_f(rng)));
+	atom_add(&film[3 * pixel + 0], film_fixed(c.x, rng_pcg_f(rng)));
+	atom_add(&film[3 * pixel + 1], film_fixed(c.y, rng_pcg_f(rng)));
+	atom_add(&film[3 * pixel + 2], film_fixed(c.z, rng_pcg_f(rng)));
 }
 
 /* Records the unweighted contribution c of a path of n segments with MIS
@@ -367,7 +367,8 @@ INLINE V3 bdpt_nee_bs(const SceneView *sc, const PathVertex *z, const PathVertex
 		      PathVertex *y, Rng *rng)
 {
 	LightSample ls;
-	float u0 = rng_f(rng), u1 = rng_f(rng), u2 = rng_f(rng), pdf_w;
+	float u0, u1, u2, pdf_w;
+	rng_nee3(rng, &u0, &u1, &u2);
 	V3 zero = v3(0.0f, 0.0f, 0.0f);
 	if (!light_sample(sc, z->p, vertex_nee_normal(z, from), u0, u1, u2, &ls) || v3_is_zero(ls.Le))
 		return zero;
@@ -435,7 +436,8 @@ INLINE void bdpt_sample(const SceneView *sc, float px, float py, PathVertex *l, 
 			Rng *rng)
 {
 	int depth = sc->params->max_depth;
-	int nl = bdpt_light_subpath(sc, l, depth, rng);
+	Rng lr = rng_fork(rng); /* the light subpath's own stream */
+	int nl = bdpt_light_subpath(sc, l, depth, &lr);
 	int ne = bdpt_eye_subpath(sc, px, py, e, depth + 1, rng);
 	bdpt_strategies(sc, l, nl, e, ne, out, rng);
 }

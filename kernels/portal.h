@@ -188,11 +188,14 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 				PathVertex *F, BdptFilm *out, Rng *rng)
 {
 	int depth = sc->params->max_depth;
-	int nl = sc->params->light_paths ? bdpt_light_subpath(sc, l, depth, rng) : 0;
+	/* The light and intermediate subpaths draw from streams of their
+	 * own, so the camera walk keeps the low-discrepancy numbers (rng.h). */
+	Rng lr = rng_fork(rng), ir = rng_fork(rng);
+	int nl = sc->params->light_paths ? bdpt_light_subpath(sc, l, depth, &lr) : 0;
 	int ne = bdpt_eye_subpath(sc, px, py, e, depth + 1, rng);
 	int nR = 0, nF = 0;
-	if (rng_f(rng) < sc->params->portal_rate)
-		portal_intermediate(sc, R, &nR, F, &nF, rng);
+	if (rng_pcg_f(&ir) < sc->params->portal_rate)
+		portal_intermediate(sc, R, &nR, F, &nF, &ir);
 	bdpt_strategies(sc, l, nl, e, ne, out, rng);
 
 	/* Eye-side ends, in chunks so any number of them is handled. */
@@ -241,7 +244,7 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 				} else if (z->type != VERTEX_SURFACE) {
 					break;
 				} else if (s == 1) {
-					lcon = bdpt_nee(sc, z, &R[a - 1], &y, rng);
+					lcon = bdpt_nee(sc, z, &R[a - 1], &y, &ir);
 					lp = &y;
 				} else {
 					V3 c = bdpt_connect(sc, &l[s - 1], z);

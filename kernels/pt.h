@@ -90,7 +90,8 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 		V3 n_nee = v3_dot(s.ns, wo) < 0.0f ? v3_neg(s.ns) : s.ns; /* as vertex_nee_normal */
 		if (!bsdf_is_delta(&bs) && depth + 2 >= prm->min_depth) {
 			LightSample ls;
-			float u0 = rng_f(rng), u1 = rng_f(rng), u2 = rng_f(rng);
+			float u0, u1, u2;
+			rng_nee3(rng, &u0, &u1, &u2);
 			if (light_sample(sc, s.p, n_nee, u0, u1, u2, &ls) && ls.pdf_w > 0.0f && !v3_is_zero(ls.Le)) {
 				float pdf_bsdf_w;
 				V3 f = bsdf_eval_fwd(&bs, wo, ls.wi, BSDF_RADIANCE, &pdf_bsdf_w);
@@ -109,7 +110,8 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 			}
 		}
 		BsdfSample bsm;
-		float u0 = rng_f(rng), u1 = rng_f(rng), u2 = rng_f(rng);
+		float u0, u1, u2;
+		rng_f3(rng, &u0, &u1, &u2);
 		if (!bsdf_sample(&bs, wo, u0, u1, u2, BSDF_RADIANCE, &bsm) || !(bsm.pdf_w > 0.0f))
 			break;
 		beta = v3_mul(beta, v3_scale(bsm.f, fabs(v3_dot(s.ns, bsm.wi)) / bsm.pdf_w));

@@ -153,7 +153,8 @@ INLINE int vertex_scatter(const SceneView *sc, PathVertex *path, int n, int ligh
 	if (v->type != VERTEX_SURFACE)
 		return 0;
 	vertex_bsdf(sc, v, &bs);
-	float u0 = rng_f(rng), u1 = rng_f(rng), u2 = rng_f(rng);
+	float u0, u1, u2;
+	rng_f3(rng, &u0, &u1, &u2);
 	if (!bsdf_sample(&bs, v->wo, u0, u1, u2, light_side ? BSDF_IMPORTANCE : BSDF_RADIANCE, &bsm) ||
 	    !(bsm.pdf_w > 0.0f))
 		return 0;

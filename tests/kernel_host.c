@@ -45,9 +45,11 @@ void host_render(HostScene *h, uint32_t spp, uint32_t seed, double *rgb, double 
 	prm->seed = seed;
 	for (uint32_t px = 0; px < npix; px++) {
 		for (uint32_t i = 0; i < spp; i++) {
-			Rng rng = rng_init(seed, px, i, 0u);
-			float x = (float)(px % (uint32_t)cam->width) + rng_f(&rng);
-			float y = (float)(px / (uint32_t)cam->width) + rng_f(&rng);
+			Rng rng = rng_init_pixel(seed, px, i);
+			float jx, jy;
+			rng_pixel(&rng, &jx, &jy);
+			float x = (float)(px % (uint32_t)cam->width) + jx;
+			float y = (float)(px / (uint32_t)cam->width) + jy;
 			V3 L;
 			if (prm->integrator != INTEGRATOR_PT) {
 				BdptFilm out = {film, film + 3 * (size_t)npix, px, v3(0, 0, 0)};

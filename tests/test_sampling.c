@@ -7,7 +7,8 @@
  * polynomial log, exp, atan2 and sin/cos of kernels/fastmath.h against
  * double precision over the ranges they promise; Russian roulette
  * (kernels/roulette.h) for its survival probability and an unchanged
- * expected throughput. */
+ * expected throughput; the low-discrepancy numbers of kernels/qmc.h and
+ * rng.h for their net structure, uniformity and independence. */
 #include "testutil.h"
 
 #include <float.h>
@@ -22,7 +23,7 @@
 #include "../kernels/sampling.h"
 
 #define N_SAMPLES 1000000
-#define N_TESTS 10 /* chi-square tests in this file, for the Sidak correction */
+#define N_TESTS 13 /* chi-square tests in this file, for the Sidak correction */
 #define ALPHA_TOTAL 1e-3
 
 static double alpha_each(void) { return 1.0 - pow(1.0 - ALPHA_TOTAL, 1.0 / N_TESTS); }
@@ -389,6 +390,126 @@ static void test_roulette(void **state)
 	}
 }
 
+/* Whether points[0, 2^k) form a (0,k,2)-net: one point in every cell of
+ * each 2^a x 2^(k-a) grid. */
+static int is_net(const float *x, const float *y, int k)
+{
+	int n = 1 << k;
+	static unsigned char seen[1 << 12];
+	for (int a = 0; a <= k; a++) {
+		memset(seen, 0, (size_t)n);
+		for (int i = 0; i < n; i++) {
+			int cx = (int)(x[i] * (float)(1 << a)), cy = (int)(y[i] * (float)(1 << (k - a)));
+			int c = (cx << (k - a)) | cy;
+			if (seen[c]++)
+				return 0;
+		}
+	}
+	return 1;
+}
+
+/* Every pair of every pixel: the first 2^k samples form a (0,k,2)-net
+ * (the shuffle keeps them together), for k up to 12; the first 2^k of
+ * a later block too. */
+static void test_qmc_nets(void **state)
+{
+	(void)state;
+	static float x[1 << 12], y[1 << 12];
+	for (uint seed = 1; seed < 40; seed += 7)
+		for (uint pair = 0; pair < 20; pair += 3)
+			for (int k = 1; k <= 12; k += 1 + (k > 4)) {
+				for (int i = 0; i < (1 << k); i++)
+					qmc_pair((uint)i, pair, seed * 2654435761u, &x[i], &y[i]);
+				if (!is_net(x, y, k))
+					fail_msg("seed %u pair %u: the first %d samples are not a (0,%d,2)-net", seed, pair, 1 << k, k);
+				for (int i = 0; i < (1 << k); i++) {
+					assert_true(x[i] >= 0.0f && x[i] < 1.0f && y[i] >= 0.0f && y[i] < 1.0f);
+					assert_true(x[i] == qmc_f((uint)i, 2 * pair, seed * 2654435761u));
+					assert_true(y[i] == qmc_f((uint)i, 2 * pair + 1, seed * 2654435761u));
+				}
+			}
+	/* Samples 3 * 2^8 .. 4 * 2^8 - 1: an aligned block is a net too. */
+	for (int i = 0; i < 256; i++)
+		qmc_pair((uint)(768 + i), 5, 12345u, &x[i], &y[i]);
+	assert_true(is_net(x, y, 8));
+}
+
+/* One sample index, many pixels: each point of a pair is uniform on the
+ * square (Owen scrambling), for the first sample and a later one. And
+ * two pairs of the same pixel and sample are independent: without the
+ * shuffle their coordinates would be tied by the common index. */
+static void test_qmc_uniform(void **state)
+{
+	(void)state;
+	enum { NP = 32 };
+	static double obs[NP * NP], expct[NP * NP];
+	const int n = N_SAMPLES / 4;
+	for (int c = 0; c < NP * NP; c++)
+		expct[c] = (double)n / (NP * NP);
+	const uint index[2] = {0u, 37u};
+	for (int t = 0; t < 2; t++) {
+		memset(obs, 0, sizeof(obs));
+		for (int p = 0; p < n; p++) {
+			Rng r = rng_init_pixel(3, (uint)p, index[t]);
+			float u, v;
+			rng_pixel(&r, &u, &v);
+			obs[(int)(u * NP) * NP + (int)(v * NP)] += 1;
+		}
+		check_chi2(t ? "qmc pixel pair, sample 37" : "qmc pixel pair, sample 0", obs, expct, NP * NP);
+	}
+	/* Within one pixel: x of pair 0 against x of pair 1 over the samples. */
+	memset(obs, 0, sizeof(obs));
+	for (int p = 0; p < n / 1024; p++)
+		for (uint i = 0; i < 1024; i++) {
+			float a = qmc_f(i, 0, (uint)p * 747796405u + 1u), b = qmc_f(i, 2, (uint)p * 747796405u + 1u);
+			obs[(int)(a * NP) * NP + (int)(b * NP)] += 1;
+		}
+	for (int c = 0; c < NP * NP; c++)
+		expct[c] = (double)(n / 1024 * 1024) / (NP * NP);
+	check_chi2("qmc pairs independent", obs, expct, NP * NP);
+}
+
+/* The sequences' bookkeeping: the pixel pair and the scattering pairs of
+ * the main sequence, the next-event sequence beside it, PCG once each is
+ * used up, and streams without low-discrepancy numbers unchanged. */
+static void test_rng_sequences(void **state)
+{
+	(void)state;
+	Rng r = rng_init_pixel(9, 77, 5), pcg = rng_init(9, 77, 5, 0);
+	uint seed = r.qmc_seed;
+	float u0, u1, u2, jx, jy;
+	rng_pixel(&r, &jx, &jy);
+	assert_true(jx == qmc_f(5, 0, seed) && jy == qmc_f(5, 1, seed));
+	rng_nee3(&r, &u0, &u1, &u2);
+	assert_true(u1 == qmc_f(5, RNG_QMC_DIMS, seed) && u2 == qmc_f(5, RNG_QMC_DIMS + 1, seed));
+	assert_true(u0 == qmc_f(5, RNG_QMC_DIMS + 2, seed));
+	rng_f3(&r, &u0, &u1, &u2);
+	assert_true(u1 == qmc_f(5, 2, seed) && u2 == qmc_f(5, 3, seed));
+	/* The lobe, and rng_f, are PCG: the same numbers as the plain stream. */
+	assert_true(u0 == rng_pcg_f(&pcg));
+	assert_true(rng_f(&r) == rng_pcg_f(&pcg));
+	/* Used up: both sequences go on with PCG. */
+	while (r.dim + 2u <= RNG_QMC_DIMS)
+		rng_f3(&r, &u0, &u1, &u2);
+	while (r.nee_dim + 2u <= RNG_QMC_DIMS)
+		rng_nee3(&r, &u0, &u1, &u2);
+	Rng copy = r;
+	rng_f3(&r, &u0, &u1, &u2);
+	assert_true(u0 == rng_pcg_f(&copy) && u1 == rng_pcg_f(&copy) && u2 == rng_pcg_f(&copy));
+	rng_nee3(&r, &u0, &u1, &u2);
+	assert_true(u0 == rng_pcg_f(&copy) && u1 == rng_pcg_f(&copy) && u2 == rng_pcg_f(&copy));
+	/* A stream from rng_init has no low-discrepancy part. */
+	Rng a = rng_init(1, 2, 3, 4), b = rng_init(1, 2, 3, 4);
+	rng_f3(&a, &u0, &u1, &u2);
+	assert_true(u0 == rng_pcg_f(&b) && u1 == rng_pcg_f(&b) && u2 == rng_pcg_f(&b));
+	/* Forks are PCG streams of their own, repeatable. */
+	Rng f1 = rng_init_pixel(9, 77, 5), f2 = rng_init_pixel(9, 77, 5);
+	Rng g1 = rng_fork(&f1), g2 = rng_fork(&f2);
+	assert_int_equal(g1.dim, RNG_QMC_DIMS);
+	for (int i = 0; i < 16; i++)
+		assert_int_equal(rng_u32(&g1), rng_u32(&g2));
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -397,6 +518,8 @@ int main(void)
 		cmocka_unit_test(test_triangle),          cmocka_unit_test(test_cdf),
 		cmocka_unit_test(test_rng_deterministic), cmocka_unit_test(test_rng_uniform),
 		cmocka_unit_test(test_fast_math),         cmocka_unit_test(test_roulette),
+		cmocka_unit_test(test_qmc_nets),          cmocka_unit_test(test_qmc_uniform),
+		cmocka_unit_test(test_rng_sequences),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
