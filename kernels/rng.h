@@ -22,8 +22,9 @@
 #include "qmc.h"
 
 /* Low-discrepancy numbers per sequence: in the main one the pixel
- * position and five scattering directions, in the next-event one four
- * light samples (a pair for the point or direction, one for the choice). */
+ * position and five scattering directions, in the next-event one three
+ * light samples (a pair for the point or direction, and the first number
+ * of another for the choice of light). */
 #define RNG_QMC_DIMS 12u
 
 typedef struct {
