@@ -9,6 +9,11 @@ camera is `perspective` with the vertical field of view, the film `hdrfilm`
 with the 1-pixel box filter. max_depth D counts segments from the camera,
 as Ajar's --max-depth does. Russian roulette is Mitsuba's default (unbiased).
 
+Sampler: `independent` (Mitsuba's default), or with --integrator ld
+(renderer name mitsuba-ld) `ldsampler`, Mitsuba's low-discrepancy sampler
+(padded, scrambled (0,2)-sequences, as Ajar's), in passes of a power of two
+samples per pixel so each pass is a whole net.
+
 Equal time: the image is rendered in passes of a few samples per pixel
 with different seeds and averaged; passes run until the time is used up (the
 last pass may overshoot; the real time is reported). One warm-up pass,
@@ -61,7 +66,7 @@ def build(mi, scene, a, tmp):
 		"near_clip": 1e-3, "far_clip": 1e5,
 		"film": {"type": "hdrfilm", "width": a.width, "height": a.height, "rfilter": {"type": "box"},
 			 "pixel_format": "rgb", "sample_border": False},
-		"sampler": {"type": "independent", "sample_count": 1},
+		"sampler": {"type": "ldsampler" if a.integrator == "ld" else "independent", "sample_count": 1},
 	}
 	for mi_index, (v, f) in scene.by_material().items():
 		m = scene.materials[mi_index]
@@ -90,6 +95,8 @@ def render(scene, a, t0):
 		sc = build(mi, scene, a, tmp)
 	# Passes small enough for the wavefront to stay in memory (about 1M lanes).
 	per_pass = max(1, min(256, (1 << 20) // (a.width * a.height)))
+	if a.integrator == "ld":
+		per_pass = 1 << (per_pass.bit_length() - 1)
 	if variant.startswith("scalar"):
 		per_pass = max(1, min(per_pass, 16))
 	if a.spp:

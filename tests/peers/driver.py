@@ -13,7 +13,7 @@ Environment: PEERS_SECONDS (20), PEERS_SCENES ("window-room living-room
 door-ajar"; cornell also works), PEERS_SIZE (image width, height from the
 camera's aspect ratio, or WxH; 128), PEERS_REF_SECONDS (each reference half;
 300), PEERS_DEPTH (32), PEERS_THREADS (all cores), PEERS_RENDERERS (default
-all: ajar-pt ajar-bdpt ajar-portal mitsuba cycles cycles-noportal
+all: ajar-pt ajar-bdpt ajar-portal mitsuba mitsuba-ld cycles cycles-noportal
 luxcore-path luxcore-bidir), PEERS_REF_<SCENE> (reference renderer for a
 scene, e.g. PEERS_REF_DOOR_AJAR=mitsuba).
 """
@@ -35,7 +35,8 @@ from scene import Scene, image_size, write_lambert_variant  # noqa: E402
 
 OUT = os.path.join(ROOT, "build", "peers")
 AJAR = os.path.join(ROOT, "build", "release", "ajar")
-ALL = ["ajar-pt", "ajar-bdpt", "ajar-portal", "mitsuba", "cycles", "cycles-noportal", "luxcore-path", "luxcore-bidir"]
+ALL = ["ajar-pt", "ajar-bdpt", "ajar-portal", "mitsuba", "mitsuba-ld", "cycles", "cycles-noportal", "luxcore-path",
+       "luxcore-bidir"]
 # Fastest to converge, measured on this machine (see the README of tests/peers).
 DEFAULT_REF = {"window-room": "mitsuba", "living-room": "mitsuba", "door-ajar": "mitsuba", "cornell": "mitsuba"}
 
