@@ -66,7 +66,7 @@ def build(mi, scene, a, tmp):
 		"near_clip": 1e-3, "far_clip": 1e5,
 		"film": {"type": "hdrfilm", "width": a.width, "height": a.height, "rfilter": {"type": "box"},
 			 "pixel_format": "rgb", "sample_border": False},
-		"sampler": {"type": "ldsampler" if a.integrator == "ld" else "independent", "sample_count": 1},
+		"sampler": {"type": "ldsampler", "sample_count": 4} if a.integrator == "ld" else {"type": "independent", "sample_count": 1},
 	}
 	for mi_index, (v, f) in scene.by_material().items():
 		m = scene.materials[mi_index]
