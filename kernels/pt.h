@@ -4,11 +4,11 @@
  * Next-event estimation to emitters and the environment, combined with BSDF
  * sampling by the power heuristic; Russian roulette (roulette.h) from vertex
  * rr_depth on scales only the throughput, so it enters neither strategy's
- * density and the MIS weights stay consistent (design.md, Pitfalls). max_depth counts
- * path segments, camera segment included (Mitsuba's max_depth); paths of
- * fewer than min_depth segments are left out, so max_depth = min_depth = k
- * gives the image of paths of exactly k segments, which each bidirectional
- * strategy must reproduce. With Params.cross_filter (a test mode) each
+ * density and the MIS weights stay consistent (design.md, Pitfalls).
+ * max_depth counts path segments, camera segment included (Mitsuba's
+ * max_depth); paths of fewer than min_depth segments are left out, so
+ * max_depth = min_depth = k gives the image of paths of exactly k segments,
+ * which each bidirectional strategy must reproduce. With Params.cross_filter (a test mode) each
  * path counts as many times as it crosses portals on the edges that one
  * group of intermediate-subpath strategies can sample (pt_cross_weight):
  * the image those strategies must reproduce. */

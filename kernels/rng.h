@@ -10,7 +10,7 @@
  * A pixel sample (rng_init_pixel) also draws low-discrepancy numbers
  * (qmc.h), indexed by the sample's number within its pixel, for the
  * decisions that matter most, in two sequences so the order in which an
- * integrator makes its decisions does not matter: the main one (rng_f,
+ * integrator makes its decisions does not matter: the main one (rng_pixel,
  * rng_f3: the pixel position, then the camera walk's scattering) and the
  * next-event one (rng_nee3: light samples along the camera walk), each for
  * its first RNG_QMC_DIMS numbers. Everything else (light subpaths and
