@@ -87,7 +87,9 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 			break;
 		Bsdf bs;
 		bsdf_setup(&bs, &sc->materials[s.material], surface_base_color(sc, &s), s.ns, s.ng);
-		V3 n_nee = v3_dot(s.ns, wo) < 0.0f ? v3_neg(s.ns) : s.ns; /* as vertex_nee_normal */
+		/* The normal next-event samples are weighed by (env_portal.h): turned
+		 * toward wo here; pt's two densities at a vertex both read n_nee. */
+		V3 n_nee = v3_dot(s.ns, wo) < 0.0f ? v3_neg(s.ns) : s.ns;
 		if (!bsdf_is_delta(&bs) && depth + 2 >= prm->min_depth) {
 			LightSample ls;
 			float u0, u1, u2;

@@ -297,18 +297,17 @@ static ajar_status collapse(const BinNode *bn, uint32_t nbin, Bvh *out)
 	/* Pending (binary node, wide id) pairs: at most 3 per wide level plus
 	 * one; BVH_MAX_DEPTH bounds the levels. */
 	struct {
-		uint32_t bin, wide;
+		uint32_t bin, wide, depth;
 	} stack[3 * BVH_MAX_DEPTH + 4];
 	int sp = 0;
 	uint32_t nwide = 1;
 	out->wide_depth = 1;
-	uint32_t depth_of[3 * BVH_MAX_DEPTH + 4];
 	stack[sp].bin = 0;
 	stack[sp].wide = 0;
-	depth_of[sp++] = 1;
+	stack[sp++].depth = 1;
 	while (sp > 0) {
 		sp--;
-		uint32_t i = stack[sp].bin, id = stack[sp].wide, depth = depth_of[sp];
+		uint32_t i = stack[sp].bin, id = stack[sp].wide, depth = stack[sp].depth;
 		if (depth > out->wide_depth)
 			out->wide_depth = depth;
 		Slots s;
@@ -332,7 +331,7 @@ static ajar_status collapse(const BinNode *bn, uint32_t nbin, Bvh *out)
 				wide_set_slot(w, k, &c->b, (int)nwide);
 				stack[sp].bin = s.bin[k];
 				stack[sp].wide = nwide++;
-				depth_of[sp++] = depth + 1;
+				stack[sp++].depth = depth + 1;
 			}
 		}
 	}
