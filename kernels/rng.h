@@ -110,14 +110,21 @@ INLINE void rng_pair(Rng *r, uint *dim, uint base, float *u1, float *u2)
 /* The position within the pixel: the main sequence's first pair. */
 INLINE void rng_pixel(Rng *r, float *jx, float *jy) { rng_pair(r, &r->dim, 0u, jx, jy); }
 
+/* Three PCG numbers in the order of the arguments: a decision whose
+ * sequence is used up draws them as streams without one always did. */
+INLINE void rng_pcg3(Rng *r, float *u0, float *u1, float *u2)
+{
+	*u0 = rng_pcg_f(r);
+	*u1 = rng_pcg_f(r);
+	*u2 = rng_pcg_f(r);
+}
+
 /* A scattering decision: *u0 picks the lobe (PCG), *u1 and *u2 the
  * direction (the main sequence's next pair). */
 INLINE void rng_f3(Rng *r, float *u0, float *u1, float *u2)
 {
-	if (r->dim + 2u > RNG_QMC_DIMS) { /* PCG alone: in the order of the arguments */
-		*u0 = rng_pcg_f(r);
-		*u1 = rng_pcg_f(r);
-		*u2 = rng_pcg_f(r);
+	if (r->dim + 2u > RNG_QMC_DIMS) {
+		rng_pcg3(r, u0, u1, u2);
 		return;
 	}
 	rng_pair(r, &r->dim, 0u, u1, u2);
@@ -130,9 +137,7 @@ INLINE void rng_f3(Rng *r, float *u0, float *u1, float *u2)
 INLINE void rng_nee3(Rng *r, float *u0, float *u1, float *u2)
 {
 	if (r->nee_dim + 2u > RNG_QMC_DIMS) {
-		*u0 = rng_pcg_f(r);
-		*u1 = rng_pcg_f(r);
-		*u2 = rng_pcg_f(r);
+		rng_pcg3(r, u0, u1, u2);
 		return;
 	}
 	rng_pair(r, &r->nee_dim, RNG_QMC_DIMS, u1, u2);
