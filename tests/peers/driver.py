@@ -20,6 +20,7 @@ scene, e.g. PEERS_REF_DOOR_AJAR=mitsuba).
 import hashlib
 import json
 import os
+import resource
 import subprocess
 import sys
 import time
@@ -55,8 +56,34 @@ def sub_env():
 	if "DRJIT_LIBLLVM_PATH" not in e and os.path.exists(llvm):
 		e["DRJIT_LIBLLVM_PATH"] = llvm
 	if "PEERS_THREADS" in os.environ:
+		# PoCL 3.x's CPU device (Debian 12) reads POCL_MAX_PTHREAD_COUNT and
+		# ignores POCL_CPU_MAX_CU_NUM, which only PoCL 4 and later read.
+		e["POCL_MAX_PTHREAD_COUNT"] = str(env_threads())
 		e["POCL_CPU_MAX_CU_NUM"] = str(env_threads())
 	return e
+
+
+def pin_cpus():
+	"""Runs in each renderer's child process before it starts: with
+	PEERS_THREADS set, binds it to that many of this process's CPUs. The
+	renderers' own thread settings are not enough: Cycles keeps two cores
+	busy when bpy is told one thread."""
+	if "PEERS_THREADS" in os.environ and hasattr(os, "sched_setaffinity"):
+		cpus = sorted(os.sched_getaffinity(0))
+		os.sched_setaffinity(0, cpus[:max(1, env_threads())])
+
+
+def run_timed(cmd, **kw):
+	"""subprocess.run, plus the cores the child kept busy on average: its
+	CPU time (user + system) over the wall time. The table reports it, so a
+	renderer that ignores PEERS_THREADS shows up instead of winning quietly."""
+	before = resource.getrusage(resource.RUSAGE_CHILDREN)
+	t = time.perf_counter()
+	r = subprocess.run(cmd, preexec_fn=pin_cpus, **kw)
+	wall = time.perf_counter() - t
+	after = resource.getrusage(resource.RUSAGE_CHILDREN)
+	cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+	return r, wall, cpu
 
 
 def ensure_ajar():
@@ -82,9 +109,7 @@ def run_ajar(integrator, path, size, depth, out, seconds=0.0, spp=0, seed=7):
 	if spp:
 		cmd += ["--spp", str(spp)]
 	for attempt in range(4):
-		t = time.perf_counter()
-		r = subprocess.run(cmd, cwd=ROOT, env=sub_env(), capture_output=True, text=True)
-		wall = time.perf_counter() - t
+		r, wall, cpu = run_timed(cmd, cwd=ROOT, env=sub_env(), capture_output=True, text=True)
 		if r.returncode == 0:
 			break
 		# Exit 3 (device: a kernel that does not build while the lead edits it) is retried.
@@ -96,7 +121,7 @@ def run_ajar(integrator, path, size, depth, out, seconds=0.0, spp=0, seed=7):
 		return None, None
 	rgb, meta = images.read_exr(out)
 	return rgb, {"spp": int(meta.get("ajar:spp", 0)), "render_seconds": float(meta.get("ajar:render_seconds", wall)),
-		     "setup_seconds": round(wall - float(meta.get("ajar:render_seconds", wall)), 3)}
+		     "setup_seconds": round(wall - float(meta.get("ajar:render_seconds", wall)), 3), "cores": cpu / wall}
 
 
 def run_peer(renderer, path, size, depth, out_base, seconds=0.0, spp=0, seed=7):
@@ -118,7 +143,7 @@ def run_peer(renderer, path, size, depth, out_base, seconds=0.0, spp=0, seed=7):
 			env["LD_PRELOAD"] = pre[0]
 	limit = 600 + 4 * (seconds or 0)
 	try:
-		r = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True, timeout=limit)
+		r, wall, cpu = run_timed(cmd, cwd=ROOT, env=env, capture_output=True, text=True, timeout=limit)
 	except subprocess.TimeoutExpired:
 		log(f"peers: {renderer} timed out after {limit:.0f} s")
 		return None, None
@@ -133,6 +158,7 @@ def run_peer(renderer, path, size, depth, out_base, seconds=0.0, spp=0, seed=7):
 	rgb = np.load(npy).astype(np.float64)
 	images.write_exr(out_base + ".exr", rgb)
 	os.remove(npy)
+	info["cores"] = cpu / wall
 	return rgb, info
 
 
@@ -231,13 +257,17 @@ def bench_scene(name, seconds, size_spec, depth, ref_seconds, renderers, rows):
 		se = float(np.sqrt(np.mean(d * d) / d.size)) / mean
 		dev = m / mean - 1
 		ok = abs(dev) <= 4 * se + 0.003
-		row = {"scene": name, "renderer": r, "spp": info["spp"], "seconds": t,
+		cores = info.get("cores", float("nan"))
+		# A renderer busier than PEERS_THREADS allows had more of the machine than the others.
+		fair = "PEERS_THREADS" not in os.environ or not cores > 1.15 * env_threads() + 0.1
+		row = {"scene": name, "renderer": r, "spp": info["spp"], "seconds": t, "cores": cores, "fair": fair,
 		       "setup": info.get("setup_seconds", 0.0), "mean": m, "dev": dev, "se": se, "ok": ok,
 		       "relmse": e_t, "ref": rinfo["renderer"], "note": info.get("variant", "")}
 		rows.append(row)
 		res[r] = row
-		log(f"  {r:16s} {info['spp']:7d} spp {t:6.1f} s  mean {m:.5f} ({100 * dev:+.2f}% +- {100 * se:.2f}%,"
-		    f" {'ok' if ok else 'MISMATCH'})  relMSE at {seconds:g} s {e_t:.3e}")
+		log(f"  {r:16s} {info['spp']:7d} spp {t:6.1f} s {cores:4.2f} cores{'' if fair else ' (TOO MANY)'}  "
+		    f"mean {m:.5f} ({100 * dev:+.2f}% +- {100 * se:.2f}%, {'ok' if ok else 'MISMATCH'})  "
+		    f"relMSE at {seconds:g} s {e_t:.3e}")
 		images.write_png(os.path.join(OUT, f"{name}-{r}.png"), img, exposure)
 		tiles.append(img)
 		labels.append(r)
@@ -258,14 +288,16 @@ def table(rows, seconds, size_spec, depth, refs):
 	for name, ri in refs.items():
 		out.append(f"- {name}: reference by {ri['renderer']}, {ri['spp'][0]} + {ri['spp'][1]} spp in "
 			   f"{ri['seconds'][0]:.0f} + {ri['seconds'][1]:.0f} s")
-	out += ["", "| scene | renderer | spp | render s | mean vs reference | relMSE at T | ratio vs ajar-portal |",
-		"|---|---|---|---|---|---|---|"]
+	out += ["", "cores = the renderer process's CPU time over its wall time (set-up included).", "",
+		"| scene | renderer | spp | render s | cores | mean vs reference | relMSE at T | ratio vs ajar-portal |",
+		"|---|---|---|---|---|---|---|---|"]
 	for r in rows:
 		if r.get("failed"):
-			out.append(f"| {r['scene']} | {r['renderer']} | failed | | | | |")
+			out.append(f"| {r['scene']} | {r['renderer']} | failed | | | | | |")
 			continue
 		check = f"{100 * r['dev']:+.2f}% ± {100 * r['se']:.2f}% {'ok' if r['ok'] else '**MISMATCH**'}"
-		out.append(f"| {r['scene']} | {r['renderer']} | {r['spp']} | {r['seconds']:.1f} | {check} | "
+		cores = f"{r['cores']:.2f}" + ("" if r["fair"] else " **too many**")
+		out.append(f"| {r['scene']} | {r['renderer']} | {r['spp']} | {r['seconds']:.1f} | {cores} | {check} | "
 			   f"{r['relmse']:.3e} | {r.get('ratio', float('nan')):.2f} |")
 	return "\n".join(out) + "\n"
 
@@ -288,7 +320,7 @@ def main():
 		f.write(md)
 	log("\n" + md)
 	log(f"peers: images, montages and results.md in {os.path.relpath(OUT, ROOT)}/")
-	return 1 if any(r.get("failed") or not r.get("ok", True) for r in rows) else 0
+	return 1 if any(r.get("failed") or not r.get("ok", True) or not r.get("fair", True) for r in rows) else 0
 
 
 if __name__ == "__main__":
