@@ -54,7 +54,7 @@ INLINE RayPre ray_pre(V3 o, V3 d)
 
 /* Watertight ray/triangle test. On a hit with 0 < t < tmax writes t and
  * the barycentrics of p1 (u) and p2 (v) and returns 1. */
-INLINE int tri_intersect(const RayPre *r, GLOBAL const Tri *tri, float tmax, float *t, float *u,
+HOT_INLINE int tri_intersect(const RayPre *r, GLOBAL const Tri *tri, float tmax, float *t, float *u,
 			 float *v)
 {
 	V3 a = v3_sub(tri->p0, r->o), b = v3_sub(tri->p1, r->o), c = v3_sub(tri->p2, r->o);
@@ -90,7 +90,7 @@ INLINE int tri_intersect(const RayPre *r, GLOBAL const Tri *tri, float tmax, flo
  * plane of a slab the ray runs parallel to) leaves the interval alone: the
  * ray is then inside that slab (pbrt's Bounds3::IntersectP). The far
  * distance grows by 1 + 2 gamma(3) against rounding (Ize 2013). */
-INLINE void box_slab(float lo, float hi, float o, float inv_d, float *tn, float *tf)
+HOT_INLINE void box_slab(float lo, float hi, float o, float inv_d, float *tn, float *tf)
 {
 	float a = (lo - o) * inv_d, b = (hi - o) * inv_d;
 	if (a > b) {
@@ -115,7 +115,7 @@ INLINE void box_slab(float lo, float hi, float o, float inv_d, float *tn, float 
  * side by side. An unused slot's box at +inf is never entered by a ray with
  * finite origin and direction (bvh_traverse refuses any other) within a
  * finite tlim. */
-INLINE int bvh_node_enter(const RayPre *r, GLOBAL const BvhNode *n, float tlim, float tn[4])
+HOT_INLINE int bvh_node_enter(const RayPre *r, GLOBAL const BvhNode *n, float tlim, float tn[4])
 {
 	float tf[4];
 	for (int i = 0; i < 4; i++) {
@@ -129,7 +129,7 @@ INLINE int bvh_node_enter(const RayPre *r, GLOBAL const BvhNode *n, float tlim, 
 }
 
 /* Index of the lowest set bit of a nonzero 4-bit mask. */
-INLINE int bvh_lowest(int m) { return (m & 1) ? 0 : (m & 2) ? 1 : (m & 4) ? 2 : 3; }
+HOT_INLINE int bvh_lowest(int m) { return (m & 1) ? 0 : (m & 2) ? 1 : (m & 4) ? 2 : 3; }
 
 INLINE int v3_finite(V3 a)
 {

@@ -12,6 +12,7 @@
 #define GLOBAL __global
 #define INLINE inline
 #define STATIC_INLINE static inline
+#define HOT_INLINE inline __attribute__((always_inline))
 #define u2f(u) as_float(u)
 #define f2u(f) as_uint(f)
 #else
@@ -23,6 +24,7 @@ typedef unsigned long ulong;
 #define GLOBAL
 #define INLINE static inline
 #define STATIC_INLINE static inline
+#define HOT_INLINE static inline __attribute__((always_inline))
 static inline float u2f(uint u) { float f; memcpy(&f, &u, 4); return f; }
 static inline uint f2u(float f) { uint u; memcpy(&u, &f, 4); return u; }
 static inline int max(int a, int b) { return a > b ? a : b; }
