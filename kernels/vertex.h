@@ -41,11 +41,16 @@ typedef struct {
 	int cross;    /* portal integrator: portal crossings of the edge to the previous vertex of this subpath */
 	V3 w0;        /* an intermediate subpath's first vertices: the portal point it started from */
 	int w0_tri;   /* and the portal triangle it lies on */
+	Bsdf bs;      /* VERTEX_SURFACE hits: the BSDF, set up once by vertex_trace */
 } PathVertex;
 
+/* The BSDF of a surface vertex that vertex_trace made. Connections and MIS
+ * densities ask for it many times per vertex (door-ajar's portal integrator
+ * spent 17% of its time rebuilding frames), so it is kept, not rebuilt. */
 INLINE void vertex_bsdf(const SceneView *sc, const PathVertex *v, Bsdf *bs)
 {
-	bsdf_setup(bs, &sc->materials[v->material], v->base, v->ns, v->ng);
+	(void)sc;
+	*bs = v->bs;
 }
 
 /* Area density at `to` of a direction sampled at `from` with solid-angle
@@ -127,6 +132,7 @@ INLINE int vertex_trace(const SceneView *sc, PathVertex *path, int n, V3 o, V3 d
 	v->base = surface_base_color(sc, &s);
 	v->material = s.material;
 	v->tri = s.tri;
+	bsdf_setup(&v->bs, &sc->materials[s.material], v->base, v->ns, v->ng);
 	float pa = parallel ? pdf_w * fabs(v3_dot(s.ng, d)) : vertex_density_a(prev, v, pdf_w);
 	if (light_side)
 		v->pf = pa;
