@@ -282,7 +282,7 @@ def bench_scene(name, seconds, size_spec, depth, ref_seconds, renderers, rows):
 
 def table(rows, seconds, size_spec, depth, refs):
 	out = [f"Equal time {seconds:g} s per render, image width {size_spec}, max depth {depth}, "
-	       f"{env_threads()} threads each. relMSE is tests/bench.c's (mean over pixels and channels of "
+	       f"{env_threads()} thread{'' if env_threads() == 1 else 's'} each. relMSE is tests/bench.c's (mean over pixels and channels of "
 	       "(x - r)^2 / (r^2 + (0.1 mean r)^2)), minus the reference's own noise, times t/T. "
 	       "ratio = relMSE / relMSE of ajar-portal (above 1: Ajar's portal integrator is better).", ""]
 	for name, ri in refs.items():
