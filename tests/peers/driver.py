@@ -262,7 +262,8 @@ def bench_scene(name, seconds, size_spec, depth, ref_seconds, renderers, rows):
 		fair = "PEERS_THREADS" not in os.environ or not cores > 1.15 * env_threads() + 0.1
 		row = {"scene": name, "renderer": r, "spp": info["spp"], "seconds": t, "cores": cores, "fair": fair,
 		       "setup": info.get("setup_seconds", 0.0), "mean": m, "dev": dev, "se": se, "ok": ok,
-		       "relmse": e_t, "ref": rinfo["renderer"], "note": info.get("variant", "")}
+		       "relmse": e_t, "var_spp": e * info["spp"], "rate": info["spp"] / t if t > 0 else float("nan"),
+		       "ref": rinfo["renderer"], "note": info.get("variant", "")}
 		rows.append(row)
 		res[r] = row
 		log(f"  {r:16s} {info['spp']:7d} spp {t:6.1f} s {cores:4.2f} cores{'' if fair else ' (TOO MANY)'}  "
@@ -288,17 +289,20 @@ def table(rows, seconds, size_spec, depth, refs):
 	for name, ri in refs.items():
 		out.append(f"- {name}: reference by {ri['renderer']}, {ri['spp'][0]} + {ri['spp'][1]} spp in "
 			   f"{ri['seconds'][0]:.0f} + {ri['seconds'][1]:.0f} s")
-	out += ["", "cores = the renderer process's CPU time over its wall time (set-up included).", "",
-		"| scene | renderer | spp | render s | cores | mean vs reference | relMSE at T | ratio vs ajar-portal |",
-		"|---|---|---|---|---|---|---|---|"]
+	out += ["", "cores = the renderer process's CPU time over its wall time (set-up included). "
+		"relMSE x spp = variance per sample, spp/s = samples per pixel per second: relMSE at T is their "
+		"ratio over T, so the two say whether a renderer wins per sample or per second.", "",
+		"| scene | renderer | spp | render s | cores | mean vs reference | relMSE at T | relMSE x spp | spp/s "
+		"| ratio vs ajar-portal |",
+		"|---|---|---|---|---|---|---|---|---|---|"]
 	for r in rows:
 		if r.get("failed"):
-			out.append(f"| {r['scene']} | {r['renderer']} | failed | | | | | |")
+			out.append(f"| {r['scene']} | {r['renderer']} | failed | | | | | | | |")
 			continue
 		check = f"{100 * r['dev']:+.2f}% ± {100 * r['se']:.2f}% {'ok' if r['ok'] else '**MISMATCH**'}"
 		cores = f"{r['cores']:.2f}" + ("" if r["fair"] else " **too many**")
 		out.append(f"| {r['scene']} | {r['renderer']} | {r['spp']} | {r['seconds']:.1f} | {cores} | {check} | "
-			   f"{r['relmse']:.3e} | {r.get('ratio', float('nan')):.2f} |")
+			   f"{r['relmse']:.3e} | {r['var_spp']:.3g} | {r['rate']:.1f} | {r.get('ratio', float('nan')):.2f} |")
 	return "\n".join(out) + "\n"
 
 
