@@ -3,7 +3,7 @@
  *
  * Triangles are tested with the watertight algorithm of Woop, Benthin and
  * Wald (JCGT 2013), two-sided, so a ray through a shared edge or vertex
- * cannot slip between neighbours. Traversal of the four-wide tree is
+ * cannot slip between neighbours. Traversal of the eight-wide tree is
  * iterative with a fixed stack (the builder bounds its depth, src/bvh.c),
  * visits children nearest first, and widens box exits by 2 gamma(3) so the
  * box test never rejects a triangle hit the exact test accepts (Ize 2013,
@@ -12,7 +12,7 @@
 #define AJAR_KERNEL_BVH_H
 #include "types.h"
 
-#define BVH_STACK_SIZE 96
+#define BVH_STACK_SIZE 224
 
 typedef struct {
 	float t;
@@ -109,27 +109,30 @@ HOT_INLINE void box_slab(float lo, float hi, float o, float inv_d, float *tn, fl
 #define BVH_LEAF_FIRST(c) ((-1 - (c)) >> 2)
 #define BVH_LEAF_COUNT(c) (((-1 - (c)) & 3) + 1)
 
-/* Enters the boxes of node n's four slots within [0, tlim]: returns the
- * mask of the slots entered (bit i: slot i) and their entry distances in
- * tn[]. The four slab tests are independent, so the compiler runs them
- * side by side. An unused slot's box at +inf is never entered by a ray with
- * finite origin and direction (bvh_traverse refuses any other) within a
- * finite tlim. */
-HOT_INLINE int bvh_node_enter(const RayPre *r, GLOBAL const BvhNode *n, float tlim, float tn[4])
+/* Enters the boxes of node n's BVH_WIDTH slots within [0, tlim]: returns
+ * the mask of the slots entered (bit i: slot i) and their entry distances
+ * in tn[]. The slab tests are independent, so the compiler runs them side
+ * by side (eight lanes: one AVX register). An unused slot's box at +inf is
+ * never entered by a ray with finite origin and direction (bvh_traverse
+ * refuses any other) within a finite tlim. */
+HOT_INLINE int bvh_node_enter(const RayPre *r, GLOBAL const BvhNode *n, float tlim, float tn[BVH_WIDTH])
 {
-	float tf[4];
-	for (int i = 0; i < 4; i++) {
+	float tf[BVH_WIDTH];
+	for (int i = 0; i < BVH_WIDTH; i++) {
 		tn[i] = 0.0f;
 		tf[i] = tlim;
 		box_slab(n->lo_x[i], n->hi_x[i], r->o.x, r->inv_d.x, &tn[i], &tf[i]);
 		box_slab(n->lo_y[i], n->hi_y[i], r->o.y, r->inv_d.y, &tn[i], &tf[i]);
 		box_slab(n->lo_z[i], n->hi_z[i], r->o.z, r->inv_d.z, &tn[i], &tf[i]);
 	}
-	return (tn[0] <= tf[0]) | (tn[1] <= tf[1]) << 1 | (tn[2] <= tf[2]) << 2 | (tn[3] <= tf[3]) << 3;
+	int m = 0;
+	for (int i = 0; i < BVH_WIDTH; i++)
+		m |= (tn[i] <= tf[i]) << i;
+	return m;
 }
 
-/* Index of the lowest set bit of a nonzero 4-bit mask. */
-HOT_INLINE int bvh_lowest(int m) { return (m & 1) ? 0 : (m & 2) ? 1 : (m & 4) ? 2 : 3; }
+/* Index of the lowest set bit of a nonzero mask. */
+HOT_INLINE int bvh_lowest(int m) { return 31 - (int)clz((uint)(m & -m)); }
 
 INLINE int v3_finite(V3 a)
 {
@@ -157,7 +160,7 @@ INLINE int bvh_traverse(const SceneView *sc, V3 o, V3 d, float tmax, int any_hit
 	for (;;) {
 		if (entry >= 0) {
 			GLOBAL const BvhNode *n = &sc->nodes[entry];
-			float tn[4];
+			float tn[BVH_WIDTH];
 			int mask = bvh_node_enter(&r, n, fmin(tmax * 1.00001f, AJAR_INF), tn);
 			if (mask != 0) {
 				int i = bvh_lowest(mask);
@@ -175,7 +178,7 @@ INLINE int bvh_traverse(const SceneView *sc, V3 o, V3 d, float tmax, int any_hit
 					stack_t[sp++] = tn[near_i ? j : i];
 					continue;
 				}
-				/* Three or four: push all, nearest on top, pop it. */
+				/* Three or more: push all, nearest on top, pop it. */
 				int base = sp;
 				stack[sp] = n->child[i];
 				stack_t[sp++] = tn[i];

@@ -29,6 +29,7 @@ static inline float u2f(uint u) { float f; memcpy(&f, &u, 4); return f; }
 static inline uint f2u(float f) { uint u; memcpy(&u, &f, 4); return u; }
 static inline int max(int a, int b) { return a > b ? a : b; }
 static inline int min(int a, int b) { return a < b ? a : b; }
+static inline uint clz(uint x) { return x ? (uint)__builtin_clz(x) : 32u; }
 /* Host tests run kernels on one thread: a plain add is the atomic. */
 static inline long atom_add(long *p, long v) { long old = *p; *p += v; return old; }
 #endif

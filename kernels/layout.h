@@ -6,7 +6,7 @@
 #include "types.h"
 
 #define AJAR_LAYOUT_TYPES(X) \
-	X(BvhNode, 128) X(Tri, 48) X(TriShade, 64) X(Material, 64) X(Texture, 16) \
+	X(BvhNode, 256) X(Tri, 48) X(TriShade, 64) X(Material, 64) X(Texture, 16) \
 	X(Emitter, 16) X(PortalTri, 64) X(Camera, 64) X(Params, 208)
 
 #define AJAR_LAYOUT_FIELDS(X)                                                          \

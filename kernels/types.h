@@ -8,19 +8,20 @@
 #define AJAR_TYPES_H
 #include "vec.h"
 
-/* Four-wide BVH node (src/bvh.c collapses its binary SAH tree into these).
+/* Eight-wide BVH node (src/bvh.c collapses its binary SAH tree into these).
  * Slot i holds a child's box, one array per bound so the traversal tests
- * the four boxes side by side, and child[i]: >= 0 an interior node; <= -1
+ * the eight boxes side by side, and child[i]: >= 0 an interior node; <= -1
  * a leaf, -1 - (4 first + count - 1), for triangles [first, first + count)
  * of the reordered triangle array, 1 <= count <= 4 (BVH_LEAF, kernels/bvh.h);
  * BVH_EMPTY an unused slot, whose box is the point (+inf, +inf, +inf), which
  * no ray from a finite origin enters. Node 0 is the root. */
+#define BVH_WIDTH 8
 typedef struct {
-	float lo_x[4], lo_y[4], lo_z[4];
-	float hi_x[4], hi_y[4], hi_z[4];
-	int child[4];
-	int pad[4];
-} BvhNode; /* 128 */
+	float lo_x[BVH_WIDTH], lo_y[BVH_WIDTH], lo_z[BVH_WIDTH];
+	float hi_x[BVH_WIDTH], hi_y[BVH_WIDTH], hi_z[BVH_WIDTH];
+	int child[BVH_WIDTH];
+	int pad[BVH_WIDTH]; /* to four whole cache lines */
+} BvhNode; /* 256 */
 
 /* Triangle as traversal sees it. `emitter` indexes Emitter (or -1). */
 typedef struct {

@@ -1,5 +1,5 @@
 /* bvh.h — the bounding volume hierarchy over the scene's triangles, built
- * on the host with binned SAH, collapsed to four-wide nodes and flattened
+ * on the host with binned SAH, collapsed to eight-wide nodes and flattened
  * into the BvhNode array that kernels/bvh.h traverses (layout in
  * kernels/types.h).
  *
@@ -17,19 +17,19 @@
 #include "../kernels/types.h"
 
 /* Deepest root-to-leaf path of the binary tree, counted in nodes. The
- * four-wide tree is at most half as deep, and its traversal pushes at most
- * three entries per level (BVH_STACK_SIZE in kernels/bvh.h). */
+ * eight-wide tree is at most half as deep, and its traversal pushes at most
+ * seven entries per level (BVH_STACK_SIZE in kernels/bvh.h). */
 #define BVH_MAX_DEPTH 64
 /* Leaf slots encode 4 first + count - 1 in an int. */
 #define BVH_MAX_TRIS (1u << 29)
 
 typedef struct {
-	BvhNode *nodes;      /* four-wide */
+	BvhNode *nodes;      /* BVH_WIDTH-wide */
 	uint32_t nnodes;
 	uint32_t *order;     /* order[i] = original index of reordered triangle i */
 	uint32_t ntris;
 	uint32_t depth;      /* binary tree: nodes on the longest root-to-leaf path */
-	uint32_t wide_depth; /* four-wide tree: the same */
+	uint32_t wide_depth; /* the wide tree: the same */
 } Bvh;
 
 /* ntris >= 1. On failure *out is left empty (safe to bvh_free). */

@@ -89,7 +89,7 @@ static void built_make(const Tri *tris, uint32_t n, Built *b)
 	b->lo = v3(INFINITY, INFINITY, INFINITY);
 	b->hi = v3(-INFINITY, -INFINITY, -INFINITY);
 	const BvhNode *root = &b->bvh.nodes[0];
-	for (int k = 0; k < 4; k++)
+	for (int k = 0; k < BVH_WIDTH; k++)
 		if (root->child[k] != BVH_EMPTY) {
 			b->lo = v3_min(b->lo, v3(root->lo_x[k], root->lo_y[k], root->lo_z[k]));
 			b->hi = v3_max(b->hi, v3(root->hi_x[k], root->hi_y[k], root->hi_z[k]));
@@ -136,7 +136,7 @@ static void check_structure(const Built *b, uint32_t n)
 	for (uint32_t i = 0; i < bvh->nnodes; i++) {
 		const BvhNode *nd = &bvh->nodes[i];
 		int used = 0;
-		for (int k = 0; k < 4; k++) {
+		for (int k = 0; k < BVH_WIDTH; k++) {
 			int c = nd->child[k];
 			V3 lo = slot_lo(nd, k), hi = slot_hi(nd, k);
 			if (c == BVH_EMPTY) {
@@ -160,7 +160,7 @@ static void check_structure(const Built *b, uint32_t n)
 				assert_true((uint32_t)c > i && (uint32_t)c < bvh->nnodes);
 				parents[c]++;
 				const BvhNode *ch = &bvh->nodes[c];
-				for (int j = 0; j < 4; j++)
+				for (int j = 0; j < BVH_WIDTH; j++)
 					if (ch->child[j] != BVH_EMPTY)
 						assert_true(box_contains(lo, hi, slot_lo(ch, j), slot_hi(ch, j)));
 			}
@@ -299,7 +299,7 @@ static void run_soup(const Tri *tris, uint32_t n, uint32_t nrays, const char *na
 	built_make(tris, n, &b);
 	check_structure(&b, n);
 	uint32_t hits = check_rays(&b, n, nrays);
-	printf("  %-12s %6u tris %6u nodes depth %2u (4-wide %2u): %u/%u rays hit\n", name, n, b.bvh.nnodes,
+	printf("  %-12s %6u tris %6u nodes depth %2u (wide %2u): %u/%u rays hit\n", name, n, b.bvh.nnodes,
 	       b.bvh.depth, b.bvh.wide_depth, hits, nrays);
 	/* The soups are built so a good share of rays hits; a BVH that
 	 * missed everything would agree with a broken brute force. */
@@ -386,7 +386,7 @@ static void test_single_triangle(void **state)
 	built_make(&t, 1, &b);
 	assert_int_equal(b.bvh.nnodes, 1);
 	assert_int_equal(b.bvh.nodes[0].child[0], BVH_LEAF(0, 1));
-	for (int k = 1; k < 4; k++)
+	for (int k = 1; k < BVH_WIDTH; k++)
 		assert_int_equal(b.bvh.nodes[0].child[k], BVH_EMPTY);
 	check_structure(&b, 1);
 	check_rays(&b, 1, 20000);
@@ -453,7 +453,7 @@ static void test_depth_bounded(void **state)
 	Built b;
 	built_make(t, n, &b);
 	check_structure(&b, n);
-	printf("  hostile      %6u tris %6u nodes depth %2u (4-wide %2u)\n", n, b.bvh.nnodes, b.bvh.depth,
+	printf("  hostile      %6u tris %6u nodes depth %2u (wide %2u)\n", n, b.bvh.nnodes, b.bvh.depth,
 	       b.bvh.wide_depth);
 	assert_true(b.bvh.depth > BVH_MAX_DEPTH - 32); /* the cap was needed */
 	for (uint32_t i = 0; i < n; i++) {
@@ -523,7 +523,7 @@ static void check_scene(const char *path)
 	uint32_t nrays = (uint32_t)(1e8 / n);
 	nrays = nrays > 2000 ? 2000 : (nrays < 150 ? 150 : nrays);
 	uint32_t hits = check_rays(&b, n, nrays);
-	printf("  %-40s %6u tris %6u nodes depth %2u (4-wide %2u), %.3f s, %.1f MB: %u/%u rays hit\n", path,
+	printf("  %-40s %6u tris %6u nodes depth %2u (wide %2u), %.3f s, %.1f MB: %u/%u rays hit\n", path,
 	       n, b.bvh.nnodes, b.bvh.depth, b.bvh.wide_depth, secs, bvh_memory(&b.bvh) / 1048576.0, hits,
 	       nrays);
 	assert_true(hits > nrays / 4);
