@@ -293,10 +293,13 @@ static void wide_set_slot(BvhNode *w, int k, const Box *b, int child)
  * node get consecutive ids, handed out as the node is written. */
 static ajar_status collapse(const BinNode *bn, uint32_t nbin, Bvh *out)
 {
-	out->nodes = malloc(sizeof(BvhNode) * nbin); /* at most one per interior binary node */
+	/* At most one per interior binary node, of which a full binary tree of
+	 * nbin nodes has (nbin - 1) / 2; one for a root that is a leaf. */
+	uint32_t cap = nbin / 2 + 1;
+	out->nodes = malloc(sizeof(BvhNode) * cap);
 	if (!out->nodes)
-		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for %u nodes", nbin);
-	memset(out->nodes, 0, sizeof(BvhNode) * nbin);
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for %u nodes", cap);
+	memset(out->nodes, 0, sizeof(BvhNode) * cap);
 	/* Pending (binary node, wide id) pairs: at most BVH_WIDTH - 1 per wide
 	 * level plus one; BVH_MAX_DEPTH bounds the levels. */
 	struct {
