@@ -18,7 +18,7 @@ MODE_FLAGS_debug := -O0 -g
 MODE_FLAGS_asan := -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
 MFLAGS := $(MODE_FLAGS_$(MODE))
 CPPFLAGS += -Iinclude -Isrc -MMD -MP
-CFLAGS += -std=c11 -D_GNU_SOURCE $(WARN) $(MFLAGS) -fPIC
+CFLAGS += -std=c11 -D_GNU_SOURCE -ffp-contract=off $(WARN) $(MFLAGS) -fPIC
 CXXFLAGS += -std=c++14 $(WARN) $(MFLAGS) -fPIC
 LDFLAGS += $(MFLAGS)
 LDLIBS = $(PKG_LIBS) -lz -lm -lpthread
@@ -48,6 +48,7 @@ DEPS_test_cache := $(BUILD)/libajar.a
 DEPS_test_cli := $(BUILD)/libajar.a
 DEPS_test_multidevice := $(BUILD)/libajar.a
 DEPS_test_integrators := $(BUILD)/libajar.a
+DEPS_test_traversal := $(BUILD)/libajar.a
 
 .PHONY: all lib cli tests test test-unit asan demo bench bench-peers install uninstall clean deps help
 all: lib cli

@@ -53,10 +53,20 @@ INLINE RayPre ray_pre(V3 o, V3 d)
 }
 
 /* Watertight ray/triangle test. On a hit with 0 < t < tmax writes t and
- * the barycentrics of p1 (u) and p2 (v) and returns 1. */
+ * the barycentrics of p1 (u) and p2 (v) and returns 1.
+ *
+ * No fused multiply-adds: two triangles sharing an edge compute its edge
+ * function as cx by - cy bx and bx cy - by cx, exact negatives of each
+ * other only when both products are rounded alike. OpenCL C contracts by
+ * default (PoCL made the first product exact and rounded the second), which
+ * lets a ray through the edge miss both; the host build never contracts
+ * (-ffp-contract=off in the Makefile). */
 HOT_INLINE int tri_intersect(const RayPre *r, GLOBAL const Tri *tri, float tmax, float *t, float *u,
 			 float *v)
 {
+#ifdef AJAR_DEVICE
+#pragma OPENCL FP_CONTRACT OFF
+#endif
 	V3 a = v3_sub(tri->p0, r->o), b = v3_sub(tri->p1, r->o), c = v3_sub(tri->p2, r->o);
 	float az = v3_comp(a, r->kz), bz = v3_comp(b, r->kz), cz = v3_comp(c, r->kz);
 	float ax = v3_comp(a, r->kx) - r->sx * az, ay = v3_comp(a, r->ky) - r->sy * az;
