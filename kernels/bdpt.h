@@ -135,9 +135,8 @@ INLINE V3 bdpt_scatter_bs(const Bsdf *bs, const PathVertex *v, V3 wi, int mode, 
 
 INLINE V3 bdpt_scatter_pdf(const SceneView *sc, const PathVertex *v, V3 wi, int mode, float *pdf_w)
 {
-	Bsdf bs;
-	vertex_bsdf(sc, v, &bs);
-	return bdpt_scatter_bs(&bs, v, wi, mode, pdf_w);
+	(void)sc;
+	return bdpt_scatter_bs(&v->bs, v, wi, mode, pdf_w);
 }
 
 INLINE V3 bdpt_scatter(const SceneView *sc, const PathVertex *v, V3 wi, int mode)
@@ -382,9 +381,7 @@ INLINE V3 bdpt_nee_bs(const SceneView *sc, const PathVertex *z, const PathVertex
 
 INLINE V3 bdpt_nee(const SceneView *sc, const PathVertex *z, const PathVertex *from, PathVertex *y, Rng *rng)
 {
-	Bsdf bz;
-	vertex_bsdf(sc, z, &bz);
-	return bdpt_nee_bs(sc, z, from, &bz, y, rng);
+	return bdpt_nee_bs(sc, z, from, &z->bs, y, rng);
 }
 
 /* Every bdpt strategy of one light and one eye subpath: adds the eye
@@ -410,18 +407,16 @@ INLINE void bdpt_strategies(const SceneView *sc, PathVertex *l, int nl, PathVert
 			break;
 		if (t > depth) /* no room for another vertex */
 			continue;
-		Bsdf bz; /* z's, for every connection below */
-		vertex_bsdf(sc, z, &bz);
 		/* s = 1: next-event estimation with a fresh light sample. */
 		{
 			PathVertex y;
-			V3 c = bdpt_nee_bs(sc, z, &e[t - 2], &bz, &y, rng);
+			V3 c = bdpt_nee_bs(sc, z, &e[t - 2], &z->bs, &y, rng);
 			if (!v3_is_zero(c))
 				bdpt_add(sc, out, 1, t, c, bdpt_weight(sc, &y, 1, e, t), out->pixel, rng);
 		}
 		/* s >= 2: light vertex s-1 to eye vertex t-1. */
 		for (int s = 2; s <= nl && s + t - 1 <= depth; s++) {
-			V3 c = bdpt_connect_bs(sc, &l[s - 1], 0, z, &bz);
+			V3 c = bdpt_connect_bs(sc, &l[s - 1], 0, z, &z->bs);
 			if (v3_is_zero(c))
 				continue;
 			bdpt_add(sc, out, s, t, v3_mul(v3_mul(l[s - 1].beta, c), z->beta), bdpt_weight(sc, l, s, e, t),

@@ -67,11 +67,10 @@ INLINE float bdpt_emission_pdf(const SceneView *sc, const PathVertex *l, const P
 INLINE float bdpt_bsdf_pdf_w(const SceneView *sc, const PathVertex *v, const PathVertex *from, const PathVertex *to,
 			     int mode)
 {
-	Bsdf bs;
+	(void)sc;
 	V3 wo = from->type == VERTEX_ENV ? from->p : v3_norm(v3_sub(from->p, v->p));
 	V3 wi = to->type == VERTEX_ENV ? to->p : v3_norm(v3_sub(to->p, v->p));
-	vertex_bsdf(sc, v, &bs);
-	return bsdf_pdf_w(&bs, wo, wi); /* densities do not depend on the transport mode */
+	return bsdf_pdf_w(&v->bs, wo, wi); /* densities do not depend on the transport mode */
 }
 
 /* Densities of `to` sampled from `v` when the path's other neighbour of v

@@ -203,8 +203,6 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 	int rb[PORTAL_RIGHT_MAX], rt[PORTAL_RIGHT_MAX];
 	uint rpix[PORTAL_RIGHT_MAX];
 	int b0 = 1, t0 = 1;
-	Bsdf bf; /* F[bf_for]'s, for its connections to every eye vertex */
-	int bf_for = -1;
 	while (nR >= 2 && nF >= 2 && b0 < nF) {
 		int nr = 0;
 		for (; b0 < nF && nr < PORTAL_RIGHT_MAX; b0++, t0 = 1) {
@@ -212,11 +210,8 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 				if (b0 + t0 > depth) /* s = 0, s' = 1 is the shortest left end */
 					continue;
 				uint pix;
-				if (bf_for != b0 && F[b0].type == VERTEX_SURFACE) {
-					vertex_bsdf(sc, &F[b0], &bf);
-					bf_for = b0;
-				}
-				V3 c = portal_right(sc, F, b0, bf_for == b0 ? &bf : 0, e, t0, out->pixel, &pix);
+				V3 c = portal_right(sc, F, b0, F[b0].type == VERTEX_SURFACE ? &F[b0].bs : 0, e, t0,
+						    out->pixel, &pix);
 				if (v3_is_zero(c))
 					continue;
 				rc[nr] = c;

@@ -41,17 +41,10 @@ typedef struct {
 	int cross;    /* portal integrator: portal crossings of the edge to the previous vertex of this subpath */
 	V3 w0;        /* an intermediate subpath's first vertices: the portal point it started from */
 	int w0_tri;   /* and the portal triangle it lies on */
-	Bsdf bs;      /* VERTEX_SURFACE hits: the BSDF, set up once by vertex_trace */
+	Bsdf bs;      /* VERTEX_SURFACE hits: the BSDF, set up once by vertex_trace;
+		       * connections and MIS densities read it many times per
+		       * vertex (rebuilding it was 17% of door-ajar's portal time) */
 } PathVertex;
-
-/* The BSDF of a surface vertex that vertex_trace made. Connections and MIS
- * densities ask for it many times per vertex (door-ajar's portal integrator
- * spent 17% of its time rebuilding frames), so it is kept, not rebuilt. */
-INLINE void vertex_bsdf(const SceneView *sc, const PathVertex *v, Bsdf *bs)
-{
-	(void)sc;
-	*bs = v->bs;
-}
 
 /* Area density at `to` of a direction sampled at `from` with solid-angle
  * density pdf_w; unchanged (solid angle) when `to` is at infinity. */
@@ -154,14 +147,12 @@ INLINE int vertex_scatter(const SceneView *sc, PathVertex *path, int n, int ligh
 			  V3 *o, V3 *d, float *pdf_w, Rng *rng)
 {
 	PathVertex *v = &path[n - 1], *prev = &path[n - 2];
-	Bsdf bs;
 	BsdfSample bsm;
 	if (v->type != VERTEX_SURFACE)
 		return 0;
-	vertex_bsdf(sc, v, &bs);
 	float u0, u1, u2;
 	rng_f3(rng, &u0, &u1, &u2);
-	if (!bsdf_sample(&bs, v->wo, u0, u1, u2, light_side ? BSDF_IMPORTANCE : BSDF_RADIANCE, &bsm) ||
+	if (!bsdf_sample(&v->bs, v->wo, u0, u1, u2, light_side ? BSDF_IMPORTANCE : BSDF_RADIANCE, &bsm) ||
 	    !(bsm.pdf_w > 0.0f))
 		return 0;
 	float k = fabs(v3_dot(v->ns, bsm.wi)) / bsm.pdf_w;
