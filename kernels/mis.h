@@ -124,15 +124,24 @@ INLINE int mis_bdpt_valid(const MisVertex *v, int k, int s)
 	return !(v[s - 1].infinite && s == k - 1);
 }
 
-/* Logs of the remapped densities of x_0 .. x_{n-1} and their prefix sums:
- * PF[j] = sum of log pf_i for i < j, PR likewise; arrays of n + 1. PF stays
- * 0 unless `need_pf` (mis_needs_pf). */
-INLINE void mis_prefix(const MisVertex *v, int n, int need_pf, float *PF, float *PR)
+/* Logs of the remapped densities of x_0 .. x_{n-1}: lf stays 0 unless
+ * `need_pf` (mis_needs_pf). */
+INLINE void mis_logs(const MisVertex *v, int n, int need_pf, float *lf, float *lr)
+{
+	for (int i = 0; i < n; i++) {
+		lf[i] = need_pf ? fast_log(mis_remap0(v[i].pf)) : 0.0f;
+		lr[i] = fast_log(mis_remap0(v[i].pr));
+	}
+}
+
+/* Their prefix sums: PF[j] = sum of log pf_i for i < j, PR likewise;
+ * arrays of n + 1. */
+INLINE void mis_prefix(const float *lf, const float *lr, int n, float *PF, float *PR)
 {
 	PF[0] = PR[0] = 0.0f;
 	for (int i = 0; i < n; i++) {
-		PF[i + 1] = need_pf ? PF[i] + fast_log(mis_remap0(v[i].pf)) : 0.0f;
-		PR[i + 1] = PR[i] + fast_log(mis_remap0(v[i].pr));
+		PF[i + 1] = PF[i] + lf[i];
+		PR[i + 1] = PR[i] + lr[i];
 	}
 }
 
@@ -184,19 +193,18 @@ INLINE void mis_pair_edges(MisPortalSet set, int k, int n, int *lo, int *hi)
 }
 
 /* Weight of strategy `cur` for the k-vertex path v among all BDPT and
- * portal strategies in use; v holds the records of the first n =
- * mis_horizon(set, k) vertices. cross[i] > 0 marks an edge (x_i, x_{i+1})
- * that crosses portals; lpsum[i] = log sum over its crossings c of
- * p_pair_c^beta (each crossing is a strategy of its own, with its own
- * direction density); lpair_cur is log p_pair of cur's own crossing. Both
- * are read for the edges of mis_pair_edges only. */
-INLINE float mis_union_weight(const MisVertex *v, int k, int n, const int *cross, const float *lpsum, float lpair_cur,
-			      MisStrategy cur, MisPortalSet set, int heuristic)
+ * portal strategies in use, from the prefix sums PF, PR of the logs of its
+ * first n = mis_horizon(set, k) records (mis_prefix) and lpn, the log of
+ * x_0's remapped pn; v gives the delta and infinite flags. cross[i] > 0
+ * marks an edge (x_i, x_{i+1}) that crosses portals; lpsum[i] = log sum
+ * over its crossings c of p_pair_c^beta (each crossing is a strategy of its
+ * own, with its own direction density); lpair_cur is log p_pair of cur's
+ * own crossing. Both are read for the edges of mis_pair_edges only. */
+INLINE float mis_union_sum(const MisVertex *v, int k, int n, const float *PF, const float *PR, float lpn,
+			   const int *cross, const float *lpsum, float lpair_cur, MisStrategy cur, MisPortalSet set,
+			   int heuristic)
 {
-	float PF[4 * 33 + 1], PR[4 * 33 + 1];
 	float beta = mis_beta(heuristic);
-	mis_prefix(v, n, mis_needs_pf(set), PF, PR);
-	float lpn = fast_log(mis_remap0(v[0].pn));
 	/* PR[n] stands in for PR[k]: the pr of x_n .. x_{k-1} are a factor of
 	 * every strategy's density. */
 	float lcur = cur.c == 1 ? mis_log_bdpt(PF, lpn, PR, n, cur.s)
@@ -230,5 +238,16 @@ INLINE float mis_union_weight(const MisVertex *v, int k, int n, const int *cross
 		}
 	}
 	return 1.0f / total;
+}
+
+/* The same weight from the records v[0..n-1] themselves. */
+INLINE float mis_union_weight(const MisVertex *v, int k, int n, const int *cross, const float *lpsum, float lpair_cur,
+			      MisStrategy cur, MisPortalSet set, int heuristic)
+{
+	float lf[4 * 33], lr[4 * 33], PF[4 * 33 + 1], PR[4 * 33 + 1];
+	mis_logs(v, n, mis_needs_pf(set), lf, lr);
+	mis_prefix(lf, lr, n, PF, PR);
+	return mis_union_sum(v, k, n, PF, PR, fast_log(mis_remap0(v[0].pn)), cross, lpsum, lpair_cur, cur, set,
+			     heuristic);
 }
 #endif

@@ -262,6 +262,10 @@ INLINE void path_records(const SceneView *sc, const PathRef *P, int heuristic, M
 			c = 1;
 		cross[i] = c;
 	}
+	for (int i = max(hi, 0); i < k - 1; i++) { /* never read, but defined for path_join_weight's copies */
+		cross[i] = 0;
+		lpsum[i] = -AJAR_INF;
+	}
 }
 
 INLINE MisPortalSet path_portal_set(GLOBAL const Params *prm)
@@ -281,6 +285,120 @@ INLINE float path_union_weight(const SceneView *sc, const PathRef *P, MisStrateg
 	int n = mis_horizon(set, P->k);
 	path_records(sc, P, heuristic, set, n, mv, cross, lpsum, &lpair_cur);
 	return mis_union_weight(mv, P->k, n, cross, lpsum, lpair_cur, cur, set, heuristic);
+}
+
+/* ---- Portal paths that share an intermediate subpath ---------------------
+ *
+ * portal.h joins every light-side end (s, s' = a: x_0..x_m = l[0..s-1],
+ * R[a..1]) with every eye-side end (t' = b, t: x_{m+1}.. = F[1..b],
+ * e[t-1..0]) of one intermediate subpath. Every record of x_0..x_m, and
+ * the crossings of edges 0..m (the pair edge m included), depend on the
+ * light-side end alone; every record of x_{m+1}.. and the crossings of the
+ * later edges on the eye-side end alone; but for pr_m (read from x_{m+1},
+ * x_{m+2}), pf_{m+1} (read from x_{m-1}, x_m) and, where s = 0 and s' = 1,
+ * pn_0 (read from x_2). path_records is what says so: each end's records
+ * are taken from path_records on one path through that end, and each pair
+ * of ends only adds up its logs. Same weights, bit for bit, as
+ * path_union_weight, for sets whose horizon is the whole path and whose
+ * intermediate strategies pair on every edge (path_join_exact). */
+typedef struct {
+	float lf, lr; /* logs of the remapped pf and pr */
+	float lpsum;  /* of the edge to the next record */
+	int bits;     /* delta | infinite << 1 | the edge's crossings << 2 */
+} MisRecord;
+
+typedef struct {
+	MisRecord r[2 * SUBPATH_MAX]; /* x_0 .. x_m and edges 0 .. m */
+	int m;
+	float lf_next; /* log pf_{m+1} */
+	float lpn;     /* log pn_0, unless pn_from_x2 */
+	int pn_from_x2;
+	float lpair_cur;
+} MisLightEnd;
+
+/* Whether joined weights are path_union_weight's for every path of set. */
+INLINE int path_join_exact(MisPortalSet set)
+{
+	return set.light_paths && set.tp_max + set.t_max >= SUBPATH_MAX; /* k <= SUBPATH_MAX */
+}
+
+INLINE void mis_record_keep(MisRecord *r, const MisVertex *v, const int *cross, const float *lpsum, int i, int edge,
+			    int need_pf)
+{
+	r->lf = need_pf ? fast_log(mis_remap0(v[i].pf)) : 0.0f;
+	r->lr = fast_log(mis_remap0(v[i].pr));
+	r->bits = (v[i].delta != 0) | (v[i].infinite != 0) << 1 | (edge ? cross[i] : 0) << 2;
+	r->lpsum = edge ? lpsum[i] : -AJAR_INF;
+}
+
+/* The light-side end l[0..s-1], R[a..1] (lp = l, or the next-event sample
+ * when s = 1), taken from the path that joins it to F[1] and the camera. */
+INLINE void path_light_end(const SceneView *sc, const PathVertex *lp, int s, const PathVertex *R, int a,
+			   const PathVertex *F, const PathVertex *e, MisLightEnd *L)
+{
+	PathRef P;
+	MisVertex mv[4 * SUBPATH_MAX];
+	int cross[4 * SUBPATH_MAX];
+	float lpsum[4 * SUBPATH_MAX];
+	MisPortalSet set = path_portal_set(sc->params);
+	int need_pf = mis_needs_pf(set);
+	path_ref(&P, lp, s, R, a, F, 1, e, 1);
+	path_records(sc, &P, sc->params->mis, set, P.k, mv, cross, lpsum, &L->lpair_cur);
+	int m = P.pair;
+	for (int i = 0; i <= m; i++)
+		mis_record_keep(&L->r[i], mv, cross, lpsum, i, 1, need_pf);
+	L->m = m;
+	L->lf_next = need_pf ? fast_log(mis_remap0(mv[m + 1].pf)) : 0.0f;
+	L->lpn = fast_log(mis_remap0(mv[0].pn));
+	L->pn_from_x2 = s == 0 && a == 1;
+}
+
+/* The eye-side end F[1..b], e[t-1..0] into r[0..b+t-1], taken from the path
+ * that joins it to A alone (s = 0, s' = 1); returns log pr_m. */
+INLINE float path_eye_end(const SceneView *sc, const PathVertex *R, const PathVertex *F, int b, const PathVertex *e,
+			  int t, MisRecord *r)
+{
+	PathRef P;
+	MisVertex mv[4 * SUBPATH_MAX];
+	int cross[4 * SUBPATH_MAX];
+	float lpsum[4 * SUBPATH_MAX], lpair_cur;
+	MisPortalSet set = path_portal_set(sc->params);
+	int need_pf = mis_needs_pf(set);
+	path_ref(&P, 0, 0, R, 1, F, b, e, t);
+	path_records(sc, &P, sc->params->mis, set, P.k, mv, cross, lpsum, &lpair_cur);
+	for (int i = 1; i < P.k; i++)
+		mis_record_keep(&r[i - 1], mv, cross, lpsum, i, i + 1 < P.k, need_pf);
+	return fast_log(mis_remap0(mv[0].pr));
+}
+
+/* The weight of portal strategy cur for the path that joins light-side end
+ * L to the eye-side end whose nr records are r (path_eye_end, lr_m its
+ * return); x2 is the path's x_2, read when L->pn_from_x2. */
+INLINE float path_join_weight(const SceneView *sc, const MisLightEnd *L, const MisRecord *r, int nr, float lr_m,
+			      const PathVertex *x2, const PathVertex *R, MisStrategy cur)
+{
+	MisVertex v[4 * SUBPATH_MAX];
+	int cross[4 * SUBPATH_MAX];
+	float lf[4 * SUBPATH_MAX], lr[4 * SUBPATH_MAX], lpsum[4 * SUBPATH_MAX];
+	float PF[4 * SUBPATH_MAX + 1], PR[4 * SUBPATH_MAX + 1];
+	int m = L->m, k = m + 1 + nr;
+	for (int i = 0; i < k; i++) {
+		const MisRecord *q = i <= m ? &L->r[i] : &r[i - m - 1];
+		lf[i] = q->lf;
+		lr[i] = q->lr;
+		v[i].delta = q->bits & 1;
+		v[i].infinite = q->bits >> 1 & 1;
+		cross[i] = q->bits >> 2;
+		lpsum[i] = q->lpsum;
+	}
+	lr[m] = lr_m;
+	lf[m + 1] = L->lf_next;
+	float lpn = L->lpn;
+	if (L->pn_from_x2)
+		lpn = fast_log(mis_remap0(bdpt_nee_pdf(sc, &R[1], &R[0], x2)));
+	mis_prefix(lf, lr, k, PF, PR);
+	MisPortalSet set = path_portal_set(sc->params);
+	return mis_union_sum(v, k, k, PF, PR, lpn, cross, lpsum, L->lpair_cur, cur, set, sc->params->mis);
 }
 
 #endif

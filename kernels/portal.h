@@ -182,6 +182,7 @@ INLINE V3 portal_right(const SceneView *sc, const PathVertex *F, int b, const Bs
 }
 
 #define PORTAL_RIGHT_MAX 48
+#define PORTAL_RECORDS_MAX 512 /* the eye-side ends' MIS records in a chunk (>= 2 SUBPATH_MAX) */
 
 /* One pixel sample of the portal integrator. */
 INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVertex *l, PathVertex *e, PathVertex *R,
@@ -202,13 +203,19 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 	V3 rc[PORTAL_RIGHT_MAX];
 	int rb[PORTAL_RIGHT_MAX], rt[PORTAL_RIGHT_MAX];
 	uint rpix[PORTAL_RIGHT_MAX];
+	/* Each end's MIS records, built once (path_mis.h, path_join_weight). */
+	int join = path_join_exact(path_portal_set(sc->params));
+	MisRecord rrec[PORTAL_RECORDS_MAX];
+	float rlr[PORTAL_RIGHT_MAX];
 	int b0 = 1, t0 = 1;
 	while (nR >= 2 && nF >= 2 && b0 < nF) {
-		int nr = 0;
+		int nr = 0, nrec = 0, ready = 0;
 		for (; b0 < nF && nr < PORTAL_RIGHT_MAX; b0++, t0 = 1) {
 			for (; t0 <= ne && t0 <= sc->params->portal_t_max && nr < PORTAL_RIGHT_MAX; t0++) {
 				if (b0 + t0 > depth) /* s = 0, s' = 1 is the shortest left end */
 					continue;
+				if (nrec + b0 + t0 > PORTAL_RECORDS_MAX)
+					break;
 				uint pix;
 				V3 c = portal_right(sc, F, b0, F[b0].type == VERTEX_SURFACE ? &F[b0].bs : 0, e, t0,
 						    out->pixel, &pix);
@@ -218,6 +225,7 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 				rb[nr] = b0;
 				rt[nr] = t0;
 				rpix[nr] = pix;
+				nrec += b0 + t0;
 				nr++;
 			}
 			if (t0 <= ne && t0 <= sc->params->portal_t_max)
@@ -247,14 +255,27 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 				}
 				if (v3_is_zero(lcon))
 					continue;
-				for (int j = 0; j < nr; j++) {
+				MisLightEnd L;
+				if (join) {
+					for (int j = 0, r = 0; !ready && j < nr; r += rb[j] + rt[j], j++)
+						rlr[j] = path_eye_end(sc, R, F, rb[j], e, rt[j], &rrec[r]);
+					ready = 1;
+					path_light_end(sc, lp, s, R, a, F, e, &L);
+				}
+				for (int j = 0, r = 0; j < nr; r += rb[j] + rt[j], j++) {
 					int b = rb[j], t = rt[j];
 					if (s + a + b + t - 1 > depth)
 						continue;
-					PathRef P;
 					MisStrategy cur = {2, s, s + a - 1, b};
-					path_ref(&P, lp, s, R, a, F, b, e, t);
-					float w = path_union_weight(sc, &P, cur);
+					float w;
+					if (join) {
+						w = path_join_weight(sc, &L, &rrec[r], b + t, rlr[j], b >= 2 ? &F[2] : &e[t - 1],
+								     R, cur);
+					} else {
+						PathRef P;
+						path_ref(&P, lp, s, R, a, F, b, e, t);
+						w = path_union_weight(sc, &P, cur);
+					}
 					portal_add(sc, out, s, a, b, t, v3_mul(lcon, rc[j]), w, rpix[j], rng);
 				}
 			}

@@ -176,6 +176,74 @@ static void check_path(const SceneView *sc, const PathRef *P, MisStats *st)
 	st->portal_paths += any > 0;
 }
 
+/* Weights joined from each end's records (path_join_weight, what the
+ * kernel uses for sets with light subpaths) against path_union_weight for
+ * every pair of ends of random intermediate subpaths: the same, bit for
+ * bit. Returns how many weights it compared. */
+static int check_join_weights(HostScene *h, int nsamples)
+{
+	SceneView *sc = &h->view;
+	Params *prm = h->data.params;
+	PathVertex l[SUBPATH_MAX], e[SUBPATH_MAX], R[SUBPATH_MAX], F[SUBPATH_MAX];
+	int depth = prm->max_depth, compared = 0;
+	assert_true(path_join_exact(path_portal_set(prm)));
+	for (int n = 0; n < nsamples; n++) {
+		Rng rng = rng_init(91, (uint)n, 0, 3);
+		float px = rng_f(&rng) * prm->camera.width, py = rng_f(&rng) * prm->camera.height;
+		int nl = bdpt_light_subpath(sc, l, depth, &rng);
+		int ne = bdpt_eye_subpath(sc, px, py, e, depth + 1, &rng);
+		int nR, nF;
+		portal_intermediate(sc, R, &nR, F, &nF, &rng);
+		for (int a = 1; a < nR; a++)
+			for (int s = 0; s <= nl && s <= prm->portal_s_max; s++) {
+				if (s >= 1 && R[a].type != VERTEX_SURFACE)
+					break;
+				PathVertex y;
+				const PathVertex *lp = l;
+				if (s == 1) {
+					if (v3_is_zero(bdpt_nee(sc, &R[a], &R[a - 1], &y, &rng)))
+						continue;
+					lp = &y;
+				}
+				MisLightEnd L;
+				path_light_end(sc, lp, s, R, a, F, e, &L);
+				for (int b = 1; b < nF; b++)
+					for (int t = 1; t <= ne && t <= prm->portal_t_max && s + a + b + t - 1 <= depth; t++) {
+						MisRecord r[2 * SUBPATH_MAX];
+						float lr_m = path_eye_end(sc, R, F, b, e, t, r);
+						MisStrategy cur = {2, s, s + a - 1, b};
+						PathRef P;
+						path_ref(&P, lp, s, R, a, F, b, e, t);
+						float want = path_union_weight(sc, &P, cur);
+						float got = path_join_weight(sc, &L, r, b + t, lr_m, b >= 2 ? &F[2] : &e[t - 1], R, cur);
+						if (memcmp(&want, &got, sizeof want) != 0)
+							fail_msg("path (s=%d, s'=%d, t'=%d, t=%d): joined weight %.9g, whole path %.9g", s,
+								 a, b, t, got, want);
+						compared++;
+					}
+			}
+	}
+	print_message("%d joined weights\n", compared);
+	return compared;
+}
+
+static void use_all_portal_strategies(HostScene *h);
+
+/* Scenes with emitters: door-ajar and bathroom, the default set and every
+ * strategy; the round trip through a mirror (delta vertices) below. */
+static void test_join_weights(void **state)
+{
+	static const char *scenes[] = {SCENE("door-ajar/door-ajar.gltf"), SCENE("bathroom/bathroom.gltf")};
+	for (int i = 0; i < 2; i++) {
+		HostScene h;
+		host_scene_open(&h, scenes[i], NULL, 24, 24, INTEGRATOR_PORTAL, 8);
+		assert_true(check_join_weights(&h, 150) > 1000);
+		use_all_portal_strategies(&h);
+		assert_true(check_join_weights(&h, 60) > 1000);
+		host_scene_close(&h);
+	}
+}
+
 /* Random samples: every bdpt path and every portal path they can form. */
 static MisStats check_scene_mis(HostScene *h, int nsamples)
 {
@@ -679,6 +747,7 @@ int main(void)
 		cmocka_unit_test(test_mis_bathroom),
 		cmocka_unit_test(test_mis_door_ajar),
 		cmocka_unit_test(test_mis_portal_surface_portal),
+		cmocka_unit_test(test_join_weights),
 		cmocka_unit_test(test_groups_unbiased_window_room),
 		cmocka_unit_test(test_groups_unbiased_round_trip),
 		cmocka_unit_test(test_directions_window_room),
