@@ -180,6 +180,19 @@ INLINE float mis_logadd(float a, float b)
 	return hi + fast_log(1.0f + fast_exp(lo - hi));
 }
 
+/* log of the sum of exp(x[i]), i < n; -INF for none. */
+INLINE float mis_logsumexp(const float *x, int n)
+{
+	float hi = -AJAR_INF, sum = 0.0f;
+	for (int i = 0; i < n; i++)
+		hi = fmax(hi, x[i]);
+	if (n == 0 || hi == -AJAR_INF)
+		return -AJAR_INF;
+	for (int i = 0; i < n; i++)
+		sum += fast_exp(x[i] - hi);
+	return hi + fast_log(sum);
+}
+
 INLINE float mis_beta(int heuristic) { return heuristic == MIS_BALANCE ? 1.0f : 2.0f; }
 
 /* The edges [*lo, *hi) that intermediate strategies in use can pair on:

@@ -180,10 +180,14 @@ INLINE float path_pair_logsum(const SceneView *sc, const PathRef *P, int i, floa
 
 /* MIS records of the first n vertices of an assembled path, and the
  * crossings and pair densities (lpsum, lpair_cur as in mis_union_weight)
- * of the edges the weights read: what mis_union_weight needs for the
- * strategies in `set`. */
-INLINE void path_records(const SceneView *sc, const PathRef *P, int heuristic, MisPortalSet set, int n, MisVertex *mv,
-			 int *cross, float *lpsum, float *lpair_cur)
+ * of the edges the weights read (path_records), or only those of one end
+ * of a portal path (`part`, below). */
+#define PATH_WHOLE 0
+#define PATH_LIGHT_END 1 /* x_0..x_m, pf_{m+1} and edges 0..m only (path_light_end) */
+#define PATH_EYE_END 2   /* x_{m+1}.., pr_m and edges after m only (path_eye_end) */
+
+INLINE void path_records_part(const SceneView *sc, const PathRef *P, int heuristic, MisPortalSet set, int n,
+			      MisVertex *mv, int *cross, float *lpsum, float *lpair_cur, int part)
 {
 	const PathVertex *const *x = P->x;
 	int k = P->k, need_pf = mis_needs_pf(set);
@@ -206,14 +210,16 @@ INLINE void path_records(const SceneView *sc, const PathRef *P, int heuristic, M
 	/* Densities the subpaths could not know. A next-event light vertex
 	 * (s = 1, t >= 2) carries its own sample density, which is pn, and
 	 * its pr when the caller stored it (bdpt_nee). */
-	mv[0].pf = bdpt_origin_pdf(sc, x[0]);
 	int nee = P->s == 1 && k >= 3; /* else a light subpath's origin (t = 1) */
-	mv[0].pn = k < 3 ? mv[0].pf : (nee ? x[0]->pf : bdpt_nee_pdf(sc, x[0], x[1], x[2]));
-	if (need_pf && P->s == 0 && k > 2)
-		mv[1].pf = path_pf(sc, P, mv, 1);
+	if (part != PATH_EYE_END) {
+		mv[0].pf = bdpt_origin_pdf(sc, x[0]);
+		mv[0].pn = k < 3 ? mv[0].pf : (nee ? x[0]->pf : bdpt_nee_pdf(sc, x[0], x[1], x[2]));
+		if (need_pf && P->s == 0 && k > 2)
+			mv[1].pf = path_pf(sc, P, mv, 1);
+	}
 	for (int j = 0; j < 2; j++) {
 		int c = conn[j];
-		if (c < 0)
+		if (c < 0 || (j == 0 && part == PATH_EYE_END) || (j == 1 && part == PATH_LIGHT_END))
 			continue;
 		if (c < n && !(c == 0 && nee && x[0]->pr > 0.0f))
 			mv[c].pr = path_pr(sc, P, mv, c);
@@ -225,9 +231,10 @@ INLINE void path_records(const SceneView *sc, const PathRef *P, int heuristic, M
 			mv[c + 2].pf = path_pf(sc, P, mv, c + 2);
 	}
 	if (P->pair >= 0 && P->pair < n) {
-		if (need_pf && P->pair + 1 < n)
+		if (need_pf && P->pair + 1 < n && part != PATH_EYE_END)
 			mv[P->pair + 1].pf = path_pf(sc, P, mv, P->pair + 1);
-		mv[P->pair].pr = path_pr(sc, P, mv, P->pair);
+		if (part != PATH_LIGHT_END)
+			mv[P->pair].pr = path_pr(sc, P, mv, P->pair);
 	}
 	/* Crossings and pair densities of the edges intermediate strategies
 	 * can pair on (mis_pair_edges), and the current sample's own crossing
@@ -241,6 +248,10 @@ INLINE void path_records(const SceneView *sc, const PathRef *P, int heuristic, M
 	for (int i = 0; i < hi; i++) {
 		int conn = i == P->c1 || i == P->c2, c = 0, found;
 		lpsum[i] = -AJAR_INF;
+		if ((part == PATH_LIGHT_END && i > m) || (part == PATH_EYE_END && i <= m)) {
+			cross[i] = 0; /* the other end's edge */
+			continue;
+		}
 		if (i < lo && i != m)
 			c = 0;
 		else if (conn)
@@ -266,6 +277,16 @@ INLINE void path_records(const SceneView *sc, const PathRef *P, int heuristic, M
 		cross[i] = 0;
 		lpsum[i] = -AJAR_INF;
 	}
+}
+
+/* MIS records of the first n vertices of an assembled path, and the
+ * crossings and pair densities (lpsum, lpair_cur as in mis_union_weight)
+ * of the edges the weights read: what mis_union_weight needs for the
+ * strategies in `set`. */
+INLINE void path_records(const SceneView *sc, const PathRef *P, int heuristic, MisPortalSet set, int n, MisVertex *mv,
+			 int *cross, float *lpsum, float *lpair_cur)
+{
+	path_records_part(sc, P, heuristic, set, n, mv, cross, lpsum, lpair_cur, PATH_WHOLE);
 }
 
 INLINE MisPortalSet path_portal_set(GLOBAL const Params *prm)
@@ -297,24 +318,51 @@ INLINE float path_union_weight(const SceneView *sc, const PathRef *P, MisStrateg
  * later edges on the eye-side end alone; but for pr_m (read from x_{m+1},
  * x_{m+2}), pf_{m+1} (read from x_{m-1}, x_m) and, where s = 0 and s' = 1,
  * pn_0 (read from x_2). path_records is what says so: each end's records
- * are taken from path_records on one path through that end, and each pair
- * of ends only adds up its logs. Same weights, bit for bit, as
- * path_union_weight, for sets whose horizon is the whole path and whose
- * intermediate strategies pair on every edge (path_join_exact). */
+ * are taken from path_records on one path through that end.
+ *
+ * The weight's sum over strategies then splits too. A bdpt strategy s'
+ * has log density LPF(s') - PR[s'] + PR[k]; those with s' <= m read the
+ * light-side records only, those with s' >= m + 2 the eye-side ones but for
+ * a common term, and s' = m + 1 is one term across. The intermediate
+ * strategies that pair on edge m take their s from the light side and
+ * their t' from the eye side, so their sum is a product of two sums. Each
+ * end keeps its sums as logs, and a pair of ends adds a handful of terms.
+ * Strategies pairing on another edge (a path that crosses portals twice)
+ * are summed over the whole path (mis_union_sum). Exact for sets whose
+ * horizon is the whole path and whose intermediate strategies pair on
+ * every edge (path_join_exact). */
 typedef struct {
 	float lf, lr; /* logs of the remapped pf and pr */
 	float lpsum;  /* of the edge to the next record */
 	int bits;     /* delta | infinite << 1 | the edge's crossings << 2 */
 } MisRecord;
 
+INLINE int mis_record_delta(const MisRecord *r) { return r->bits & 1; }
+
 typedef struct {
 	MisRecord r[2 * SUBPATH_MAX]; /* x_0 .. x_m and edges 0 .. m */
 	int m;
-	float lf_next; /* log pf_{m+1} */
-	float lpn;     /* log pn_0, unless pn_from_x2 */
-	int pn_from_x2;
+	float lf_next;   /* log pf_{m+1} */
+	float lpn;       /* log pn_0, unless pn_from_x2 */
+	int pn_from_x2;  /* (then m = 0) */
 	float lpair_cur;
+	float pf_m1;     /* PF[m + 1] */
+	float pr_m;      /* PR[m] */
+	float cur;       /* LPF(s) + PR[m] - PR[s] of its own s */
+	float bdpt;      /* log sum over valid s' <= m of exp(beta (LPF(s') - PR[s'])) */
+	float pair;      /* log sum over the s pairing on edge m of exp(beta (LPF(s) + PR[m] - PR[s])) */
+	int other;       /* an earlier edge crosses portals within the pairing edges */
 } MisLightEnd;
+
+typedef struct {
+	int nr;          /* records x_{m+1} .. x_{k-1} */
+	float lr_m;      /* log pr_m */
+	float pr_rest;   /* PR[k] - PR[m + 1] */
+	float cur;       /* PF[m+b+1] - PF[m+2] + PR[k] - PR[m+b+1] of its own b */
+	float bdpt;      /* log sum over valid s' = m+1+o, o >= 1, of exp(beta (PF[s'] - PF[m+2] - PR[s'] + PR[m+1])) */
+	float pair;      /* log sum over the t' with edge m of exp(beta (PF[m+t'+1] - PF[m+2] + PR[k] - PR[m+t'+1])) */
+	int first_cross; /* first of its edges (0: x_{m+1} to x_{m+2}) that crosses portals, or nr */
+} MisEyeEnd;
 
 /* Whether joined weights are path_union_weight's for every path of set. */
 INLINE int path_join_exact(MisPortalSet set)
@@ -342,8 +390,9 @@ INLINE void path_light_end(const SceneView *sc, const PathVertex *lp, int s, con
 	float lpsum[4 * SUBPATH_MAX];
 	MisPortalSet set = path_portal_set(sc->params);
 	int need_pf = mis_needs_pf(set);
+	float beta = mis_beta(sc->params->mis);
 	path_ref(&P, lp, s, R, a, F, 1, e, 1);
-	path_records(sc, &P, sc->params->mis, set, P.k, mv, cross, lpsum, &L->lpair_cur);
+	path_records_part(sc, &P, sc->params->mis, set, P.k, mv, cross, lpsum, &L->lpair_cur, PATH_LIGHT_END);
 	int m = P.pair;
 	for (int i = 0; i <= m; i++)
 		mis_record_keep(&L->r[i], mv, cross, lpsum, i, 1, need_pf);
@@ -351,12 +400,36 @@ INLINE void path_light_end(const SceneView *sc, const PathVertex *lp, int s, con
 	L->lf_next = need_pf ? fast_log(mis_remap0(mv[m + 1].pf)) : 0.0f;
 	L->lpn = fast_log(mis_remap0(mv[0].pn));
 	L->pn_from_x2 = s == 0 && a == 1;
+	float PF[2 * SUBPATH_MAX + 1], PR[2 * SUBPATH_MAX + 1];
+	PF[0] = PR[0] = 0.0f;
+	for (int i = 0; i <= m; i++) {
+		PF[i + 1] = PF[i] + L->r[i].lf;
+		PR[i + 1] = PR[i] + L->r[i].lr;
+	}
+	L->pf_m1 = PF[m + 1];
+	L->pr_m = PR[m];
+	L->cur = mis_lpf(PF, L->lpn, s) + PR[m] - PR[s];
+	float x[2 * SUBPATH_MAX];
+	int nx = 0;
+	for (int j = 0; j <= m; j++)
+		if (j == 0 || !(mis_record_delta(&L->r[j - 1]) || mis_record_delta(&L->r[j])))
+			x[nx++] = beta * (mis_lpf(PF, L->lpn, j) - PR[j]);
+	L->bdpt = mis_logsumexp(x, nx);
+	nx = 0;
+	for (int j = max(0, m + 1 - set.sp_max); j <= m && j <= set.s_max; j++)
+		if (j == 0 || !(mis_record_delta(&L->r[j - 1]) || mis_record_delta(&L->r[j])))
+			x[nx++] = beta * (mis_lpf(PF, L->lpn, j) + PR[m] - PR[j]);
+	L->pair = mis_logsumexp(x, nx);
+	int S = set.s_max + set.sp_max; /* edges past it pair no strategy */
+	L->other = m >= S;
+	for (int i = 0; i < m && i < S; i++)
+		L->other |= L->r[i].bits >> 2 > 0;
 }
 
-/* The eye-side end F[1..b], e[t-1..0] into r[0..b+t-1], taken from the path
- * that joins it to A alone (s = 0, s' = 1); returns log pr_m. */
-INLINE float path_eye_end(const SceneView *sc, const PathVertex *R, const PathVertex *F, int b, const PathVertex *e,
-			  int t, MisRecord *r)
+/* The eye-side end F[1..b], e[t-1..0] into E and its records r[0..b+t-1],
+ * taken from the path that joins it to A alone (s = 0, s' = 1). */
+INLINE void path_eye_end(const SceneView *sc, const PathVertex *R, const PathVertex *F, int b, const PathVertex *e,
+			 int t, MisEyeEnd *E, MisRecord *r)
 {
 	PathRef P;
 	MisVertex mv[4 * SUBPATH_MAX];
@@ -364,24 +437,52 @@ INLINE float path_eye_end(const SceneView *sc, const PathVertex *R, const PathVe
 	float lpsum[4 * SUBPATH_MAX], lpair_cur;
 	MisPortalSet set = path_portal_set(sc->params);
 	int need_pf = mis_needs_pf(set);
+	float beta = mis_beta(sc->params->mis);
 	path_ref(&P, 0, 0, R, 1, F, b, e, t);
-	path_records(sc, &P, sc->params->mis, set, P.k, mv, cross, lpsum, &lpair_cur);
+	path_records_part(sc, &P, sc->params->mis, set, P.k, mv, cross, lpsum, &lpair_cur, PATH_EYE_END);
+	int nr = P.k - 1;
 	for (int i = 1; i < P.k; i++)
 		mis_record_keep(&r[i - 1], mv, cross, lpsum, i, i + 1 < P.k, need_pf);
-	return fast_log(mis_remap0(mv[0].pr));
+	E->nr = nr;
+	E->lr_m = fast_log(mis_remap0(mv[0].pr));
+	/* FR[o] = PF[m+1+o] - PF[m+2] (o >= 1), RR[o] = PR[m+1+o] - PR[m+1] */
+	float FR[2 * SUBPATH_MAX + 1], RR[2 * SUBPATH_MAX + 1];
+	FR[1] = 0.0f;
+	RR[0] = 0.0f;
+	for (int o = 0; o < nr; o++) {
+		RR[o + 1] = RR[o] + r[o].lr;
+		if (o >= 1)
+			FR[o + 1] = FR[o] + r[o].lf;
+	}
+	E->pr_rest = RR[nr];
+	E->cur = FR[b] + RR[nr] - RR[b];
+	float x[2 * SUBPATH_MAX];
+	int nx = 0;
+	for (int o = 1; o < nr; o++) /* s' = m + 1 + o < k */
+		if (!(mis_record_delta(&r[o - 1]) || mis_record_delta(&r[o])) && !((r[o - 1].bits >> 1 & 1) && o == nr - 1))
+			x[nx++] = beta * (FR[o] - RR[o]);
+	E->bdpt = mis_logsumexp(x, nx);
+	nx = 0;
+	for (int tp = 1; tp <= nr - 1 && tp <= set.tp_max; tp++)
+		if (!(mis_record_delta(&r[tp - 1]) || mis_record_delta(&r[tp])) && nr - tp <= set.t_max)
+			x[nx++] = beta * (FR[tp] + RR[nr] - RR[tp]);
+	E->pair = mis_logsumexp(x, nx);
+	E->first_cross = nr;
+	for (int o = nr - 2; o >= 0; o--)
+		if (r[o].bits >> 2 > 0)
+			E->first_cross = o;
 }
 
-/* The weight of portal strategy cur for the path that joins light-side end
- * L to the eye-side end whose nr records are r (path_eye_end, lr_m its
- * return); x2 is the path's x_2, read when L->pn_from_x2. */
-INLINE float path_join_weight(const SceneView *sc, const MisLightEnd *L, const MisRecord *r, int nr, float lr_m,
-			      const PathVertex *x2, const PathVertex *R, MisStrategy cur)
+/* The weight of portal strategy cur for the path over the whole of both
+ * ends' records (mis_union_sum), for paths that cross portals twice. */
+INLINE float path_join_whole(const SceneView *sc, const MisLightEnd *L, const MisEyeEnd *E, const MisRecord *r,
+			     float lpn, MisStrategy cur)
 {
 	MisVertex v[4 * SUBPATH_MAX];
 	int cross[4 * SUBPATH_MAX];
 	float lf[4 * SUBPATH_MAX], lr[4 * SUBPATH_MAX], lpsum[4 * SUBPATH_MAX];
 	float PF[4 * SUBPATH_MAX + 1], PR[4 * SUBPATH_MAX + 1];
-	int m = L->m, k = m + 1 + nr;
+	int m = L->m, k = m + 1 + E->nr;
 	for (int i = 0; i < k; i++) {
 		const MisRecord *q = i <= m ? &L->r[i] : &r[i - m - 1];
 		lf[i] = q->lf;
@@ -391,14 +492,37 @@ INLINE float path_join_weight(const SceneView *sc, const MisLightEnd *L, const M
 		cross[i] = q->bits >> 2;
 		lpsum[i] = q->lpsum;
 	}
-	lr[m] = lr_m;
+	lr[m] = E->lr_m;
 	lf[m + 1] = L->lf_next;
-	float lpn = L->lpn;
-	if (L->pn_from_x2)
-		lpn = fast_log(mis_remap0(bdpt_nee_pdf(sc, &R[1], &R[0], x2)));
 	mis_prefix(lf, lr, k, PF, PR);
 	MisPortalSet set = path_portal_set(sc->params);
 	return mis_union_sum(v, k, k, PF, PR, lpn, cross, lpsum, L->lpair_cur, cur, set, sc->params->mis);
+}
+
+/* The weight of portal strategy cur (L's s and s', E's t' and t) for the
+ * path that joins light-side end L to eye-side end E, whose records are r;
+ * x2 is the path's x_2, read when L->pn_from_x2. */
+INLINE float path_join_weight(const SceneView *sc, const MisLightEnd *L, const MisEyeEnd *E, const MisRecord *r,
+			      const PathVertex *x2, const PathVertex *R, MisStrategy cur)
+{
+	int m = L->m;
+	float lpn = L->pn_from_x2 ? fast_log(mis_remap0(bdpt_nee_pdf(sc, &R[1], &R[0], x2))) : L->lpn;
+	MisPortalSet set = path_portal_set(sc->params);
+	if (L->other || E->first_cross < min(E->nr - 1, set.s_max + set.sp_max - m - 1))
+		return path_join_whole(sc, L, E, r, lpn, cur);
+	float beta = mis_beta(sc->params->mis);
+	float lcur = L->cur + L->lpair_cur + E->cur + set.lrate;
+	float pr_m1 = L->pr_m + E->lr_m;              /* PR[m + 1] */
+	float g = beta * (pr_m1 + E->pr_rest - lcur); /* beta (PR[k] - lcur) */
+	/* bdpt: s' <= m, s' = m + 1, s' >= m + 2 */
+	float lpf_m1 = m == 0 ? lpn : L->pf_m1; /* LPF(m + 1) */
+	float total = fast_exp(g + L->bdpt);
+	if (!(mis_record_delta(&L->r[m]) || mis_record_delta(&r[0])))
+		total += fast_exp(g + beta * (lpf_m1 - pr_m1));
+	total += fast_exp(g + beta * (L->pf_m1 + L->lf_next - pr_m1) + E->bdpt);
+	/* intermediate strategies pairing on edge m */
+	total += fast_exp(L->r[m].lpsum + beta * (set.lrate - lcur) + L->pair + E->pair);
+	return 1.0f / total;
 }
 
 #endif

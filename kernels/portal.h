@@ -206,7 +206,7 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 	/* Each end's MIS records, built once (path_mis.h, path_join_weight). */
 	int join = path_join_exact(path_portal_set(sc->params));
 	MisRecord rrec[PORTAL_RECORDS_MAX];
-	float rlr[PORTAL_RIGHT_MAX];
+	MisEyeEnd rend[PORTAL_RIGHT_MAX];
 	int b0 = 1, t0 = 1;
 	while (nR >= 2 && nF >= 2 && b0 < nF) {
 		int nr = 0, nrec = 0, ready = 0;
@@ -258,7 +258,7 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 				MisLightEnd L;
 				if (join) {
 					for (int j = 0, r = 0; !ready && j < nr; r += rb[j] + rt[j], j++)
-						rlr[j] = path_eye_end(sc, R, F, rb[j], e, rt[j], &rrec[r]);
+						path_eye_end(sc, R, F, rb[j], e, rt[j], &rend[j], &rrec[r]);
 					ready = 1;
 					path_light_end(sc, lp, s, R, a, F, e, &L);
 				}
@@ -269,8 +269,8 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 					MisStrategy cur = {2, s, s + a - 1, b};
 					float w;
 					if (join) {
-						w = path_join_weight(sc, &L, &rrec[r], b + t, rlr[j], b >= 2 ? &F[2] : &e[t - 1],
-								     R, cur);
+						w = path_join_weight(sc, &L, &rend[j], &rrec[r], b >= 2 ? &F[2] : &e[t - 1], R,
+								     cur);
 					} else {
 						PathRef P;
 						path_ref(&P, lp, s, R, a, F, b, e, t);
