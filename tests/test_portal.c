@@ -673,9 +673,6 @@ static void check_wasted(const char *path, const char *name)
 	host_scene_close(&h);
 }
 
-/* The rate of intermediate subpaths: 0.1 where the sky is the only light,
- * 0.25 with emitters, AJAR_PORTAL_RATE in (0, 1] overriding it, anything
- * else ignored with a warning. */
 /* The default strategy sets, and AJAR_PORTAL_SET taken whole or not at all. */
 static void test_portal_set(void **state)
 {
@@ -711,6 +708,9 @@ static void test_portal_set(void **state)
 	unsetenv("AJAR_PORTAL_SET");
 }
 
+/* The rate of intermediate subpaths: 0.1 where the sky is the only light,
+ * 0.5 with emitters, AJAR_PORTAL_RATE in (0, 1] overriding it, anything
+ * else ignored with a warning. */
 static void test_portal_rate(void **state)
 {
 	HostScene h;
@@ -718,10 +718,10 @@ static void test_portal_rate(void **state)
 	assert_float_equal(h.data.params->portal_rate, 0.1f, 0.0f);
 	host_scene_close(&h);
 	host_scene_open(&h, SCENE("door-ajar/door-ajar.gltf"), NULL, 8, 8, INTEGRATOR_PORTAL, 8);
-	assert_float_equal(h.data.params->portal_rate, 0.25f, 0.0f);
+	assert_float_equal(h.data.params->portal_rate, 0.5f, 0.0f);
 	host_scene_close(&h);
-	const char *rates[] = {"0.5", "1", "0", "1.5", "0.3x", ""};
-	const float expect[] = {0.5f, 1.0f, 0.1f, 0.1f, 0.1f, 0.1f};
+	const char *rates[] = {"0.25", "1", "0", "1.5", "0.3x", ""};
+	const float expect[] = {0.25f, 1.0f, 0.1f, 0.1f, 0.1f, 0.1f};
 	for (int i = 0; i < 6; i++) {
 		setenv("AJAR_PORTAL_RATE", rates[i], 1);
 		host_scene_open(&h, SCENE("window-room/window-room.gltf"), NULL, 8, 8, INTEGRATOR_PORTAL, 8);
