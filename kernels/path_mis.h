@@ -370,13 +370,32 @@ INLINE int path_join_exact(MisPortalSet set)
 	return set.light_paths && set.tp_max + set.t_max >= SUBPATH_MAX; /* k <= SUBPATH_MAX */
 }
 
+INLINE void mis_record_set(MisRecord *r, float lf, float lr, const MisVertex *v, const int *cross, const float *lpsum,
+			   int i, int edge)
+{
+	r->lf = lf;
+	r->lr = lr;
+	r->bits = (v[i].delta != 0) | (v[i].infinite != 0) << 1 | (edge ? cross[i] : 0) << 2;
+	r->lpsum = edge ? lpsum[i] : -AJAR_INF;
+}
+
 INLINE void mis_record_keep(MisRecord *r, const MisVertex *v, const int *cross, const float *lpsum, int i, int edge,
 			    int need_pf)
 {
-	r->lf = need_pf ? fast_log(mis_remap0(v[i].pf)) : 0.0f;
-	r->lr = fast_log(mis_remap0(v[i].pr));
-	r->bits = (v[i].delta != 0) | (v[i].infinite != 0) << 1 | (edge ? cross[i] : 0) << 2;
-	r->lpsum = edge ? lpsum[i] : -AJAR_INF;
+	mis_record_set(r, need_pf ? fast_log(mis_remap0(v[i].pf)) : 0.0f, fast_log(mis_remap0(v[i].pr)), v, cross,
+		       lpsum, i, edge);
+}
+
+/* Logs of the remapped stored densities of n subpath vertices, lpf and lpr
+ * in turn (lpf 0 unless need_pf): the eye-side ends of one intermediate
+ * subpath share most of their records, and reuse the logs of those that
+ * path_records left as stored. */
+INLINE void path_vertex_logs(const PathVertex *v, int n, int need_pf, float *out)
+{
+	for (int i = 0; i < n; i++) {
+		out[2 * i] = need_pf ? fast_log(mis_remap0(v[i].pf)) : 0.0f;
+		out[2 * i + 1] = fast_log(mis_remap0(v[i].pr));
+	}
 }
 
 /* The light-side end l[0..s-1], R[a..1] (lp = l, or the next-event sample
@@ -427,9 +446,10 @@ INLINE void path_light_end(const SceneView *sc, const PathVertex *lp, int s, con
 }
 
 /* The eye-side end F[1..b], e[t-1..0] into E and its records r[0..b+t-1],
- * taken from the path that joins it to A alone (s = 0, s' = 1). */
+ * taken from the path that joins it to A alone (s = 0, s' = 1); lF and lE
+ * are path_vertex_logs of F[0..b] and e[0..t-1]. */
 INLINE void path_eye_end(const SceneView *sc, const PathVertex *R, const PathVertex *F, int b, const PathVertex *e,
-			 int t, MisEyeEnd *E, MisRecord *r)
+			 int t, const float *lF, const float *lE, MisEyeEnd *E, MisRecord *r)
 {
 	PathRef P;
 	MisVertex mv[4 * SUBPATH_MAX];
@@ -441,8 +461,13 @@ INLINE void path_eye_end(const SceneView *sc, const PathVertex *R, const PathVer
 	path_ref(&P, 0, 0, R, 1, F, b, e, t);
 	path_records_part(sc, &P, sc->params->mis, set, P.k, mv, cross, lpsum, &lpair_cur, PATH_EYE_END);
 	int nr = P.k - 1;
-	for (int i = 1; i < P.k; i++)
-		mis_record_keep(&r[i - 1], mv, cross, lpsum, i, i + 1 < P.k, need_pf);
+	for (int i = 1; i < P.k; i++) {
+		const float *lv = i <= b ? &lF[2 * i] : &lE[2 * (t + b - i)]; /* x_i is F[i] or e[t + b - i] */
+		const PathVertex *xv = P.x[i];
+		float lf = !need_pf ? 0.0f : mv[i].pf == xv->pf ? lv[0] : fast_log(mis_remap0(mv[i].pf));
+		float lr = mv[i].pr == xv->pr ? lv[1] : fast_log(mis_remap0(mv[i].pr));
+		mis_record_set(&r[i - 1], lf, lr, mv, cross, lpsum, i, i + 1 < P.k);
+	}
 	E->nr = nr;
 	E->lr_m = fast_log(mis_remap0(mv[0].pr));
 	/* FR[o] = PF[m+1+o] - PF[m+2] (o >= 1), RR[o] = PR[m+1+o] - PR[m+1] */

@@ -207,6 +207,8 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 	int join = path_join_exact(path_portal_set(sc->params));
 	MisRecord rrec[PORTAL_RECORDS_MAX];
 	MisEyeEnd rend[PORTAL_RIGHT_MAX];
+	float lF[2 * SUBPATH_MAX], lE[2 * SUBPATH_MAX];
+	int logs = 0;
 	int b0 = 1, t0 = 1;
 	while (nR >= 2 && nF >= 2 && b0 < nF) {
 		int nr = 0, nrec = 0, ready = 0;
@@ -257,8 +259,14 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 					continue;
 				MisLightEnd L;
 				if (join) {
+					if (!logs) {
+						int need_pf = mis_needs_pf(path_portal_set(sc->params));
+						path_vertex_logs(F, nF, need_pf, lF);
+						path_vertex_logs(e, ne, need_pf, lE);
+						logs = 1;
+					}
 					for (int j = 0, r = 0; !ready && j < nr; r += rb[j] + rt[j], j++)
-						path_eye_end(sc, R, F, rb[j], e, rt[j], &rend[j], &rrec[r]);
+						path_eye_end(sc, R, F, rb[j], e, rt[j], lF, lE, &rend[j], &rrec[r]);
 					ready = 1;
 					path_light_end(sc, lp, s, R, a, F, e, &L);
 				}

@@ -194,6 +194,9 @@ static int check_join_weights(HostScene *h, int nsamples)
 		int ne = bdpt_eye_subpath(sc, px, py, e, depth + 1, &rng);
 		int nR, nF;
 		portal_intermediate(sc, R, &nR, F, &nF, &rng);
+		float lF[2 * SUBPATH_MAX], lE[2 * SUBPATH_MAX];
+		path_vertex_logs(F, nF, mis_needs_pf(path_portal_set(prm)), lF);
+		path_vertex_logs(e, ne, mis_needs_pf(path_portal_set(prm)), lE);
 		for (int a = 1; a < nR; a++)
 			for (int s = 0; s <= nl && s <= prm->portal_s_max; s++) {
 				if (s >= 1 && R[a].type != VERTEX_SURFACE)
@@ -211,7 +214,7 @@ static int check_join_weights(HostScene *h, int nsamples)
 					for (int t = 1; t <= ne && t <= prm->portal_t_max && s + a + b + t - 1 <= depth; t++) {
 						MisRecord r[2 * SUBPATH_MAX];
 						MisEyeEnd E;
-						path_eye_end(sc, R, F, b, e, t, &E, r);
+						path_eye_end(sc, R, F, b, e, t, lF, lE, &E, r);
 						MisStrategy cur = {2, s, s + a - 1, b};
 						PathRef P;
 						path_ref(&P, lp, s, R, a, F, b, e, t);
