@@ -149,12 +149,12 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	 * light, next-event estimation through the portals takes the direct
 	 * light, and short halves and eye parts of at most 3 vertices do best;
 	 * with emitters behind an opening (door-ajar) the intermediate
-	 * subpaths carry the indirect light, with halves of up to 4 vertices
-	 * and any eye part. AJAR_PORTAL_SET="s,s',t'[,t[,light paths]]"
+	 * subpaths carry the indirect light on both sides of it, with halves
+	 * and eye parts as long as the depth allows. AJAR_PORTAL_SET="s,s',t'[,t[,light paths]]"
 	 * overrides it for experiments, e.g. "32,32,32,33,1" for all of them. */
 	p->portal_s_max = 1;
-	p->portal_sp_max = p->light_paths ? 4 : 2;
-	p->portal_tp_max = p->light_paths ? 4 : 1;
+	p->portal_sp_max = p->light_paths ? AJAR_BIDIR_MAX_DEPTH : 2;
+	p->portal_tp_max = p->light_paths ? AJAR_BIDIR_MAX_DEPTH : 1;
 	p->portal_t_max = p->light_paths ? 1 << 20 : 3; /* any t, or 3 */
 	const char *set = getenv("AJAR_PORTAL_SET");
 	if (set) {

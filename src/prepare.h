@@ -31,7 +31,7 @@ typedef struct {
  * scenes lit only by the sky and with emitters (README, Results);
  * AJAR_PORTAL_RATE overrides them. */
 #define PORTAL_RATE_SKY 0.1f
-#define PORTAL_RATE_EMITTERS 0.5f
+#define PORTAL_RATE_EMITTERS 1.0f
 
 ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *out);
 void prepare_free(SceneData *d);

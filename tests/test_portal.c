@@ -685,11 +685,11 @@ static void test_portal_set(void **state)
 		int expect[5]; /* s, s', t', t, light paths */
 	} cases[] = {
 		{"window-room/window-room.gltf", NULL, {1, 2, 1, 3, 0}},
-		{"door-ajar/door-ajar.gltf", NULL, {1, 4, 4, 1 << 20, 1}},
+		{"door-ajar/door-ajar.gltf", NULL, {1, AJAR_BIDIR_MAX_DEPTH, AJAR_BIDIR_MAX_DEPTH, 1 << 20, 1}},
 		{"door-ajar/door-ajar.gltf", "2,4,5", {2, 4, 5, 1 << 20, 1}},
 		{"door-ajar/door-ajar.gltf", "1,2,2,4,0", {1, 2, 2, 4, 0}},
-		{"door-ajar/door-ajar.gltf", "2", {1, 4, 4, 1 << 20, 1}},       /* too short: ignored */
-		{"door-ajar/door-ajar.gltf", "1,0,1", {1, 4, 4, 1 << 20, 1}},   /* s' = 0: ignored */
+		{"door-ajar/door-ajar.gltf", "2", {1, AJAR_BIDIR_MAX_DEPTH, AJAR_BIDIR_MAX_DEPTH, 1 << 20, 1}},     /* too short: ignored */
+		{"door-ajar/door-ajar.gltf", "1,0,1", {1, AJAR_BIDIR_MAX_DEPTH, AJAR_BIDIR_MAX_DEPTH, 1 << 20, 1}}, /* s' = 0: ignored */
 		{"window-room/window-room.gltf", "3,2,1", {1, 2, 1, 3, 0}},     /* s > 1 needs light subpaths */
 	};
 	for (unsigned i = 0; i < sizeof cases / sizeof cases[0]; i++) {
@@ -712,7 +712,7 @@ static void test_portal_set(void **state)
 }
 
 /* The rate of intermediate subpaths: 0.1 where the sky is the only light,
- * 0.5 with emitters, AJAR_PORTAL_RATE in (0, 1] overriding it, anything
+ * 1 with emitters, AJAR_PORTAL_RATE in (0, 1] overriding it, anything
  * else ignored with a warning. */
 static void test_portal_rate(void **state)
 {
@@ -721,7 +721,7 @@ static void test_portal_rate(void **state)
 	assert_float_equal(h.data.params->portal_rate, 0.1f, 0.0f);
 	host_scene_close(&h);
 	host_scene_open(&h, SCENE("door-ajar/door-ajar.gltf"), NULL, 8, 8, INTEGRATOR_PORTAL, 8);
-	assert_float_equal(h.data.params->portal_rate, 0.5f, 0.0f);
+	assert_float_equal(h.data.params->portal_rate, 1.0f, 0.0f);
 	host_scene_close(&h);
 	const char *rates[] = {"0.25", "1", "0", "1.5", "0.3x", ""};
 	const float expect[] = {0.25f, 1.0f, 0.1f, 0.1f, 0.1f, 0.1f};
