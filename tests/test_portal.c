@@ -176,6 +176,20 @@ static void check_path(const SceneView *sc, const PathRef *P, MisStats *st)
 	st->portal_paths += any > 0;
 }
 
+/* The subpaths of random sample n (stream `seed`): light, eye (through a
+ * random point of the image) and intermediate, as a pixel sample traces
+ * them. */
+static void trace_subpaths(SceneView *sc, uint seed, int n, PathVertex *l, int *nl, PathVertex *e, int *ne,
+			   PathVertex *R, int *nR, PathVertex *F, int *nF)
+{
+	const Params *prm = sc->params;
+	Rng rng = rng_init(seed, (uint)n, 0, 3);
+	float px = rng_f(&rng) * prm->camera.width, py = rng_f(&rng) * prm->camera.height;
+	*nl = bdpt_light_subpath(sc, l, prm->max_depth, &rng);
+	*ne = bdpt_eye_subpath(sc, px, py, e, prm->max_depth + 1, &rng);
+	portal_intermediate(sc, R, nR, F, nF, &rng);
+}
+
 /* Weights joined from each end's records (path_join_weight, what the
  * kernel uses for sets with light subpaths) against path_union_weight for
  * every pair of ends of random intermediate subpaths: the same, bit for
@@ -188,12 +202,9 @@ static int check_join_weights(HostScene *h, int nsamples)
 	int depth = prm->max_depth, compared = 0, whole = 0;
 	assert_true(path_join_exact(path_portal_set(prm)));
 	for (int n = 0; n < nsamples; n++) {
-		Rng rng = rng_init(91, (uint)n, 0, 3);
-		float px = rng_f(&rng) * prm->camera.width, py = rng_f(&rng) * prm->camera.height;
-		int nl = bdpt_light_subpath(sc, l, depth, &rng);
-		int ne = bdpt_eye_subpath(sc, px, py, e, depth + 1, &rng);
-		int nR, nF;
-		portal_intermediate(sc, R, &nR, F, &nF, &rng);
+		int nl, ne, nR, nF;
+		trace_subpaths(sc, 91, n, l, &nl, e, &ne, R, &nR, F, &nF);
+		Rng rng = rng_init(92, (uint)n, 0, 3); /* next-event samples */
 		float lF[2 * SUBPATH_MAX], lE[2 * SUBPATH_MAX];
 		path_vertex_logs(F, nF, mis_needs_pf(path_portal_set(prm)), lF);
 		path_vertex_logs(e, ne, mis_needs_pf(path_portal_set(prm)), lE);
@@ -258,12 +269,9 @@ static MisStats check_scene_mis(HostScene *h, int nsamples)
 	MisStats st = {0, 0, 0, 0, 0, 0, 0};
 	int depth = prm->max_depth;
 	for (int n = 0; n < nsamples; n++) {
-		Rng rng = rng_init(77, (uint)n, 0, 3);
-		float px = rng_f(&rng) * prm->camera.width, py = rng_f(&rng) * prm->camera.height;
-		int nl = bdpt_light_subpath(sc, l, depth, &rng);
-		int ne = bdpt_eye_subpath(sc, px, py, e, depth + 1, &rng);
-		int nR, nF;
-		portal_intermediate(sc, R, &nR, F, &nF, &rng);
+		int nl, ne, nR, nF;
+		trace_subpaths(sc, 77, n, l, &nl, e, &ne, R, &nR, F, &nF);
+		Rng rng = rng_init(78, (uint)n, 0, 3); /* next-event samples */
 		PathRef P;
 		/* bdpt paths (s >= 2 connections and s = 0 hits; the light's own
 		 * first vertex stands in for s = 1) */
