@@ -338,6 +338,8 @@ typedef struct {
 } MisRecord;
 
 INLINE int mis_record_delta(const MisRecord *r) { return r->bits & 1; }
+INLINE int mis_record_infinite(const MisRecord *r) { return r->bits >> 1 & 1; }
+INLINE int mis_record_cross(const MisRecord *r) { return r->bits >> 2; }
 
 typedef struct {
 	MisRecord r[2 * SUBPATH_MAX]; /* x_0 .. x_m and edges 0 .. m */
@@ -400,14 +402,13 @@ INLINE void path_vertex_logs(const PathVertex *v, int n, int need_pf, float *out
 
 /* The light-side end l[0..s-1], R[a..1] (lp = l, or the next-event sample
  * when s = 1), taken from the path that joins it to F[1] and the camera. */
-INLINE void path_light_end(const SceneView *sc, const PathVertex *lp, int s, const PathVertex *R, int a,
-			   const PathVertex *F, const PathVertex *e, MisLightEnd *L)
+INLINE void path_light_end(const SceneView *sc, MisPortalSet set, const PathVertex *lp, int s, const PathVertex *R,
+			   int a, const PathVertex *F, const PathVertex *e, MisLightEnd *L)
 {
 	PathRef P;
 	MisVertex mv[4 * SUBPATH_MAX];
 	int cross[4 * SUBPATH_MAX];
 	float lpsum[4 * SUBPATH_MAX];
-	MisPortalSet set = path_portal_set(sc->params);
 	int need_pf = mis_needs_pf(set);
 	float beta = mis_beta(sc->params->mis);
 	path_ref(&P, lp, s, R, a, F, 1, e, 1);
@@ -442,20 +443,19 @@ INLINE void path_light_end(const SceneView *sc, const PathVertex *lp, int s, con
 	int S = set.s_max + set.sp_max; /* edges past it pair no strategy */
 	L->other = m >= S;
 	for (int i = 0; i < m && i < S; i++)
-		L->other |= L->r[i].bits >> 2 > 0;
+		L->other |= mis_record_cross(&L->r[i]) > 0;
 }
 
 /* The eye-side end F[1..b], e[t-1..0] into E and its records r[0..b+t-1],
  * taken from the path that joins it to A alone (s = 0, s' = 1); lF and lE
  * are path_vertex_logs of F[0..b] and e[0..t-1]. */
-INLINE void path_eye_end(const SceneView *sc, const PathVertex *R, const PathVertex *F, int b, const PathVertex *e,
-			 int t, const float *lF, const float *lE, MisEyeEnd *E, MisRecord *r)
+INLINE void path_eye_end(const SceneView *sc, MisPortalSet set, const PathVertex *R, const PathVertex *F, int b,
+			 const PathVertex *e, int t, const float *lF, const float *lE, MisEyeEnd *E, MisRecord *r)
 {
 	PathRef P;
 	MisVertex mv[4 * SUBPATH_MAX];
 	int cross[4 * SUBPATH_MAX];
 	float lpsum[4 * SUBPATH_MAX], lpair_cur;
-	MisPortalSet set = path_portal_set(sc->params);
 	int need_pf = mis_needs_pf(set);
 	float beta = mis_beta(sc->params->mis);
 	path_ref(&P, 0, 0, R, 1, F, b, e, t);
@@ -484,7 +484,7 @@ INLINE void path_eye_end(const SceneView *sc, const PathVertex *R, const PathVer
 	float x[2 * SUBPATH_MAX];
 	int nx = 0;
 	for (int o = 1; o < nr; o++) /* s' = m + 1 + o < k */
-		if (!(mis_record_delta(&r[o - 1]) || mis_record_delta(&r[o])) && !((r[o - 1].bits >> 1 & 1) && o == nr - 1))
+		if (!(mis_record_delta(&r[o - 1]) || mis_record_delta(&r[o])) && !(mis_record_infinite(&r[o - 1]) && o == nr - 1))
 			x[nx++] = beta * (FR[o] - RR[o]);
 	E->bdpt = mis_logsumexp(x, nx);
 	nx = 0;
@@ -494,14 +494,14 @@ INLINE void path_eye_end(const SceneView *sc, const PathVertex *R, const PathVer
 	E->pair = mis_logsumexp(x, nx);
 	E->first_cross = nr;
 	for (int o = nr - 2; o >= 0; o--)
-		if (r[o].bits >> 2 > 0)
+		if (mis_record_cross(&r[o]) > 0)
 			E->first_cross = o;
 }
 
 /* The weight of portal strategy cur for the path over the whole of both
  * ends' records (mis_union_sum), for paths that cross portals twice. */
-INLINE float path_join_whole(const SceneView *sc, const MisLightEnd *L, const MisEyeEnd *E, const MisRecord *r,
-			     float lpn, MisStrategy cur)
+INLINE float path_join_whole(const SceneView *sc, MisPortalSet set, const MisLightEnd *L, const MisEyeEnd *E,
+			     const MisRecord *r, float lpn, MisStrategy cur)
 {
 	MisVertex v[4 * SUBPATH_MAX];
 	int cross[4 * SUBPATH_MAX];
@@ -512,29 +512,28 @@ INLINE float path_join_whole(const SceneView *sc, const MisLightEnd *L, const Mi
 		const MisRecord *q = i <= m ? &L->r[i] : &r[i - m - 1];
 		lf[i] = q->lf;
 		lr[i] = q->lr;
-		v[i].delta = q->bits & 1;
-		v[i].infinite = q->bits >> 1 & 1;
-		cross[i] = q->bits >> 2;
+		v[i].delta = mis_record_delta(q);
+		v[i].infinite = mis_record_infinite(q);
+		cross[i] = mis_record_cross(q);
 		lpsum[i] = q->lpsum;
 	}
 	lr[m] = E->lr_m;
 	lf[m + 1] = L->lf_next;
 	mis_prefix(lf, lr, k, PF, PR);
-	MisPortalSet set = path_portal_set(sc->params);
 	return mis_union_sum(v, k, k, PF, PR, lpn, cross, lpsum, L->lpair_cur, cur, set, sc->params->mis);
 }
 
 /* The weight of portal strategy cur (L's s and s', E's t' and t) for the
  * path that joins light-side end L to eye-side end E, whose records are r;
- * x2 is the path's x_2, read when L->pn_from_x2. */
-INLINE float path_join_weight(const SceneView *sc, const MisLightEnd *L, const MisEyeEnd *E, const MisRecord *r,
-			      const PathVertex *x2, const PathVertex *R, MisStrategy cur)
+ * x2 is the path's x_2, read when L->pn_from_x2. set is
+ * path_portal_set(sc->params), which the caller makes once. */
+INLINE float path_join_weight(const SceneView *sc, MisPortalSet set, const MisLightEnd *L, const MisEyeEnd *E,
+			      const MisRecord *r, const PathVertex *x2, const PathVertex *R, MisStrategy cur)
 {
 	int m = L->m;
 	float lpn = L->pn_from_x2 ? fast_log(mis_remap0(bdpt_nee_pdf(sc, &R[1], &R[0], x2))) : L->lpn;
-	MisPortalSet set = path_portal_set(sc->params);
 	if (L->other || E->first_cross < min(E->nr - 1, set.s_max + set.sp_max - m - 1))
-		return path_join_whole(sc, L, E, r, lpn, cur);
+		return path_join_whole(sc, set, L, E, r, lpn, cur);
 	float beta = mis_beta(sc->params->mis);
 	float lcur = L->cur + L->lpair_cur + E->cur + set.lrate;
 	float pr_m1 = L->pr_m + E->lr_m;              /* PR[m + 1] */

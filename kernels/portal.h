@@ -204,7 +204,8 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 	int rb[PORTAL_RIGHT_MAX], rt[PORTAL_RIGHT_MAX];
 	uint rpix[PORTAL_RIGHT_MAX];
 	/* Each end's MIS records, built once (path_mis.h, path_join_weight). */
-	int join = path_join_exact(path_portal_set(sc->params));
+	MisPortalSet set = path_portal_set(sc->params);
+	int join = path_join_exact(set);
 	MisRecord rrec[PORTAL_RECORDS_MAX];
 	MisEyeEnd rend[PORTAL_RIGHT_MAX];
 	float lF[2 * SUBPATH_MAX], lE[2 * SUBPATH_MAX];
@@ -260,15 +261,14 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 				MisLightEnd L;
 				if (join) {
 					if (!logs) {
-						int need_pf = mis_needs_pf(path_portal_set(sc->params));
-						path_vertex_logs(F, nF, need_pf, lF);
-						path_vertex_logs(e, ne, need_pf, lE);
+						path_vertex_logs(F, nF, mis_needs_pf(set), lF);
+						path_vertex_logs(e, ne, mis_needs_pf(set), lE);
 						logs = 1;
 					}
 					for (int j = 0, r = 0; !ready && j < nr; r += rb[j] + rt[j], j++)
-						path_eye_end(sc, R, F, rb[j], e, rt[j], lF, lE, &rend[j], &rrec[r]);
+						path_eye_end(sc, set, R, F, rb[j], e, rt[j], lF, lE, &rend[j], &rrec[r]);
 					ready = 1;
-					path_light_end(sc, lp, s, R, a, F, e, &L);
+					path_light_end(sc, set, lp, s, R, a, F, e, &L);
 				}
 				for (int j = 0, r = 0; j < nr; r += rb[j] + rt[j], j++) {
 					int b = rb[j], t = rt[j];
@@ -277,8 +277,8 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 					MisStrategy cur = {2, s, s + a - 1, b};
 					float w;
 					if (join) {
-						w = path_join_weight(sc, &L, &rend[j], &rrec[r], b >= 2 ? &F[2] : &e[t - 1], R,
-								     cur);
+						w = path_join_weight(sc, set, &L, &rend[j], &rrec[r], b >= 2 ? &F[2] : &e[t - 1],
+								     R, cur);
 					} else {
 						PathRef P;
 						path_ref(&P, lp, s, R, a, F, b, e, t);

@@ -200,14 +200,15 @@ static int check_join_weights(HostScene *h, int nsamples)
 	Params *prm = h->data.params;
 	PathVertex l[SUBPATH_MAX], e[SUBPATH_MAX], R[SUBPATH_MAX], F[SUBPATH_MAX];
 	int depth = prm->max_depth, compared = 0, whole = 0;
-	assert_true(path_join_exact(path_portal_set(prm)));
+	MisPortalSet set = path_portal_set(prm);
+	assert_true(path_join_exact(set));
 	for (int n = 0; n < nsamples; n++) {
 		int nl, ne, nR, nF;
 		trace_subpaths(sc, 91, n, l, &nl, e, &ne, R, &nR, F, &nF);
 		Rng rng = rng_init(92, (uint)n, 0, 3); /* next-event samples */
 		float lF[2 * SUBPATH_MAX], lE[2 * SUBPATH_MAX];
-		path_vertex_logs(F, nF, mis_needs_pf(path_portal_set(prm)), lF);
-		path_vertex_logs(e, ne, mis_needs_pf(path_portal_set(prm)), lE);
+		path_vertex_logs(F, nF, mis_needs_pf(set), lF);
+		path_vertex_logs(e, ne, mis_needs_pf(set), lE);
 		for (int a = 1; a < nR; a++)
 			for (int s = 0; s <= nl && s <= prm->portal_s_max; s++) {
 				if (s >= 1 && R[a].type != VERTEX_SURFACE)
@@ -220,17 +221,17 @@ static int check_join_weights(HostScene *h, int nsamples)
 					lp = &y;
 				}
 				MisLightEnd L;
-				path_light_end(sc, lp, s, R, a, F, e, &L);
+				path_light_end(sc, set, lp, s, R, a, F, e, &L);
 				for (int b = 1; b < nF; b++)
 					for (int t = 1; t <= ne && t <= prm->portal_t_max && s + a + b + t - 1 <= depth; t++) {
 						MisRecord r[2 * SUBPATH_MAX];
 						MisEyeEnd E;
-						path_eye_end(sc, R, F, b, e, t, lF, lE, &E, r);
+						path_eye_end(sc, set, R, F, b, e, t, lF, lE, &E, r);
 						MisStrategy cur = {2, s, s + a - 1, b};
 						PathRef P;
 						path_ref(&P, lp, s, R, a, F, b, e, t);
 						float want = path_union_weight(sc, &P, cur);
-						float got = path_join_weight(sc, &L, &E, r, b >= 2 ? &F[2] : &e[t - 1], R, cur);
+						float got = path_join_weight(sc, set, &L, &E, r, b >= 2 ? &F[2] : &e[t - 1], R, cur);
 						if (!(fabs(got - want) <= 1e-5f + 1e-4f * want))
 							fail_msg("path (s=%d, s'=%d, t'=%d, t=%d): joined weight %.9g, whole path %.9g", s,
 								 a, b, t, got, want);
