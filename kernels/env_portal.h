@@ -27,6 +27,7 @@
 #define PORTAL_NEE_MIX 0.8f
 #define PORTAL_SA_MIN 1e-3f
 #define PORTAL_COS_MIN 0.1f
+#define PORTAL_W_KEPT 16
 
 /* Solid angle of the triangle with unit corner directions a, b, c, seen
  * from their origin (Van Oosterom and Strackee 1983). */
@@ -142,7 +143,8 @@ INLINE float env_portal_pdf_w(const SceneView *sc, V3 x, V3 n, V3 wi, float tota
 	for (int j = 0; j < sc->params->num_portals; j++) {
 		GLOBAL const PortalTri *pt = &sc->portals[j];
 		float w, t;
-		if (j == skip || !portal_env_facing(pt, x) ||
+		/* From the room side, only a ray toward the sky side meets the plane. */
+		if (j == skip || !portal_env_facing(pt, x) || !((float)pt->env_side * v3_dot(wi, pt->n) > 0.0f) ||
 		    !portal_tri_crossing(x, wi, AJAR_INF, pt->p0, pt->p1, pt->p2, &t) ||
 		    !((w = portal_env_weight(pt, x, n)) > 0.0f))
 			continue;
@@ -180,23 +182,27 @@ INLINE V3 env_nee_sample(const SceneView *sc, V3 x, V3 n, float u_mix, float u1,
 		*pdf_w = PORTAL_NEE_MIX * env_portal_pdf_w(sc, x, n, *wi, total, -1) + (1.0f - PORTAL_NEE_MIX) * pe;
 		return Le;
 	}
-	/* The triangle, by weight, in one pass that also sums the weights: k
-	 * replaces the pick with probability w_k over the sum so far, and the
-	 * number is rescaled to what is left of its interval. */
-	float u = u_mix / PORTAL_NEE_MIX, w = 0.0f;
-	int j = -1;
-	for (int k = 0; k < sc->params->num_portals; k++) {
+	/* The triangle, by weight: the weights and their sum first (they are
+	 * independent, so they pipeline), then a scan to u W. The first
+	 * PORTAL_W_KEPT weights are kept for the scan, the rest computed again.
+	 * (Picking in one pass, with the number rescaled at every step, chained
+	 * two divisions per triangle and cost more than the weights.) */
+	int np = sc->params->num_portals;
+	float kept[PORTAL_W_KEPT];
+	for (int k = 0; k < np; k++) {
 		float wk = portal_env_weight(&sc->portals[k], x, n);
-		if (!(wk > 0.0f))
-			continue;
+		if (k < PORTAL_W_KEPT)
+			kept[k] = wk;
 		total += wk;
-		float p = wk / total;
-		if (u < p) {
+	}
+	float target = u_mix / PORTAL_NEE_MIX * total, cum = 0.0f, w = 0.0f;
+	int j = -1;
+	for (int k = 0; k < np && cum <= target; k++) {
+		float wk = k < PORTAL_W_KEPT ? kept[k] : portal_env_weight(&sc->portals[k], x, n);
+		if (wk > 0.0f) { /* the last positive one if rounding leaves target >= the sum */
 			j = k;
 			w = wk;
-			u = u / p;
-		} else {
-			u = fmin((u - p) / (1.0f - p), 0.99999994f);
+			cum += wk;
 		}
 	}
 	if (j < 0) /* no portal shows x the sky */

@@ -26,7 +26,12 @@ static uint32_t rnd_u32(void)
 	return (xs >> rot) | (xs << ((-rot) & 31));
 }
 
-static float rnd(void) { return (float)(rnd_u32() >> 8) * (1.0f / 16777216.0f); }
+/* Uniform in the open interval (0, 1): a 0 would put a portal sample
+ * exactly on a triangle's corner or edge (sph_tri_sample), which the
+ * neighbouring triangles share, so that one direction would count as
+ * crossing several (measure zero, but the density checks compare each
+ * sample's density exactly). */
+static float rnd(void) { return ((float)(rnd_u32() >> 8) + 0.5f) * (1.0f / 16777216.0f); }
 
 #define ALPHA 1e-3 /* chi-square significance; fixed seeds make it reproducible */
 
@@ -662,6 +667,45 @@ static void test_light_sample_env_portal_near(void **state)
 	lit_free(&l);
 }
 
+/* A window cut into 24 triangles (a 4 x 3 grid of quads), more than
+ * env_nee_sample keeps weights for between its sum and its pick
+ * (PORTAL_W_KEPT): the rest are weighed again, and the pick must still
+ * follow the weights. */
+static void test_light_sample_env_portal_grid(void **state)
+{
+	rng_state = 29;
+	Lit l;
+	build_light_scene(&l);
+	assert_int_equal(scene_set_env_image(l.s, 40, 20, synthetic_sky(40, 20), 0.02f), AJAR_OK);
+	enum { NX = 4, NY = 3, NV = (NX + 1) * (NY + 1), NT = 2 * NX * NY };
+	float pos[3 * NV];
+	uint32_t idx[3 * NT];
+	for (int j = 0; j <= NY; j++)
+		for (int i = 0; i <= NX; i++) {
+			float *v = &pos[3 * (j * (NX + 1) + i)];
+			v[0] = -1.0f + 2.0f * (float)i / NX;
+			v[1] = -0.6f + 1.5f * (float)j / NY;
+			v[2] = 1.0f;
+		}
+	int t = 0;
+	for (int j = 0; j < NY; j++)
+		for (int i = 0; i < NX; i++) {
+			uint32_t a = (uint32_t)(j * (NX + 1) + i), b = a + 1, c = a + NX + 2, d = a + NX + 1;
+			uint32_t q[6] = {a, b, c, a, c, d};
+			for (int k = 0; k < 6; k++)
+				idx[3 * t + k] = q[k];
+			t += 2;
+		}
+	assert_true(NT > PORTAL_W_KEPT);
+	assert_int_equal(scene_add_portal(l.s, "grid", pos, NV, idx, NT), AJAR_OK);
+	lit_build(&l);
+	V3 x = v3(0.3f, 0.1f, 0.2f);
+	for (int j = 0; j < NT; j++)
+		l.s->portals[j].env_side = v3_dot(v3_sub(x, l.s->portals[j].p0), l.s->portals[j].n) > 0 ? -1 : 1;
+	check_light_sample(&l, x, v3_norm(v3(0.2f, -0.3f, 0.9f)), "+ portal grid");
+	lit_free(&l);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -675,6 +719,7 @@ int main(void)
 		cmocka_unit_test(test_light_sample_env_image),
 		cmocka_unit_test(test_light_sample_env_portals),
 		cmocka_unit_test(test_light_sample_env_portal_near),
+		cmocka_unit_test(test_light_sample_env_portal_grid),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
