@@ -122,27 +122,21 @@ INLINE int bdpt_visible(const SceneView *sc, const PathVertex *a, const PathVert
 
 /* f (with the shading-normal correction on light subpaths) times the
  * shading cosine toward wi, at a surface vertex v whose subpath
- * predecessor lies along v->wo, with v's BSDF bs; and the solid-angle
- * density *pdf_w of bs sampling wi. */
-INLINE V3 bdpt_scatter_bs(const Bsdf *bs, const PathVertex *v, V3 wi, int mode, float *pdf_w)
+ * predecessor lies along v->wo, from the BSDF the vertex keeps; and the
+ * solid-angle density *pdf_w of that BSDF sampling wi. */
+INLINE V3 bdpt_scatter_pdf(const PathVertex *v, V3 wi, int mode, float *pdf_w)
 {
-	V3 f = bsdf_eval_fwd(bs, v->wo, wi, mode, pdf_w);
+	V3 f = bsdf_eval_fwd(&v->bs, v->wo, wi, mode, pdf_w);
 	float k = fabs(v3_dot(v->ns, wi));
 	if (mode == BSDF_IMPORTANCE)
 		k *= vertex_shading_correction(v, v->wo, wi);
 	return v3_scale(f, k);
 }
 
-INLINE V3 bdpt_scatter_pdf(const SceneView *sc, const PathVertex *v, V3 wi, int mode, float *pdf_w)
-{
-	(void)sc;
-	return bdpt_scatter_bs(&v->bs, v, wi, mode, pdf_w);
-}
-
-INLINE V3 bdpt_scatter(const SceneView *sc, const PathVertex *v, V3 wi, int mode)
+INLINE V3 bdpt_scatter(const PathVertex *v, V3 wi, int mode)
 {
 	float pdf_w;
-	return bdpt_scatter_pdf(sc, v, wi, mode, &pdf_w);
+	return bdpt_scatter_pdf(v, wi, mode, &pdf_w);
 }
 
 /* Traces the light subpath into l[]; returns its vertex count (0 if the
@@ -253,29 +247,21 @@ INLINE void bdpt_add(const SceneView *sc, BdptFilm *out, int s, int t, V3 c, flo
 
 /* Connecting light vertex y (s >= 2) to eye vertex z (t >= 2), both on
  * surfaces: f_y G f_z without the betas, or 0 if occluded or either BSDF
- * is black toward the other. by and bz are their BSDFs when the caller
- * has them (one side stays the same over a loop of connections), else 0. */
-INLINE V3 bdpt_connect_bs(const SceneView *sc, const PathVertex *y, const Bsdf *by, const PathVertex *z,
-			  const Bsdf *bz)
+ * is black toward the other. */
+INLINE V3 bdpt_connect(const SceneView *sc, const PathVertex *y, const PathVertex *z)
 {
 	V3 d = v3_sub(z->p, y->p);
-	float d2 = v3_len2(d), pdf_w;
+	float d2 = v3_len2(d);
 	if (!(d2 > 0.0f))
 		return v3(0.0f, 0.0f, 0.0f);
 	V3 w = v3_scale(d, 1.0f / sqrt(d2));
-	V3 fy = by ? bdpt_scatter_bs(by, y, w, BSDF_IMPORTANCE, &pdf_w) : bdpt_scatter(sc, y, w, BSDF_IMPORTANCE);
+	V3 fy = bdpt_scatter(y, w, BSDF_IMPORTANCE);
 	if (v3_is_zero(fy))
 		return fy;
-	V3 fz = bz ? bdpt_scatter_bs(bz, z, v3_neg(w), BSDF_RADIANCE, &pdf_w)
-		   : bdpt_scatter(sc, z, v3_neg(w), BSDF_RADIANCE);
+	V3 fz = bdpt_scatter(z, v3_neg(w), BSDF_RADIANCE);
 	if (v3_is_zero(fz) || !bdpt_visible(sc, y, z))
 		return v3(0.0f, 0.0f, 0.0f);
 	return v3_scale(v3_mul(fy, fz), 1.0f / d2);
-}
-
-INLINE V3 bdpt_connect(const SceneView *sc, const PathVertex *y, const PathVertex *z)
-{
-	return bdpt_connect_bs(sc, y, 0, z, 0);
 }
 
 /* Light-side vertex y (its subpath predecessor along y->wo; `origin` if it
@@ -293,7 +279,7 @@ INLINE V3 bdpt_to_camera(const SceneView *sc, const PathVertex *y, int origin, c
 	V3 w = v3_scale(d, 1.0f / sqrt(d2));
 	if (!camera_raster(cam, v3_neg(w), &px, &py, &cos_c))
 		return zero;
-	V3 fy = origin ? v3_scale(bdpt_emitted(sc, y, w), fabs(v3_dot(y->ng, w))) : bdpt_scatter(sc, y, w, BSDF_IMPORTANCE);
+	V3 fy = origin ? v3_scale(bdpt_emitted(sc, y, w), fabs(v3_dot(y->ng, w))) : bdpt_scatter(y, w, BSDF_IMPORTANCE);
 	if (v3_is_zero(fy) || !bdpt_visible(sc, y, cam_v))
 		return zero;
 	*pixel = (uint)py * (uint)cam->width + (uint)px;
@@ -358,12 +344,11 @@ INLINE int bdpt_nee_visible(const SceneView *sc, const PathVertex *z, const Ligh
 	return segment_clear(sc, z->p, z->ng, ls->p, ls->n);
 }
 
-/* Next-event estimation at eye-side surface vertex z, whose BSDF is bz
- * and whose neighbour on the eye side is `from`: the light sample's vertex
+/* Next-event estimation at eye-side surface vertex z, whose neighbour on
+ * the eye side is `from`: the light sample's vertex
  * *y (with pr, z's density of sampling it, which MIS records need) and the
  * contribution from z's throughput on, 0 if occluded. */
-INLINE V3 bdpt_nee_bs(const SceneView *sc, const PathVertex *z, const PathVertex *from, const Bsdf *bz,
-		      PathVertex *y, Rng *rng)
+INLINE V3 bdpt_nee(const SceneView *sc, const PathVertex *z, const PathVertex *from, PathVertex *y, Rng *rng)
 {
 	LightSample ls;
 	float u0, u1, u2, pdf_w;
@@ -372,16 +357,11 @@ INLINE V3 bdpt_nee_bs(const SceneView *sc, const PathVertex *z, const PathVertex
 	if (!light_sample(sc, z->p, vertex_nee_normal(z, from), u0, u1, u2, &ls) || v3_is_zero(ls.Le))
 		return zero;
 	bdpt_light_vertex(y, &ls);
-	V3 f = bdpt_scatter_bs(bz, z, ls.wi, BSDF_RADIANCE, &pdf_w);
+	V3 f = bdpt_scatter_pdf(z, ls.wi, BSDF_RADIANCE, &pdf_w);
 	if (v3_is_zero(f) || !bdpt_nee_visible(sc, z, &ls))
 		return zero;
 	y->pr = vertex_density_a(z, y, pdf_w);
 	return v3_scale(v3_mul(v3_mul(z->beta, f), ls.Le), 1.0f / ls.pdf_w);
-}
-
-INLINE V3 bdpt_nee(const SceneView *sc, const PathVertex *z, const PathVertex *from, PathVertex *y, Rng *rng)
-{
-	return bdpt_nee_bs(sc, z, from, &z->bs, y, rng);
 }
 
 /* Every bdpt strategy of one light and one eye subpath: adds the eye
@@ -410,13 +390,13 @@ INLINE void bdpt_strategies(const SceneView *sc, PathVertex *l, int nl, PathVert
 		/* s = 1: next-event estimation with a fresh light sample. */
 		{
 			PathVertex y;
-			V3 c = bdpt_nee_bs(sc, z, &e[t - 2], &z->bs, &y, rng);
+			V3 c = bdpt_nee(sc, z, &e[t - 2], &y, rng);
 			if (!v3_is_zero(c))
 				bdpt_add(sc, out, 1, t, c, bdpt_weight(sc, &y, 1, e, t), out->pixel, rng);
 		}
 		/* s >= 2: light vertex s-1 to eye vertex t-1. */
 		for (int s = 2; s <= nl && s + t - 1 <= depth; s++) {
-			V3 c = bdpt_connect_bs(sc, &l[s - 1], 0, z, &z->bs);
+			V3 c = bdpt_connect(sc, &l[s - 1], z);
 			if (v3_is_zero(c))
 				continue;
 			bdpt_add(sc, out, s, t, v3_mul(v3_mul(l[s - 1].beta, c), z->beta), bdpt_weight(sc, l, s, e, t),

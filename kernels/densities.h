@@ -64,10 +64,8 @@ INLINE float bdpt_emission_pdf(const SceneView *sc, const PathVertex *l, const P
 
 /* Solid-angle density of `v`'s BSDF sampling `to`, given the vertex `from`
  * on its other side (wo), for the mode of the subpath v belongs to. */
-INLINE float bdpt_bsdf_pdf_w(const SceneView *sc, const PathVertex *v, const PathVertex *from, const PathVertex *to,
-			     int mode)
+INLINE float bdpt_bsdf_pdf_w(const PathVertex *v, const PathVertex *from, const PathVertex *to, int mode)
 {
-	(void)sc;
 	V3 wo = from->type == VERTEX_ENV ? from->p : v3_norm(v3_sub(from->p, v->p));
 	V3 wi = to->type == VERTEX_ENV ? to->p : v3_norm(v3_sub(to->p, v->p));
 	return bsdf_pdf_w(&v->bs, wo, wi); /* densities do not depend on the transport mode */
@@ -79,7 +77,7 @@ INLINE float bdpt_bsdf_pdf_w(const SceneView *sc, const PathVertex *v, const Pat
 INLINE float bdpt_pdf_a(const SceneView *sc, const PathVertex *v, const PathVertex *from, const PathVertex *to,
 			int mode)
 {
-	return vertex_density_a(v, to, bdpt_bsdf_pdf_w(sc, v, from, to, mode));
+	return vertex_density_a(v, to, bdpt_bsdf_pdf_w(v, from, to, mode));
 }
 
 #endif

@@ -162,11 +162,11 @@ INLINE void portal_add(const SceneView *sc, BdptFilm *out, int s, int sp, int tp
 	bdpt_film_add(sc, out, n, layer, t == 1, v3_scale(c, 1.0f / sc->params->portal_rate), w, pixel, rng);
 }
 
-/* The eye-side end of portal strategies: -> vertex F[b] (a surface, with
- * BSDF by) to eye vertex e[t-1] (t >= 2) or to the camera (t = 1): the
- * contribution from F[b]'s throughput on, and the pixel it lands in. */
-INLINE V3 portal_right(const SceneView *sc, const PathVertex *F, int b, const Bsdf *by, const PathVertex *e, int t,
-		       uint own_pixel, uint *pixel)
+/* The eye-side end of portal strategies: -> vertex F[b] (a surface) to
+ * eye vertex e[t-1] (t >= 2) or to the camera (t = 1): the contribution
+ * from F[b]'s throughput on, and the pixel it lands in. */
+INLINE V3 portal_right(const SceneView *sc, const PathVertex *F, int b, const PathVertex *e, int t, uint own_pixel,
+		       uint *pixel)
 {
 	const PathVertex *y = &F[b];
 	*pixel = own_pixel;
@@ -175,7 +175,7 @@ INLINE V3 portal_right(const SceneView *sc, const PathVertex *F, int b, const Bs
 	if (t >= 2) {
 		if (e[t - 1].type != VERTEX_SURFACE)
 			return v3(0.0f, 0.0f, 0.0f);
-		V3 c = bdpt_connect_bs(sc, y, by, &e[t - 1], 0);
+		V3 c = bdpt_connect(sc, y, &e[t - 1]);
 		return v3_mul(v3_mul(y->beta, c), e[t - 1].beta);
 	}
 	return bdpt_to_camera(sc, y, 0, &e[0], pixel);
@@ -220,8 +220,7 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 				if (nrec + b0 + t0 > PORTAL_RECORDS_MAX)
 					break;
 				uint pix;
-				V3 c = portal_right(sc, F, b0, F[b0].type == VERTEX_SURFACE ? &F[b0].bs : 0, e, t0,
-						    out->pixel, &pix);
+				V3 c = portal_right(sc, F, b0, e, t0, out->pixel, &pix);
 				if (v3_is_zero(c))
 					continue;
 				rc[nr] = c;

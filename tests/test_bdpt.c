@@ -56,10 +56,10 @@ static int check_mis(HostScene *h, int nsamples)
 					/* Both ends must scatter toward each other. */
 					if (s >= 2) {
 						V3 w = v3_norm(v3_sub(e[t - 1].p, l[s - 1].p));
-						if (v3_is_zero(bdpt_scatter(sc, &l[s - 1], w, BSDF_IMPORTANCE)))
+						if (v3_is_zero(bdpt_scatter(&l[s - 1], w, BSDF_IMPORTANCE)))
 							continue;
 					}
-					if (t >= 2 && v3_is_zero(bdpt_scatter(sc, &e[t - 1], oracle_dir(&e[t - 1], &l[s - 1]),
+					if (t >= 2 && v3_is_zero(bdpt_scatter(&e[t - 1], oracle_dir(&e[t - 1], &l[s - 1]),
 									   BSDF_RADIANCE)))
 						continue;
 				}

@@ -301,7 +301,7 @@ static MisStats check_scene_mis(HostScene *h, int nsamples)
 		for (int s = 1; s <= nl && s <= depth; s++) {
 			V3 w = v3_sub(e[0].p, l[s - 1].p);
 			if (l[s - 1].type == VERTEX_ENV ||
-			    (s >= 2 && v3_is_zero(bdpt_scatter(sc, &l[s - 1], v3_norm(w), BSDF_IMPORTANCE))))
+			    (s >= 2 && v3_is_zero(bdpt_scatter(&l[s - 1], v3_norm(w), BSDF_IMPORTANCE))))
 				continue;
 			path_ref(&P, l, s, 0, 0, 0, 0, e, 1);
 			check_path(sc, &P, &st);
