@@ -10,9 +10,8 @@
 #ifdef __OPENCL_C_VERSION__
 #define AJAR_DEVICE 1
 #define GLOBAL __global
-#define INLINE inline
-#define STATIC_INLINE static inline
-#define HOT_INLINE inline __attribute__((always_inline))
+/* Light paths splat into the image with 64-bit atomic adds (bdpt.h). */
+#pragma OPENCL EXTENSION cl_khr_int64_base_atomics : enable
 #define u2f(u) as_float(u)
 #define f2u(f) as_uint(f)
 #else
@@ -22,9 +21,6 @@
 typedef unsigned int uint;
 typedef unsigned long ulong;
 #define GLOBAL
-#define INLINE static inline
-#define STATIC_INLINE static inline
-#define HOT_INLINE static inline __attribute__((always_inline))
 static inline float u2f(uint u) { float f; memcpy(&f, &u, 4); return f; }
 static inline uint f2u(float f) { uint u; memcpy(&u, &f, 4); return u; }
 static inline int max(int a, int b) { return a > b ? a : b; }
@@ -33,6 +29,12 @@ static inline uint clz(uint x) { return x ? (uint)__builtin_clz(x) : 32u; }
 /* Host tests run kernels on one thread: a plain add is the atomic. */
 static inline long atom_add(long *p, long v) { long old = *p; *p += v; return old; }
 #endif
+
+/* static on the device too: OpenCL C 1.2 follows C99, where a plain
+ * `inline` definition provides no symbol, so a compiler that keeps a call
+ * (NVIDIA's with -cl-opt-disable) fails to link. */
+#define INLINE static inline
+#define HOT_INLINE static inline __attribute__((always_inline))
 
 #define AJAR_PI 3.14159265358979323846f
 #define AJAR_INV_PI 0.31830988618379067154f
