@@ -32,10 +32,10 @@ __kernel void render_pass(AJAR_SCENE_BUFFERS(AJAR_KERNEL_ARG) __global long *acc
 		float jx, jy;
 		rng_pixel(&rng, &jx, &jy);
 		V3 L;
-		if (params->integrator != INTEGRATOR_PT) {
+		if (PARAMS_INTEGRATOR(params) != INTEGRATOR_PT) {
 			BdptFilm out = {splat, splat + 3 * (ulong)cam->width * cam->height, pixel,
 					v3(0.0f, 0.0f, 0.0f)};
-			if (params->integrator == INTEGRATOR_PORTAL)
+			if (PARAMS_INTEGRATOR(params) == INTEGRATOR_PORTAL)
 				portal_sample_pixel(&sc, x + jx, y + jy, light, eye, back, fwd, &out, &rng);
 			else
 				bdpt_sample(&sc, x + jx, y + jy, light, eye, &out, &rng);

@@ -93,7 +93,7 @@ INLINE int bdpt_mis_path(const SceneView *sc, const PathVertex *l, int s, const 
  * in the portal integrator, over both families (path_mis.h). */
 INLINE float bdpt_weight(const SceneView *sc, const PathVertex *l, int s, const PathVertex *e, int t)
 {
-	if (sc->params->integrator == INTEGRATOR_PORTAL) {
+	if (PARAMS_INTEGRATOR(sc->params) == INTEGRATOR_PORTAL) {
 		PathRef P;
 		MisStrategy cur = {1, s, 0, 0};
 		path_ref(&P, l, s, 0, 0, 0, 0, e, t);

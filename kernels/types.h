@@ -105,6 +105,16 @@ typedef struct {
 #define INTEGRATOR_BDPT 1
 #define INTEGRATOR_PORTAL 2
 
+/* The integrator a program runs. The host builds one program per integrator
+ * (-DAJAR_INTEGRATOR=n), so a device compiles only the code it runs: GPU
+ * compilers take minutes over all three inlined into one kernel. Without the
+ * define (host tests, tools) it is read from Params. */
+#ifdef AJAR_INTEGRATOR
+#define PARAMS_INTEGRATOR(p) AJAR_INTEGRATOR
+#else
+#define PARAMS_INTEGRATOR(p) ((p)->integrator)
+#endif
+
 /* Everything about a render that is not an array. One per upload. */
 typedef struct {
 	Camera camera;          /* 0 */

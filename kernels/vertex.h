@@ -94,7 +94,7 @@ INLINE int vertex_trace(const SceneView *sc, PathVertex *path, int n, V3 o, V3 d
 {
 	PathVertex *prev = &path[n - 1], *v = &path[n];
 	Hit h = {0.0f, 0.0f, 0.0f, -1}; /* gcc cannot see bvh_intersect set it */
-	int portals = sc->params->integrator == INTEGRATOR_PORTAL;
+	int portals = PARAMS_INTEGRATOR(sc->params) == INTEGRATOR_PORTAL;
 	v->beta = beta;
 	v->wo = v3_neg(d);
 	v->delta = 0;

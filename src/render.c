@@ -32,6 +32,7 @@
 #include "device.h"
 #include "error.h"
 #include "exr.h"
+#include "kernel_source.h"
 #include "prepare.h"
 #include "scene.h"
 #include "render_info.h"
@@ -44,7 +45,6 @@
 #define DEFAULT_WIDTH 512
 #define MAX_RENDER_DEVICES 16
 
-extern const char ajar_kernel_source[];
 
 typedef struct {
 	uint32_t first, count;
@@ -211,8 +211,10 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 	ajar_status st;
 	cl_long zero = 0;
 	size_t bytes = film_bytes(r), sbytes = splat_bytes(r);
+	char options[64]; /* one program per integrator: see PARAMS_INTEGRATOR */
+	snprintf(options, sizeof options, KERNEL_OPTIONS "%d", r->data.params->integrator);
 	if ((st = device_open(d, plat, id)) != AJAR_OK ||
-	    (st = device_build(d, ajar_kernel_source, "-cl-std=CL1.2")) != AJAR_OK ||
+	    (st = device_build(d, ajar_kernel_source, options)) != AJAR_OK ||
 	    (st = device_kernel(d, "render_pass", &rd->k_render)) != AJAR_OK ||
 	    (st = upload_scene(d, &r->data, &rd->bufs)) != AJAR_OK ||
 	    (st = upload_bind(d, rd->k_render, &rd->bufs, &rd->arg_first)) != AJAR_OK ||

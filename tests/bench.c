@@ -12,11 +12,11 @@
 
 #include "ajar.h"
 #include "device.h"
+#include "kernel_source.h"
 #include "prepare.h"
 #include "scene.h"
 #include "upload.h"
 
-extern const char ajar_kernel_source[];
 
 static double now(void)
 {
@@ -122,7 +122,7 @@ static void bench_scene(const char *path, uint32_t spp)
 	check(prepare_scene(s, &po, &sd));
 	check(device_select(NULL, &plat, &id, 1, &ndev));
 	check(device_open(&d, plat, id));
-	check(device_build(&d, ajar_kernel_source, "-cl-std=CL1.2"));
+	check(device_build(&d, ajar_kernel_source, KERNEL_OPTIONS "0"));
 	double mrays = traversal_mrays(&sd, &d);
 	double msps = pt_msamples(s, 256, spp);
 	printf("%-34s %9u tris  load %6.2f s  BVH build %6.3f s  %7.1f MiB  %5u nodes/k-tri  "

@@ -19,11 +19,11 @@
 #include <unistd.h>
 
 #include "device.h"
+#include "kernel_source.h"
 #include "testutil.h"
 
-#define BASE_OPTIONS "-cl-std=CL1.2"
+#define BASE_OPTIONS KERNEL_OPTIONS "0"
 
-extern const char ajar_kernel_source[];
 extern const unsigned ajar_layout_host[];
 extern const unsigned ajar_layout_count;
 

@@ -4,9 +4,9 @@
 #include <stdlib.h>
 
 #include "device.h"
+#include "kernel_source.h"
 #include "testutil.h"
 
-extern const char ajar_kernel_source[];
 extern const unsigned ajar_layout_host[];
 extern const unsigned ajar_layout_count;
 
@@ -20,7 +20,7 @@ static void test_probe_matches_host(void **state)
 	cl_mem buf;
 	cl_uint *dev = calloc(ajar_layout_count, sizeof *dev);
 	if (device_select(NULL, &plat, &id, 1, &n) != AJAR_OK || device_open(&d, plat, id) != AJAR_OK ||
-	    device_build(&d, ajar_kernel_source, "-cl-std=CL1.2") != AJAR_OK)
+	    device_build(&d, ajar_kernel_source, KERNEL_OPTIONS "0") != AJAR_OK)
 		fail_msg("%s", ajar_last_error());
 	assert_int_equal(device_kernel(&d, "layout_probe", &k), AJAR_OK);
 	assert_int_equal(device_buffer(&d, CL_MEM_WRITE_ONLY, sizeof(cl_uint) * ajar_layout_count, NULL, &buf),

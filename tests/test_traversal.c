@@ -11,13 +11,13 @@
 
 #include "ajar.h"
 #include "device.h"
+#include "kernel_source.h"
 #include "prepare.h"
 #include "scene.h"
 #include "testutil.h"
 #include "upload.h"
 #include "../kernels/bvh.h"
 
-extern const char ajar_kernel_source[];
 
 #define GRID 24 /* quads per cube face edge */
 
@@ -115,7 +115,7 @@ static void test_closed_mesh_has_no_cracks(void **state)
 	cl_device_id id;
 	uint32_t ndev;
 	if (device_select(NULL, &plat, &id, 1, &ndev) != AJAR_OK || device_open(&d, plat, id) != AJAR_OK ||
-	    device_build(&d, ajar_kernel_source, "-cl-std=CL1.2") != AJAR_OK)
+	    device_build(&d, ajar_kernel_source, KERNEL_OPTIONS "0") != AJAR_OK)
 		fail_msg("%s", ajar_last_error());
 	SceneBuffers buf;
 	cl_kernel k;
