@@ -211,11 +211,27 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 	ajar_status st;
 	cl_long zero = 0;
 	size_t bytes = film_bytes(r), sbytes = splat_bytes(r);
-	char options[64]; /* one program per integrator: see PARAMS_INTEGRATOR */
-	snprintf(options, sizeof options, KERNEL_OPTIONS "%d", r->data.params->integrator);
-	if ((st = device_open(d, plat, id)) != AJAR_OK ||
-	    (st = device_build(d, ajar_kernel_source, options)) != AJAR_OK ||
-	    (st = device_kernel(d, "render_pass", &rd->k_render)) != AJAR_OK ||
+	/* One program per integrator (see PARAMS_INTEGRATOR), plus what
+	 * AJAR_CL_OPTIONS adds for a driver that needs it (README, GPUs). */
+	const char *extra = getenv("AJAR_CL_OPTIONS");
+	char options[512];
+	if (extra && strlen(extra) > 400)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "AJAR_CL_OPTIONS is %zu characters long; at most 400",
+			       strlen(extra));
+	snprintf(options, sizeof options, KERNEL_OPTIONS "%d %s", r->data.params->integrator, extra ? extra : "");
+	if ((st = device_open(d, plat, id)) != AJAR_OK)
+		return st;
+	if ((st = device_build(d, ajar_kernel_source, options)) != AJAR_OK) {
+		char *why = extra && extra[0] ? strdup(ajar_last_error()) : NULL;
+		if (why) {
+			for (size_t n = strlen(why); n > 0 && (why[n - 1] == '\n' || why[n - 1] == ' '); n--)
+				why[n - 1] = '\0';
+			err_set(st, "%s\n(the build options included AJAR_CL_OPTIONS='%s')", why, extra);
+		}
+		free(why);
+		return st;
+	}
+	if ((st = device_kernel(d, "render_pass", &rd->k_render)) != AJAR_OK ||
 	    (st = upload_scene(d, &r->data, &rd->bufs)) != AJAR_OK ||
 	    (st = upload_bind(d, rd->k_render, &rd->bufs, &rd->arg_first)) != AJAR_OK ||
 	    (st = device_buffer(d, CL_MEM_READ_WRITE, bytes, NULL, &rd->accum)) != AJAR_OK ||

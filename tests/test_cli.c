@@ -283,6 +283,39 @@ static void test_tiny_render(void **state)
 	free(png);
 }
 
+/* AJAR_CL_OPTIONS reaches the kernel build: -cl-opt-disable renders the
+ * same image bit for bit (on PoCL), and an option the driver refuses fails
+ * with exit 3, naming the variable, and writes nothing. */
+static void test_cl_options(void **state)
+{
+	(void)state;
+	char *a = path_in("opt.exr"), *b = path_in("noopt.exr"), *bad = path_in("bad.exr");
+	const char *const args_a[] = {"render", CORNELL, "-o", a, "--size", "16x16", "--spp", "2", "-q", NULL};
+	const char *const args_b[] = {"render", CORNELL, "-o", b, "--size", "16x16", "--spp", "2", "-q", NULL};
+	const char *const args_bad[] = {"render", CORNELL, "-o", bad, "--size", "16x16", "--spp", "2", NULL};
+	expect(args_a, 0, NULL);
+	assert_int_equal(setenv("AJAR_CL_OPTIONS", "-cl-opt-disable", 1), 0);
+	expect(args_b, 0, NULL);
+	float *pa, *pb;
+	uint32_t w, h;
+	assert_int_equal(ajar_read_exr(a, &pa, &w, &h), AJAR_OK);
+	assert_int_equal(ajar_read_exr(b, &pb, &w, &h), AJAR_OK);
+	assert_memory_equal(pa, pb, sizeof(float) * 4 * w * h);
+	free(pa);
+	free(pb);
+
+	assert_int_equal(setenv("AJAR_CL_OPTIONS", "-cl-ajar-no-such-option", 1), 0);
+	int entries = count_tmp_entries();
+	expect(args_bad, 3, "AJAR_CL_OPTIONS='-cl-ajar-no-such-option'");
+	assert_int_equal(count_tmp_entries(), entries);
+	assert_int_equal(unsetenv("AJAR_CL_OPTIONS"), 0);
+	unlink(a);
+	unlink(b);
+	free(a);
+	free(b);
+	free(bad);
+}
+
 static double now(void)
 {
 	struct timespec t;
@@ -344,6 +377,7 @@ int main(void)
 		cmocka_unit_test(test_bad_scenes),
 		cmocka_unit_test(test_info),
 		cmocka_unit_test(test_tiny_render),
+		cmocka_unit_test(test_cl_options),
 		cmocka_unit_test(test_sigint),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
