@@ -45,7 +45,6 @@
 #define DEFAULT_WIDTH 512
 #define MAX_RENDER_DEVICES 16
 
-
 typedef struct {
 	uint32_t first, count;
 } Range;

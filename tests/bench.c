@@ -17,7 +17,6 @@
 #include "scene.h"
 #include "upload.h"
 
-
 static double now(void)
 {
 	struct timespec ts;

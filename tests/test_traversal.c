@@ -18,7 +18,6 @@
 #include "upload.h"
 #include "../kernels/bvh.h"
 
-
 #define GRID 24 /* quads per cube face edge */
 
 /* A cube of GRID x GRID quads per face pushed out onto the unit sphere:
