@@ -121,10 +121,39 @@ HOT_INLINE void box_slab(float lo, float hi, float o, float inv_d, float *tn, fl
 
 /* Enters the boxes of node n's BVH_WIDTH slots within [0, tlim]: returns
  * the mask of the slots entered (bit i: slot i) and their entry distances
- * in tn[]. The slab tests are independent, so the compiler runs them side
- * by side (eight lanes: one AVX register). An unused slot's box at +inf is
- * never entered by a ray with finite origin and direction (bvh_traverse
- * refuses any other) within a finite tlim. */
+ * in tn[]. An unused slot's box at +inf is never entered by a ray with
+ * finite origin and direction (bvh_traverse refuses any other) within a
+ * finite tlim.
+ *
+ * The slab tests are independent, so they run side by side in eight lanes.
+ * Compiled for an x86 CPU with AVX (PoCL), the lanes are written out as
+ * float8: the compiler then keeps them in one register and takes the mask
+ * with one compare (a movmskps), where the loop below left it to spill the
+ * lanes and gather their bits one by one: 1.03-1.05x the incoherent rays
+ * per second on living-room and bathroom (make bench), 1.00-1.05x their
+ * renders. Both give the same bits: the same operations in the same order,
+ * and select() keeps box_slab's NaN behaviour. */
+#if defined(AJAR_DEVICE) && defined(__AVX__) && defined(__clang__) && BVH_WIDTH == 8
+HOT_INLINE void box_slab8(GLOBAL const float *lo, GLOBAL const float *hi, float o, float inv_d, float8 *tn,
+			  float8 *tf)
+{
+	float8 a = (vload8(0, lo) - o) * inv_d, b = (vload8(0, hi) - o) * inv_d;
+	int8 swap = a > b;
+	float8 near = select(a, b, swap), far = select(b, a, swap) * 1.00000036f;
+	*tn = select(*tn, near, near > *tn);
+	*tf = select(*tf, far, far < *tf);
+}
+
+HOT_INLINE int bvh_node_enter(const RayPre *r, GLOBAL const BvhNode *n, float tlim, float tn[BVH_WIDTH])
+{
+	float8 near = (float8)(0.0f), far = (float8)(tlim);
+	box_slab8(n->lo_x, n->hi_x, r->o.x, r->inv_d.x, &near, &far);
+	box_slab8(n->lo_y, n->hi_y, r->o.y, r->inv_d.y, &near, &far);
+	box_slab8(n->lo_z, n->hi_z, r->o.z, r->inv_d.z, &near, &far);
+	vstore8(near, 0, tn);
+	return __builtin_ia32_movmskps256(as_float8(near <= far));
+}
+#else
 HOT_INLINE int bvh_node_enter(const RayPre *r, GLOBAL const BvhNode *n, float tlim, float tn[BVH_WIDTH])
 {
 	float tf[BVH_WIDTH];
@@ -140,6 +169,7 @@ HOT_INLINE int bvh_node_enter(const RayPre *r, GLOBAL const BvhNode *n, float tl
 		m |= (tn[i] <= tf[i]) << i;
 	return m;
 }
+#endif
 
 /* Index of the lowest set bit of a nonzero mask. */
 HOT_INLINE int bvh_lowest(int m) { return 31 - (int)clz((uint)(m & -m)); }
