@@ -3,7 +3,8 @@
  * rays (dedicated kernel), path-tracing samples per second, and the cold and
  * warm start-up time of the CLI (a cold start has neither Ajar's nor PoCL's
  * kernel cache). Speeds vary between runs on shared machines; compare
- * figures from one run. */
+ * figures from one run. AJAR_BENCH_SCENES (equal-time part only) and
+ * AJAR_BENCH_FILES (per-scene figures only) pick what runs. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -286,6 +287,16 @@ int main(int argc, char **argv)
 	if (!mkdtemp(dir))
 		return 1;
 	printf("Ajar %s bench (device: first CPU device; one run, compare figures within it)\n", ajar_version());
+	/* AJAR_BENCH_FILES="a.gltf b.gltf": only the BVH, traversal and pt
+	 * figures, for those files (tests/peers/rays.py sets it). */
+	const char *files = getenv("AJAR_BENCH_FILES");
+	if (files) {
+		char list[4096];
+		snprintf(list, sizeof list, "%s", files);
+		for (char *save, *f = strtok_r(list, " ", &save); f; f = strtok_r(NULL, " ", &save))
+			bench_scene(f, 1);
+		return 0;
+	}
 	if (getenv("AJAR_BENCH_SCENES"))
 		goto equal_time;
 	bench_devices();

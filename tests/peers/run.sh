@@ -9,6 +9,7 @@
 # Python 3.11; the others accept that, so one environment serves all). Then
 # runs tests/peers/driver.py. Knobs: PEERS_SECONDS, PEERS_SCENES, PEERS_SIZE,
 # PEERS_REF_SECONDS, PEERS_DEPTH, PEERS_THREADS, PEERS_RENDERERS (driver.py).
+# `run.sh rays` instead compares Ajar's ray queries with Embree's (rays.py).
 set -eu
 cd "$(dirname "$0")/../.."
 
@@ -48,4 +49,8 @@ if [ -e /usr/lib/x86_64-linux-gnu/libLLVM-19.so ]; then
 fi
 # No __pycache__ in the source tree.
 export PYTHONDONTWRITEBYTECODE=1
+# `run.sh rays`: the ray queries alone against Embree's (rays.py).
+if [ "${1:-}" = rays ]; then
+	exec "$VENV/bin/python" tests/peers/rays.py
+fi
 exec "$VENV/bin/python" tests/peers/driver.py
