@@ -283,9 +283,6 @@ static void bench_equal_time(const char *path, uint32_t size, double seconds, do
 
 int main(int argc, char **argv)
 {
-	char dir[] = "/tmp/ajar-bench-XXXXXX";
-	if (!mkdtemp(dir))
-		return 1;
 	printf("Ajar %s bench (device: first CPU device; one run, compare figures within it)\n", ajar_version());
 	/* AJAR_BENCH_FILES="a.gltf b.gltf": only the BVH, traversal and pt
 	 * figures, for those files (tests/peers/rays.py sets it). */
@@ -297,6 +294,9 @@ int main(int argc, char **argv)
 			bench_scene(f, 1);
 		return 0;
 	}
+	char dir[] = "/tmp/ajar-bench-XXXXXX";
+	if (!mkdtemp(dir))
+		return 1;
 	if (getenv("AJAR_BENCH_SCENES"))
 		goto equal_time;
 	bench_devices();
