@@ -91,7 +91,7 @@ INLINE int bdpt_mis_path(const SceneView *sc, const PathVertex *l, int s, const 
 
 /* The weight of bdpt strategy (s, t): over the bdpt strategies alone, or,
  * in the portal integrator, over both families (path_mis.h). */
-INLINE float bdpt_weight(const SceneView *sc, const PathVertex *l, int s, const PathVertex *e, int t)
+CALLED float bdpt_weight(const SceneView *sc, const PathVertex *l, int s, const PathVertex *e, int t)
 {
 	if (PARAMS_INTEGRATOR(sc->params) == INTEGRATOR_PORTAL) {
 		PathRef P;
@@ -141,7 +141,7 @@ INLINE V3 bdpt_scatter(const PathVertex *v, V3 wi, int mode)
 
 /* Traces the light subpath into l[]; returns its vertex count (0 if the
  * scene has nothing to start from). */
-INLINE int bdpt_light_subpath(const SceneView *sc, PathVertex *l, int max_verts, Rng *rng)
+CALLED int bdpt_light_subpath(const SceneView *sc, PathVertex *l, int max_verts, Rng *rng)
 {
 	GLOBAL const Params *prm = sc->params;
 	float ps = prm->env_pdf_select;
@@ -248,7 +248,7 @@ INLINE void bdpt_add(const SceneView *sc, BdptFilm *out, int s, int t, V3 c, flo
 /* Connecting light vertex y (s >= 2) to eye vertex z (t >= 2), both on
  * surfaces: f_y G f_z without the betas, or 0 if occluded or either BSDF
  * is black toward the other. */
-INLINE V3 bdpt_connect(const SceneView *sc, const PathVertex *y, const PathVertex *z)
+CALLED V3 bdpt_connect(const SceneView *sc, const PathVertex *y, const PathVertex *z)
 {
 	V3 d = v3_sub(z->p, y->p);
 	float d2 = v3_len2(d);
@@ -288,7 +288,7 @@ INLINE V3 bdpt_to_camera(const SceneView *sc, const PathVertex *y, int origin, c
 }
 
 /* Light vertex s - 1 seen by the camera: splats its weighted contribution. */
-INLINE void bdpt_light_to_camera(const SceneView *sc, PathVertex *l, int s, PathVertex *cam_v, BdptFilm *out,
+CALLED void bdpt_light_to_camera(const SceneView *sc, PathVertex *l, int s, PathVertex *cam_v, BdptFilm *out,
 				 Rng *rng)
 {
 	uint pixel;
@@ -299,7 +299,7 @@ INLINE void bdpt_light_to_camera(const SceneView *sc, PathVertex *l, int s, Path
 
 /* Traces the eye subpath through raster point (px, py) into e[]; e[0] is
  * the camera. Returns its vertex count. */
-INLINE int bdpt_eye_subpath(const SceneView *sc, float px, float py, PathVertex *e, int max_verts, Rng *rng)
+CALLED int bdpt_eye_subpath(const SceneView *sc, float px, float py, PathVertex *e, int max_verts, Rng *rng)
 {
 	GLOBAL const Camera *cam = &sc->params->camera;
 	PathVertex *z0 = &e[0];
@@ -348,7 +348,7 @@ INLINE int bdpt_nee_visible(const SceneView *sc, const PathVertex *z, const Ligh
  * the eye side is `from`: the light sample's vertex
  * *y (with pr, z's density of sampling it, which MIS records need) and the
  * contribution from z's throughput on, 0 if occluded. */
-INLINE V3 bdpt_nee(const SceneView *sc, const PathVertex *z, const PathVertex *from, PathVertex *y, Rng *rng)
+CALLED V3 bdpt_nee(const SceneView *sc, const PathVertex *z, const PathVertex *from, PathVertex *y, Rng *rng)
 {
 	LightSample ls;
 	float u0, u1, u2, pdf_w;
@@ -366,7 +366,7 @@ INLINE V3 bdpt_nee(const SceneView *sc, const PathVertex *z, const PathVertex *f
 
 /* Every bdpt strategy of one light and one eye subpath: adds the eye
  * strategies to out->L and splats light tracing (t = 1). */
-INLINE void bdpt_strategies(const SceneView *sc, PathVertex *l, int nl, PathVertex *e, int ne, BdptFilm *out,
+CALLED void bdpt_strategies(const SceneView *sc, PathVertex *l, int nl, PathVertex *e, int ne, BdptFilm *out,
 			    Rng *rng)
 {
 	int depth = sc->params->max_depth;

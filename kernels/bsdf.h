@@ -358,7 +358,7 @@ INLINE V3 bsdf_eval_fwd(const Bsdf *bs, V3 wo, V3 wi, int mode, float *pdf_w)
 }
 
 /* bsdf_eval_fwd and pdf_rev_w of sampling wo given wi (for BDPT). */
-INLINE V3 bsdf_eval(const Bsdf *bs, V3 wo, V3 wi, int mode, float *pdf_w, float *pdf_rev_w)
+CALLED V3 bsdf_eval(const Bsdf *bs, V3 wo, V3 wi, int mode, float *pdf_w, float *pdf_rev_w)
 {
 	V3 lo, li;
 	float eta;
@@ -395,7 +395,7 @@ INLINE float bsdf_glass_delta_prob(const Bsdf *bs, V3 wo, float eta, int reflect
  * included) divided by |wi.n| (shading normal), so f |wi.n| / pdf_w is the
  * throughput; pdf_w and pdf_rev_w are then the probabilities of picking
  * that delta event from wo and from wi. */
-INLINE int bsdf_sample(const Bsdf *bs, V3 wo, float u0, float u1, float u2, int mode, BsdfSample *s)
+CALLED int bsdf_sample(const Bsdf *bs, V3 wo, float u0, float u1, float u2, int mode, BsdfSample *s)
 {
 	float so = bsdf_side(bs, wo);
 	if (so == 0.0f)

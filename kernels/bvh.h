@@ -270,13 +270,13 @@ INLINE int bvh_traverse(const SceneView *sc, V3 o, V3 d, float tmax, int any_hit
 }
 
 /* Closest hit with 0 < t < tmax; returns 1 if there is one. */
-INLINE int bvh_intersect(const SceneView *sc, V3 o, V3 d, float tmax, Hit *hit)
+CALLED int bvh_intersect(const SceneView *sc, V3 o, V3 d, float tmax, Hit *hit)
 {
 	return bvh_traverse(sc, o, d, tmax, 0, hit);
 }
 
 /* Whether anything lies on the ray with 0 < t < tmax. */
-INLINE int bvh_occluded(const SceneView *sc, V3 o, V3 d, float tmax)
+CALLED int bvh_occluded(const SceneView *sc, V3 o, V3 d, float tmax)
 {
 	Hit h;
 	return bvh_traverse(sc, o, d, tmax, 1, &h);

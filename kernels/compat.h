@@ -35,6 +35,17 @@ static inline long atom_add(long *p, long v) { long old = *p; *p += v; return ol
  * (NVIDIA's with -cl-opt-disable) fails to link. */
 #define INLINE static inline
 #define HOT_INLINE static inline __attribute__((always_inline))
+/* The large functions: traversal, subpaths, connections, MIS. With
+ * -DAJAR_CALLS they stay calls on the device. NVIDIA's OpenCL compiler did
+ * not finish bdpt's or portal's program in 5 minutes with everything
+ * inlined, and builds them in under half a minute this way (README, GPUs); the host
+ * adds it for bdpt and portal on devices that are not CPUs. On PoCL it
+ * costs 0-3%, so CPUs inline. */
+#if defined(AJAR_DEVICE) && defined(AJAR_CALLS)
+#define CALLED static __attribute__((noinline))
+#else
+#define CALLED static inline
+#endif
 
 #define AJAR_PI 3.14159265358979323846f
 #define AJAR_INV_PI 0.31830988618379067154f

@@ -137,7 +137,7 @@ INLINE float env_portal_term(GLOBAL const PortalTri *pt, float p_sel, float omeg
 
 /* The portal part of the density of wi from x: the sum over the portal
  * triangles the ray crosses, leaving out `skip` (-1 for none). */
-INLINE float env_portal_pdf_w(const SceneView *sc, V3 x, V3 n, V3 wi, float total, int skip)
+CALLED float env_portal_pdf_w(const SceneView *sc, V3 x, V3 n, V3 wi, float total, int skip)
 {
 	float p = 0.0f;
 	for (int j = 0; j < sc->params->num_portals; j++) {

@@ -96,7 +96,7 @@ INLINE int light_sample_emitter(const SceneView *sc, V3 x, float u, float u1, fl
  * power and a uniform point on it. Returns 0 when there is nothing to
  * sample or the sample cannot carry light (emitter seen from behind or
  * edge-on, zero distance, zero density); the caller then adds nothing. */
-INLINE int light_sample(const SceneView *sc, V3 x, V3 n, float u_sel, float u1, float u2, LightSample *ls)
+CALLED int light_sample(const SceneView *sc, V3 x, V3 n, float u_sel, float u1, float u2, LightSample *ls)
 {
 	float ps = sc->params->env_pdf_select;
 	ls->is_env = 0;

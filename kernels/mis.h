@@ -56,7 +56,7 @@ INLINE float mis_term(float r, int heuristic) { return heuristic == MIS_BALANCE 
  * v[0..k-1] among all strategies s' in [0, k-1] that can produce it (t' = 0
  * is impossible with a pinhole camera). The connection of s' joins
  * x_{s'-1} and x_{s'}; s' = 0 means the eye subpath hit the light. */
-INLINE float mis_path_weight(const MisVertex *v, int k, int s, int heuristic)
+CALLED float mis_path_weight(const MisVertex *v, int k, int s, int heuristic)
 {
 	/* x_0's density is pn for s' = 1 and pf for s' >= 2. */
 	float pn_pf = mis_remap0(v[0].pn) / mis_remap0(v[0].pf);
@@ -254,7 +254,7 @@ INLINE float mis_union_sum(const MisVertex *v, int k, int n, const float *PF, co
 }
 
 /* The same weight from the records v[0..n-1] themselves. */
-INLINE float mis_union_weight(const MisVertex *v, int k, int n, const int *cross, const float *lpsum, float lpair_cur,
+CALLED float mis_union_weight(const MisVertex *v, int k, int n, const int *cross, const float *lpsum, float lpair_cur,
 			      MisStrategy cur, MisPortalSet set, int heuristic)
 {
 	float lf[4 * 33], lr[4 * 33], PF[4 * 33 + 1], PR[4 * 33 + 1];

@@ -283,7 +283,7 @@ INLINE void path_records_part(const SceneView *sc, const PathRef *P, int heurist
  * crossings and pair densities (lpsum, lpair_cur as in mis_union_weight)
  * of the edges the weights read: what mis_union_weight needs for the
  * strategies in `set`. */
-INLINE void path_records(const SceneView *sc, const PathRef *P, int heuristic, MisPortalSet set, int n, MisVertex *mv,
+CALLED void path_records(const SceneView *sc, const PathRef *P, int heuristic, MisPortalSet set, int n, MisVertex *mv,
 			 int *cross, float *lpsum, float *lpair_cur)
 {
 	path_records_part(sc, P, heuristic, set, n, mv, cross, lpsum, lpair_cur, PATH_WHOLE);
@@ -296,7 +296,7 @@ INLINE MisPortalSet path_portal_set(GLOBAL const Params *prm)
 	return set;
 }
 
-INLINE float path_union_weight(const SceneView *sc, const PathRef *P, MisStrategy cur)
+CALLED float path_union_weight(const SceneView *sc, const PathRef *P, MisStrategy cur)
 {
 	MisVertex mv[4 * SUBPATH_MAX];
 	int cross[4 * SUBPATH_MAX];
@@ -402,7 +402,7 @@ INLINE void path_vertex_logs(const PathVertex *v, int n, int need_pf, float *out
 
 /* The light-side end l[0..s-1], R[a..1] (lp = l, or the next-event sample
  * when s = 1), taken from the path that joins it to F[1] and the camera. */
-INLINE void path_light_end(const SceneView *sc, MisPortalSet set, const PathVertex *lp, int s, const PathVertex *R,
+CALLED void path_light_end(const SceneView *sc, MisPortalSet set, const PathVertex *lp, int s, const PathVertex *R,
 			   int a, const PathVertex *F, const PathVertex *e, MisLightEnd *L)
 {
 	PathRef P;
@@ -449,7 +449,7 @@ INLINE void path_light_end(const SceneView *sc, MisPortalSet set, const PathVert
 /* The eye-side end F[1..b], e[t-1..0] into E and its records r[0..b+t-1],
  * taken from the path that joins it to A alone (s = 0, s' = 1); lF and lE
  * are path_vertex_logs of F[0..b] and e[0..t-1]. */
-INLINE void path_eye_end(const SceneView *sc, MisPortalSet set, const PathVertex *R, const PathVertex *F, int b,
+CALLED void path_eye_end(const SceneView *sc, MisPortalSet set, const PathVertex *R, const PathVertex *F, int b,
 			 const PathVertex *e, int t, const float *lF, const float *lE, MisEyeEnd *E, MisRecord *r)
 {
 	PathRef P;
@@ -527,7 +527,7 @@ INLINE float path_join_whole(const SceneView *sc, MisPortalSet set, const MisLig
  * path that joins light-side end L to eye-side end E, whose records are r;
  * x2 is the path's x_2, read when L->pn_from_x2. set is
  * path_portal_set(sc->params), which the caller makes once. */
-INLINE float path_join_weight(const SceneView *sc, MisPortalSet set, const MisLightEnd *L, const MisEyeEnd *E,
+CALLED float path_join_weight(const SceneView *sc, MisPortalSet set, const MisLightEnd *L, const MisEyeEnd *E,
 			      const MisRecord *r, const PathVertex *x2, const PathVertex *R, MisStrategy cur)
 {
 	int m = L->m;

@@ -92,7 +92,7 @@ INLINE int portal_guided_reached(const SceneView *sc, const PathVertex *A, V3 w0
 /* Traces both halves; returns the vertex counts of R and F (each >= 2 when
  * the half has a first vertex, counting the copy at index 0), or 0 when
  * the sample is wasted. */
-INLINE void portal_intermediate(const SceneView *sc, PathVertex *R, int *nR, PathVertex *F, int *nF, Rng *rng)
+CALLED void portal_intermediate(const SceneView *sc, PathVertex *R, int *nR, PathVertex *F, int *nF, Rng *rng)
 {
 	GLOBAL const Params *prm = sc->params;
 	int depth = prm->max_depth;
@@ -165,7 +165,7 @@ INLINE void portal_add(const SceneView *sc, BdptFilm *out, int s, int sp, int tp
 /* The eye-side end of portal strategies: -> vertex F[b] (a surface) to
  * eye vertex e[t-1] (t >= 2) or to the camera (t = 1): the contribution
  * from F[b]'s throughput on, and the pixel it lands in. */
-INLINE V3 portal_right(const SceneView *sc, const PathVertex *F, int b, const PathVertex *e, int t, uint own_pixel,
+CALLED V3 portal_right(const SceneView *sc, const PathVertex *F, int b, const PathVertex *e, int t, uint own_pixel,
 		       uint *pixel)
 {
 	const PathVertex *y = &F[b];

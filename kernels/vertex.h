@@ -89,7 +89,7 @@ INLINE float vertex_shading_correction(const PathVertex *v, V3 wo, V3 wi)
  * light subpaths and the portal's -> half). A ray that escapes becomes an
  * environment vertex if `escape_env` and the scene has one. Returns 1 if
  * a vertex was appended. */
-INLINE int vertex_trace(const SceneView *sc, PathVertex *path, int n, V3 o, V3 d, V3 beta, float pdf_w,
+CALLED int vertex_trace(const SceneView *sc, PathVertex *path, int n, V3 o, V3 d, V3 beta, float pdf_w,
 			int parallel, int light_side, int escape_env)
 {
 	PathVertex *prev = &path[n - 1], *v = &path[n];
@@ -180,7 +180,7 @@ INLINE int vertex_scatter(const SceneView *sc, PathVertex *path, int n, int ligh
  * until max_verts vertices, a miss, or Russian roulette. beta_ref is the
  * roulette's reference throughput; 0 takes the throughput after the first
  * scattering (camera walks, roulette.h). Returns the new vertex count. */
-INLINE int vertex_extend(const SceneView *sc, PathVertex *path, int n, int max_verts, int light_side,
+CALLED int vertex_extend(const SceneView *sc, PathVertex *path, int n, int max_verts, int light_side,
 			 int escape_env, float beta_ref, Rng *rng)
 {
 	V3 o, d, beta;
@@ -199,7 +199,7 @@ INLINE int vertex_extend(const SceneView *sc, PathVertex *path, int n, int max_v
  * BSDF sampling (vertex_trace and vertex_extend). The roulette of a light
  * walk is relative to its starting throughput, that of a camera walk to the
  * throughput after its first scattering. */
-INLINE int vertex_walk(const SceneView *sc, PathVertex *path, int n, int max_verts, V3 o, V3 d, V3 beta,
+CALLED int vertex_walk(const SceneView *sc, PathVertex *path, int n, int max_verts, V3 o, V3 d, V3 beta,
 		       float pdf_w, int parallel, int light_side, int escape_env, Rng *rng)
 {
 	if (n >= max_verts || !vertex_trace(sc, path, n, o, d, beta, pdf_w, parallel, light_side, escape_env))

@@ -210,16 +210,19 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 	ajar_status st;
 	cl_long zero = 0;
 	size_t bytes = film_bytes(r), sbytes = splat_bytes(r);
-	/* One program per integrator (see PARAMS_INTEGRATOR), plus what
-	 * AJAR_CL_OPTIONS adds for a driver that needs it (README, GPUs). */
+	/* One program per integrator (see PARAMS_INTEGRATOR); bdpt's and
+	 * portal's large functions stay calls except on CPUs (CALLED in
+	 * kernels/compat.h); then what AJAR_CL_OPTIONS adds (README, GPUs). */
 	const char *extra = getenv("AJAR_CL_OPTIONS");
 	char options[512];
 	if (extra && strlen(extra) > 400)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "AJAR_CL_OPTIONS is %zu characters long; at most 400",
 			       strlen(extra));
-	snprintf(options, sizeof options, KERNEL_OPTIONS "%d %s", r->data.params->integrator, extra ? extra : "");
 	if ((st = device_open(d, plat, id)) != AJAR_OK)
 		return st;
+	int calls = !d->is_cpu && r->data.params->integrator != INTEGRATOR_PT;
+	snprintf(options, sizeof options, KERNEL_OPTIONS "%d%s %s", r->data.params->integrator,
+		 calls ? " -DAJAR_CALLS" : "", extra ? extra : "");
 	if ((st = device_build(d, ajar_kernel_source, options)) != AJAR_OK) {
 		char *why = extra && extra[0] ? strdup(ajar_last_error()) : NULL;
 		if (why) {
