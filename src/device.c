@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include "error.h"
+#include "kernel_source.h"
 
 #define MAX_PLATFORMS 16
 #define MAX_DEVICES 64
@@ -232,6 +233,15 @@ ajar_status device_open(Device *d, cl_platform_id platform, cl_device_id id)
 	clGetDeviceInfo(id, CL_DEVICE_NAME, sizeof d->name - 1, d->name, NULL);
 	clGetDeviceInfo(id, CL_DEVICE_TYPE, sizeof t, &t, NULL);
 	d->is_cpu = (t & CL_DEVICE_TYPE_CPU) != 0;
+	size_t n = 0;
+	if (clGetDeviceInfo(id, CL_DEVICE_EXTENSIONS, 0, NULL, &n) == CL_SUCCESS && n > 0) {
+		char *ext = malloc(n + 1);
+		if (ext && clGetDeviceInfo(id, CL_DEVICE_EXTENSIONS, n, ext, NULL) == CL_SUCCESS) {
+			ext[n] = '\0';
+			d->nv_options = strstr(ext, "cl_nv_compiler_options") != NULL;
+		}
+		free(ext);
+	}
 	device_selector_of(id, d->selector, sizeof d->selector);
 	cl_context_properties props[] = {CL_CONTEXT_PLATFORM, (cl_context_properties)platform, 0};
 	d->ctx = clCreateContext(props, 1, &id, NULL, NULL, &err);
@@ -404,6 +414,23 @@ static ajar_status build_failed(Device *d, cl_int err)
 	}
 	free(log);
 	return AJAR_ERROR_DEVICE;
+}
+
+void device_build_options(const Device *d, int integrator, int bidirectional, const char *extra, char *buf,
+			  size_t cap)
+{
+	/* bdpt's and portal's large functions stay calls on GPUs (CALLED in
+	 * kernels/compat.h): inlined, NVIDIA's compiler did not finish them.
+	 * On NVIDIA a register cap raises the work-items in flight by more
+	 * than the spills cost. H100, Msamples/s, no cap / 40 / 32 registers
+	 * (same images bit for bit): living-room pt 45.2 / 48.2 / 43.5, bdpt
+	 * 2.95 / 3.71 / 3.47, portal 4.58 / 5.30 / 5.06; door-ajar portal
+	 * 0.366 / 0.461 / 0.501; bathroom bdpt 2.10 / 2.24 / 2.62. */
+	char regs[40] = "";
+	if (d->nv_options)
+		snprintf(regs, sizeof regs, " -cl-nv-maxrregcount=%d", bidirectional ? 32 : 40);
+	snprintf(buf, cap, KERNEL_OPTIONS "%d%s%s %s", integrator, bidirectional && !d->is_cpu ? " -DAJAR_CALLS" : "",
+		 regs, extra ? extra : "");
 }
 
 ajar_status device_build(Device *d, const char *source, const char *options)

@@ -210,9 +210,8 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 	ajar_status st;
 	cl_long zero = 0;
 	size_t bytes = film_bytes(r), sbytes = splat_bytes(r);
-	/* One program per integrator (see PARAMS_INTEGRATOR); bdpt's and
-	 * portal's large functions stay calls except on CPUs (CALLED in
-	 * kernels/compat.h); then what AJAR_CL_OPTIONS adds (README, GPUs). */
+	/* One program per integrator (see PARAMS_INTEGRATOR), built with
+	 * device_build_options and what AJAR_CL_OPTIONS adds (README, GPUs). */
 	const char *extra = getenv("AJAR_CL_OPTIONS");
 	char options[512];
 	if (extra && strlen(extra) > 400)
@@ -220,9 +219,8 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 			       strlen(extra));
 	if ((st = device_open(d, plat, id)) != AJAR_OK)
 		return st;
-	int calls = !d->is_cpu && r->data.params->integrator != INTEGRATOR_PT;
-	snprintf(options, sizeof options, KERNEL_OPTIONS "%d%s %s", r->data.params->integrator,
-		 calls ? " -DAJAR_CALLS" : "", extra ? extra : "");
+	device_build_options(d, r->data.params->integrator, r->data.params->integrator != INTEGRATOR_PT, extra,
+			     options, sizeof options);
 	if ((st = device_build(d, ajar_kernel_source, options)) != AJAR_OK) {
 		char *why = extra && extra[0] ? strdup(ajar_last_error()) : NULL;
 		if (why) {

@@ -3,7 +3,8 @@
  * source and options loads it and the program runs; other options get
  * their own file; a corrupted file is detected, rebuilt and replaced by a
  * good binary; AJAR_CACHE_DIR=off neither reads nor writes; the directory
- * falls back to $XDG_CACHE_HOME/ajar, then ~/.cache/ajar.
+ * falls back to $XDG_CACHE_HOME/ajar, then ~/.cache/ajar; and the build
+ * options each kind of device gets.
  *
  * Every test gets a fresh cache directory under one temporary root. PoCL
  * keeps a cache of its own, so POCL_CACHE_DIR points into the root too
@@ -280,6 +281,28 @@ static void test_off_disables_the_cache(void **state)
 	free(dir);
 }
 
+/* The options each kind of device builds each integrator with (0 pt,
+ * 1 bdpt, 2 portal): calls for the bidirectional ones off CPUs, NVIDIA's
+ * register cap where the device takes it, AJAR_CL_OPTIONS last. */
+static void test_build_options(void **state)
+{
+	(void)state;
+	char buf[512];
+	Device cpu = {.is_cpu = 1}, gpu = {.is_cpu = 0}, nvidia = {.is_cpu = 0, .nv_options = 1};
+	device_build_options(&cpu, 0, 0, NULL, buf, sizeof buf);
+	assert_string_equal(buf, KERNEL_OPTIONS "0 ");
+	device_build_options(&cpu, 2, 1, "-cl-opt-disable", buf, sizeof buf);
+	assert_string_equal(buf, KERNEL_OPTIONS "2 -cl-opt-disable");
+	device_build_options(&gpu, 0, 0, NULL, buf, sizeof buf);
+	assert_string_equal(buf, KERNEL_OPTIONS "0 ");
+	device_build_options(&gpu, 1, 1, NULL, buf, sizeof buf);
+	assert_string_equal(buf, KERNEL_OPTIONS "1 -DAJAR_CALLS ");
+	device_build_options(&nvidia, 0, 0, NULL, buf, sizeof buf);
+	assert_string_equal(buf, KERNEL_OPTIONS "0 -cl-nv-maxrregcount=40 ");
+	device_build_options(&nvidia, 2, 1, "-UAJAR_CALLS -cl-nv-maxrregcount=255", buf, sizeof buf);
+	assert_string_equal(buf, KERNEL_OPTIONS "2 -DAJAR_CALLS -cl-nv-maxrregcount=32 -UAJAR_CALLS -cl-nv-maxrregcount=255");
+}
+
 static void test_directory_fallbacks(void **state)
 {
 	char buf[512];
@@ -319,6 +342,7 @@ int main(void)
 		cmocka_unit_test(test_corrupt_file_is_rebuilt),
 		cmocka_unit_test(test_off_disables_the_cache),
 		cmocka_unit_test(test_directory_fallbacks),
+		cmocka_unit_test(test_build_options),
 	};
 	int rc = cmocka_run_group_tests_name("cache", tests, NULL, NULL);
 	test_remove_tree(root);
