@@ -19,6 +19,7 @@
 
 #include "error.h"
 #include "kernel_source.h"
+#include "../kernels/types.h"
 
 #define MAX_PLATFORMS 16
 #define MAX_DEVICES 64
@@ -416,8 +417,7 @@ static ajar_status build_failed(Device *d, cl_int err)
 	return AJAR_ERROR_DEVICE;
 }
 
-void device_build_options(const Device *d, int integrator, int bidirectional, const char *extra, char *buf,
-			  size_t cap)
+void device_build_options(const Device *d, int integrator, const char *extra, char *buf, size_t cap)
 {
 	/* bdpt's and portal's large functions stay calls on GPUs (CALLED in
 	 * kernels/compat.h): inlined, NVIDIA's compiler did not finish them.
@@ -426,6 +426,7 @@ void device_build_options(const Device *d, int integrator, int bidirectional, co
 	 * (same images bit for bit): living-room pt 45.2 / 48.2 / 43.5, bdpt
 	 * 2.95 / 3.71 / 3.47, portal 4.58 / 5.30 / 5.06; door-ajar portal
 	 * 0.366 / 0.461 / 0.501; bathroom bdpt 2.10 / 2.24 / 2.62. */
+	int bidirectional = integrator != INTEGRATOR_PT;
 	char regs[40] = "";
 	if (d->nv_options)
 		snprintf(regs, sizeof regs, " -cl-nv-maxrregcount=%d", bidirectional ? 32 : 40);

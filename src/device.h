@@ -42,12 +42,11 @@ void device_close(Device *d);
 /* Builds `source` with `options`, reusing a cached binary for this device,
  * driver, source and options when one exists. Build logs go into the error. */
 ajar_status device_build(Device *d, const char *source, const char *options);
-/* The build options of integrator `integrator` on d: KERNEL_OPTIONS, then
- * -DAJAR_CALLS for a bidirectional integrator on a device that is not a
- * CPU, a register cap where the device takes NVIDIA's options, and last
- * `extra` (AJAR_CL_OPTIONS, NULL for none), which can undo both. */
-void device_build_options(const Device *d, int integrator, int bidirectional, const char *extra, char *buf,
-			  size_t cap);
+/* The build options of integrator `integrator` (INTEGRATOR_*) on d:
+ * KERNEL_OPTIONS, then -DAJAR_CALLS for bdpt and portal on a device that
+ * is not a CPU, a register cap where the device takes NVIDIA's options,
+ * and last `extra` (AJAR_CL_OPTIONS, NULL for none), which can undo both. */
+void device_build_options(const Device *d, int integrator, const char *extra, char *buf, size_t cap);
 ajar_status device_kernel(Device *d, const char *name, cl_kernel *out);
 ajar_status device_buffer(Device *d, cl_mem_flags flags, size_t bytes, const void *host, cl_mem *out);
 

@@ -219,8 +219,7 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 			       strlen(extra));
 	if ((st = device_open(d, plat, id)) != AJAR_OK)
 		return st;
-	device_build_options(d, r->data.params->integrator, r->data.params->integrator != INTEGRATOR_PT, extra,
-			     options, sizeof options);
+	device_build_options(d, r->data.params->integrator, extra, options, sizeof options);
 	if ((st = device_build(d, ajar_kernel_source, options)) != AJAR_OK) {
 		char *why = extra && extra[0] ? strdup(ajar_last_error()) : NULL;
 		if (why) {

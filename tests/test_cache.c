@@ -289,17 +289,17 @@ static void test_build_options(void **state)
 	(void)state;
 	char buf[512];
 	Device cpu = {.is_cpu = 1}, gpu = {.is_cpu = 0}, nvidia = {.is_cpu = 0, .nv_options = 1};
-	device_build_options(&cpu, 0, 0, NULL, buf, sizeof buf);
+	device_build_options(&cpu, 0, NULL, buf, sizeof buf);
 	assert_string_equal(buf, KERNEL_OPTIONS "0 ");
-	device_build_options(&cpu, 2, 1, "-cl-opt-disable", buf, sizeof buf);
+	device_build_options(&cpu, 2, "-cl-opt-disable", buf, sizeof buf);
 	assert_string_equal(buf, KERNEL_OPTIONS "2 -cl-opt-disable");
-	device_build_options(&gpu, 0, 0, NULL, buf, sizeof buf);
+	device_build_options(&gpu, 0, NULL, buf, sizeof buf);
 	assert_string_equal(buf, KERNEL_OPTIONS "0 ");
-	device_build_options(&gpu, 1, 1, NULL, buf, sizeof buf);
+	device_build_options(&gpu, 1, NULL, buf, sizeof buf);
 	assert_string_equal(buf, KERNEL_OPTIONS "1 -DAJAR_CALLS ");
-	device_build_options(&nvidia, 0, 0, NULL, buf, sizeof buf);
+	device_build_options(&nvidia, 0, NULL, buf, sizeof buf);
 	assert_string_equal(buf, KERNEL_OPTIONS "0 -cl-nv-maxrregcount=40 ");
-	device_build_options(&nvidia, 2, 1, "-UAJAR_CALLS -cl-nv-maxrregcount=255", buf, sizeof buf);
+	device_build_options(&nvidia, 2, "-UAJAR_CALLS -cl-nv-maxrregcount=255", buf, sizeof buf);
 	assert_string_equal(buf, KERNEL_OPTIONS "2 -DAJAR_CALLS -cl-nv-maxrregcount=32 -UAJAR_CALLS -cl-nv-maxrregcount=255");
 }
 
