@@ -34,5 +34,5 @@
 	X(Params, strategy_len) X(Params, strategy_unweighted) X(Params, cross_filter)  \
 	X(Params, cross_lo) X(Params, cross_hi) X(Params, portal_s_max)                   \
 	X(Params, portal_sp_max) X(Params, portal_tp_max) X(Params, light_paths) \
-	X(Params, portal_t_max) X(Params, portal_rate)
+	X(Params, portal_t_max) X(Params, portal_rate) X(Params, env_rotation)
 #endif

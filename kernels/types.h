@@ -149,7 +149,7 @@ typedef struct {
 	int light_paths;        /* 192, portal: 0 = no light subpaths (bdpt's s >= 2 and t = 1 left out) */
 	int portal_t_max;       /* intermediate strategies use at most this many eye vertices */
 	float portal_rate;      /* 200, probability that a pixel sample traces an intermediate subpath */
-	int pad1;
+	float env_rotation;     /* radians about +Y, right-handed (env.h) */
 } Params; /* 208 */
 
 /* Layout of the float array `env`: for an ENV_IMAGE of W x H,

@@ -710,6 +710,118 @@ static void test_environment_image(void **state)
 	load_fails("envmissing.gltf", AJAR_ERROR_IO, "scenes[0].extras.environment.image");
 }
 
+/* Warnings sent to the log callback while a test loads something. */
+static int warnings;
+static char last_warning[2048];
+
+static void count_warnings(ajar_log_level level, const char *message, void *user)
+{
+	if (level != AJAR_LOG_WARNING)
+		return;
+	warnings++;
+	snprintf(last_warning, sizeof last_warning, "%s", message);
+}
+
+/* An 8x4 EXR of 0.5 with `bad` at the pixels listed (x, y pairs). */
+static void write_sky(const char *name, float bad, const int *xy, int n)
+{
+	float rgba[8 * 4 * 4];
+	for (int i = 0; i < 8 * 4 * 4; i++)
+		rgba[i] = 0.5f;
+	for (int k = 0; k < n; k++)
+		rgba[4 * (xy[2 * k + 1] * 8 + xy[2 * k]) + (k % 3)] = bad;
+	char *exr = tmp_path(name);
+	assert_int_equal(ajar_write_exr(exr, rgba, 8, 4, NULL, 0), AJAR_OK);
+	free(exr);
+}
+
+static void test_environment_pixels(void **state)
+{
+	/* Tiny negatives (as filtering tools leave them) become 0 with one
+	 * warning that counts them and names the file. */
+	static const int neg[] = {1, 0, 5, 2, 7, 3};
+	write_sky("negsky.exr", -1e-4f, neg, 3);
+	write_tri_gltf("negsky.gltf", "0", "{\"mesh\":0}", ",\"extras\":{\"environment\":{\"image\":\"negsky.exr\"}}");
+	warnings = 0;
+	ajar_set_log_callback(count_warnings, NULL);
+	Scene *s = load_ok("negsky.gltf");
+	ajar_set_log_callback(NULL, NULL);
+	assert_int_equal(warnings, 1);
+	if (!strstr(last_warning, "negsky.exr") || !strstr(last_warning, "3 negative pixel values"))
+		fail_msg("warning \"%s\"", last_warning);
+	assert_int_equal(s->env_type, ENV_IMAGE);
+	assert_float_equal(s->env_rgb[3 * (0 * 8 + 1)], 0.0f, 0.0);
+	assert_float_equal(s->env_rgb[3 * (2 * 8 + 5) + 1], 0.0f, 0.0);
+	assert_float_equal(s->env_rgb[3 * (3 * 8 + 7) + 2], 0.0f, 0.0);
+	for (int i = 0; i < 8 * 4 * 3; i++)
+		assert_true(s->env_rgb[i] == 0.0f || s->env_rgb[i] == 0.5f);
+	ajar_scene_destroy(&s);
+
+	/* A clean sky: no warning. */
+	write_sky("cleansky.exr", 0.0f, neg, 0);
+	write_tri_gltf("cleansky.gltf", "0", "{\"mesh\":0}",
+		       ",\"extras\":{\"environment\":{\"image\":\"cleansky.exr\"}}");
+	warnings = 0;
+	ajar_set_log_callback(count_warnings, NULL);
+	s = load_ok("cleansky.gltf");
+	ajar_set_log_callback(NULL, NULL);
+	assert_int_equal(warnings, 0);
+	ajar_scene_destroy(&s);
+
+	/* NaN and Inf are refused, naming the file and the pixel; the glTF
+	 * loader adds the scene file and the element. */
+	static const int one[] = {6, 2};
+	write_sky("nansky.exr", NAN, one, 1);
+	write_tri_gltf("nansky.gltf", "0", "{\"mesh\":0}", ",\"extras\":{\"environment\":{\"image\":\"nansky.exr\"}}");
+	load_fails("nansky.gltf", AJAR_ERROR_BAD_INPUT, "nansky.exr: environment: pixel (6, 2) channel R is nan");
+	write_sky("infsky.exr", -INFINITY, one, 1);
+	write_tri_gltf("infsky.gltf", "0", "{\"mesh\":0}", ",\"extras\":{\"environment\":{\"image\":\"infsky.exr\"}}");
+	load_fails("infsky.gltf", AJAR_ERROR_BAD_INPUT, "infsky.exr: environment: pixel (6, 2) channel R is -inf");
+
+	/* Through the API: the same check, and the scene keeps no sky. */
+	ajar_scene *as = NULL;
+	assert_int_equal(ajar_scene_create(&as), AJAR_OK);
+	char *nan_exr = tmp_path("nansky.exr");
+	assert_int_equal(ajar_scene_set_environment_image(as, nan_exr, 1.0f), AJAR_ERROR_BAD_INPUT);
+	if (!strstr(ajar_last_error(), "nansky.exr: environment: pixel (6, 2)"))
+		fail_msg("\"%s\"", ajar_last_error());
+	free(nan_exr);
+	ajar_scene_info in;
+	assert_int_equal(ajar_scene_info_get(as, &in), AJAR_OK);
+	assert_int_equal(in.environment, 0);
+	ajar_scene_destroy(&as);
+}
+
+static void test_environment_rotation(void **state)
+{
+	/* Degrees in the extras, radians about +Y in the scene, reduced
+	 * modulo a turn; any number of degrees, of either sign. */
+	write_sky("rotsky.exr", 0.0f, NULL, 0);
+	write_tri_gltf("rot.gltf", "0", "{\"mesh\":0}",
+		       ",\"extras\":{\"environment\":{\"image\":\"rotsky.exr\",\"rotation\":-450}}");
+	Scene *s = load_ok("rot.gltf");
+	assert_float_equal(s->env_rotation, -0.5 * M_PI, 1e-6);
+	ajar_scene_destroy(&s);
+	write_tri_gltf("rotcol.gltf", "0", "{\"mesh\":0}",
+		       ",\"extras\":{\"environment\":{\"color\":[1,1,1],\"rotation\":30}}");
+	s = load_ok("rotcol.gltf");
+	assert_float_equal(s->env_rotation, M_PI / 6.0, 1e-6);
+	ajar_scene_destroy(&s);
+	write_tri_gltf("rotbad.gltf", "0", "{\"mesh\":0}",
+		       ",\"extras\":{\"environment\":{\"color\":[1,1,1],\"rotation\":\"east\"}}");
+	load_fails("rotbad.gltf", AJAR_ERROR_BAD_INPUT, "scenes[0].extras.environment.rotation must be a number");
+
+	ajar_scene *as = NULL;
+	assert_int_equal(ajar_scene_create(&as), AJAR_OK);
+	assert_float_equal(as->env_rotation, 0.0f, 0.0);
+	assert_int_equal(ajar_scene_set_environment_rotation(as, 90.0f), AJAR_OK);
+	assert_float_equal(as->env_rotation, 0.5 * M_PI, 1e-6);
+	assert_int_equal(ajar_scene_set_environment_rotation(as, NAN), AJAR_ERROR_INVALID_ARGUMENT);
+	assert_int_equal(ajar_scene_set_environment_rotation(NULL, 1.0f), AJAR_ERROR_INVALID_ARGUMENT);
+	assert_float_equal(as->env_rotation, 0.5 * M_PI, 1e-6);
+	ajar_scene_destroy(&as);
+}
+
 /* ---- Broken files ------------------------------------------------------ */
 
 static void test_broken_files(void **state)
@@ -816,6 +928,8 @@ int main(void)
 		cmocka_unit_test(test_glb),
 		cmocka_unit_test(test_portals_and_environment),
 		cmocka_unit_test(test_environment_image),
+		cmocka_unit_test(test_environment_pixels),
+		cmocka_unit_test(test_environment_rotation),
 		cmocka_unit_test(test_broken_files),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
