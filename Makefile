@@ -9,9 +9,9 @@ Q := $(if $(filter 1,$(V)),,@)
 
 CC ?= cc
 CXX ?= c++
-PKGS := OpenEXR OpenCL tinygltf
+PKGS := OpenEXR OpenCL tinygltf stb
 PKG_CFLAGS = $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
-PKG_LIBS = $(shell pkg-config --libs OpenEXR OpenCL tinygltf 2>/dev/null)
+PKG_LIBS = $(shell pkg-config --libs OpenEXR OpenCL tinygltf stb 2>/dev/null)
 WARN := -Wall -Wextra -Werror -Wno-unused-parameter
 MODE_FLAGS_release := -O2 -g
 MODE_FLAGS_debug := -O0 -g
@@ -34,11 +34,11 @@ TESTS := $(patsubst tests/%.c,%,$(wildcard tests/test_*.c))
 obj = $(addprefix $(BUILD)/src/,$(addsuffix .o,$(1)))
 DEPS_test_bsdf := $(call obj,error)
 DEPS_test_sampling := $(call obj,error)
-DEPS_test_bvh := $(call obj,error scene bvh gltf exr exr_dwa)
-DEPS_test_lights := $(call obj,error scene lights exr exr_dwa)
-DEPS_test_scene := $(call obj,error scene scene_api gltf exr exr_dwa)
+DEPS_test_bvh := $(call obj,error scene bvh gltf exr exr_dwa hdr)
+DEPS_test_lights := $(call obj,error scene lights exr exr_dwa hdr)
+DEPS_test_scene := $(call obj,error scene scene_api gltf exr exr_dwa hdr)
 DEPS_test_exr := $(call obj,error exr exr_dwa png)
-DEPS_test_bdpt := $(BUILD)/tests/kernel_host.o $(BUILD)/tests/mis_oracle.o $(call obj,error scene scene_api gltf exr exr_dwa bvh lights prepare portal_flux)
+DEPS_test_bdpt := $(BUILD)/tests/kernel_host.o $(BUILD)/tests/mis_oracle.o $(call obj,error scene scene_api gltf exr exr_dwa hdr bvh lights prepare portal_flux)
 DEPS_test_portal := $(DEPS_test_bdpt)
 # Tests that render need the whole library.
 DEPS_test_layout := $(BUILD)/libajar.a

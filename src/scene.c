@@ -13,6 +13,7 @@
 
 #include "error.h"
 #include "exr.h"
+#include "hdr.h"
 
 /* Device code indexes with int, so no array may pass INT32_MAX entries. */
 #define SCENE_MAX_ITEMS ((size_t)INT32_MAX)
@@ -382,6 +383,10 @@ ajar_status scene_load_env_image(Scene *s, const char *path, float strength)
 {
 	float *rgba = NULL;
 	uint32_t w = 0, h = 0;
+	if (hdr_file(path)) {
+		ajar_status st = hdr_read(path, &rgba, &w, &h);
+		return st ? st : set_env_image(s, path, w, h, rgba, strength);
+	}
 	ajar_status st = ajar_read_exr(path, &rgba, &w, &h);
 	if (st)
 		return st;

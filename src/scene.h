@@ -69,7 +69,8 @@ ajar_status scene_set_camera(Scene *s, V3 pos, V3 forward, V3 up, float yfov, fl
 void scene_set_env_color(Scene *s, V3 rgb);
 /* Takes ownership of rgb (malloc'ed, w * h * 3 floats). */
 ajar_status scene_set_env_image(Scene *s, uint32_t w, uint32_t h, float *rgb, float strength);
-/* Reads the equirectangular image at `path` (OpenEXR) and sets it; errors
+/* Reads the equirectangular image at `path` (OpenEXR, or Radiance .hdr
+ * told by its header) and sets it; errors
  * name the file. Negative pixels become 0 with one warning; NaN or Inf is
  * refused, naming the pixel. */
 ajar_status scene_load_env_image(Scene *s, const char *path, float strength);

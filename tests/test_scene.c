@@ -822,6 +822,66 @@ static void test_environment_rotation(void **state)
 	ajar_scene_destroy(&as);
 }
 
+/* A flat (not run-length) 8x4 Radiance file: pixel i has mantissas
+ * (128 + i, 64, 0) and exponent byte 129, so RGB = (1 + i / 128, 0.5, 0). */
+static void write_hdr(const char *name)
+{
+	static const char head[] = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4 +X 8\n";
+	unsigned char data[sizeof head - 1 + 8 * 4 * 4];
+	memcpy(data, head, sizeof head - 1);
+	for (int i = 0; i < 8 * 4; i++) {
+		unsigned char *p = data + sizeof head - 1 + 4 * i;
+		p[0] = (unsigned char)(128 + i);
+		p[1] = 64;
+		p[2] = 0;
+		p[3] = 129;
+	}
+	write_bytes(name, data, sizeof data);
+}
+
+static void test_environment_hdr(void **state)
+{
+	/* Told by its header, not its name. */
+	write_hdr("sky.hdr");
+	write_hdr("sky-hdr.exr");
+	const char *names[2] = {"sky.hdr", "sky-hdr.exr"};
+	for (int k = 0; k < 2; k++) {
+		char extras[256];
+		snprintf(extras, sizeof extras, ",\"extras\":{\"environment\":{\"image\":\"%s\",\"strength\":2}}",
+			 names[k]);
+		write_tri_gltf("hdr.gltf", "0", "{\"mesh\":0}", extras);
+		Scene *s = load_ok("hdr.gltf");
+		assert_int_equal(s->env_type, ENV_IMAGE);
+		assert_int_equal(s->env_width, 8);
+		assert_int_equal(s->env_height, 4);
+		assert_float_equal(s->env_strength, 2.0f, 0.0);
+		for (int i = 0; i < 8 * 4; i++) {
+			assert_true(s->env_rgb[3 * i] == 1.0f + (float)i / 128.0f);
+			assert_true(s->env_rgb[3 * i + 1] == 0.5f);
+			assert_true(s->env_rgb[3 * i + 2] == 0.0f);
+		}
+		ajar_scene_destroy(&s);
+	}
+	ajar_scene *as = NULL;
+	assert_int_equal(ajar_scene_create(&as), AJAR_OK);
+	char *p = tmp_path("sky.hdr");
+	assert_int_equal(ajar_scene_set_environment_image(as, p, 1.0f), AJAR_OK);
+	free(p);
+	assert_int_equal(as->env_width, 8);
+	assert_true(as->env_rgb[3 * 9] == 1.0f + 9.0f / 128.0f);
+	ajar_scene_destroy(&as);
+
+	/* A Radiance header with a layout stb_image does not read, and one
+	 * cut short: refused, naming the file. */
+	write_text("sideways.hdr", "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n+X 8 -Y 4\n");
+	write_tri_gltf("hdrbad.gltf", "0", "{\"mesh\":0}",
+		       ",\"extras\":{\"environment\":{\"image\":\"sideways.hdr\"}}");
+	load_fails("hdrbad.gltf", AJAR_ERROR_BAD_INPUT, "sideways.hdr: not a readable Radiance HDR image");
+	write_text("cut.hdr", "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4 +X 8\n\x80\x40");
+	write_tri_gltf("hdrcut.gltf", "0", "{\"mesh\":0}", ",\"extras\":{\"environment\":{\"image\":\"cut.hdr\"}}");
+	load_fails("hdrcut.gltf", AJAR_ERROR_BAD_INPUT, "cut.hdr: not a readable Radiance HDR image");
+}
+
 /* ---- Broken files ------------------------------------------------------ */
 
 static void test_broken_files(void **state)
@@ -930,6 +990,7 @@ int main(void)
 		cmocka_unit_test(test_environment_image),
 		cmocka_unit_test(test_environment_pixels),
 		cmocka_unit_test(test_environment_rotation),
+		cmocka_unit_test(test_environment_hdr),
 		cmocka_unit_test(test_broken_files),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
