@@ -29,24 +29,72 @@ INLINE float emitter_pdf_a(const SceneView *sc, int tri)
 	return sc->emitters[e].pdf_select / sc->emitters[e].area;
 }
 
-/* Picks an emitter by power (u_sel) and a uniform point on it (u1, u2):
- * position *p, unit front normal *n, *pdf_a including the selection.
- * Returns the triangle index, or -1 if there are no emitters. */
-INLINE int emitter_sample(const SceneView *sc, float u_sel, float u1, float u2, V3 *p, V3 *n,
-			  float *pdf_a)
+/* Index in emitter_cdf chosen by u_sel: an emitter below num_emitters,
+ * a punctual light from there on; -1 if the table is empty. */
+INLINE int light_pick(const SceneView *sc, float u_sel)
 {
 	float p_sel, u_rest;
-	*pdf_a = 0.0f;
-	*p = v3(0.0f, 0.0f, 0.0f);
-	*n = v3(0.0f, 0.0f, 1.0f);
-	int k = sample_cdf(sc->emitter_cdf, sc->params->num_emitters, u_sel, &p_sel, &u_rest);
-	if (k < 0)
-		return -1;
+	return sample_cdf(sc->emitter_cdf, sc->params->num_emitters + sc->params->num_lights, u_sel, &p_sel, &u_rest);
+}
+
+/* A uniform point on emitter k (see emitter_sample); returns its triangle. */
+INLINE int emitter_point(const SceneView *sc, int k, float u1, float u2, V3 *p, V3 *n, float *pdf_a)
+{
 	GLOBAL const Emitter *e = &sc->emitters[k];
 	GLOBAL const Tri *t = &sc->tris[e->tri];
 	sample_triangle_point(t->p0, t->p1, t->p2, u1, u2, p, n);
 	*pdf_a = e->pdf_select / e->area;
 	return e->tri;
+}
+
+/* Picks an emitter by power (u_sel) and a uniform point on it (u1, u2):
+ * position *p, unit front normal *n, *pdf_a including the selection.
+ * Returns the triangle index, or -1 if there are no emitters or the choice
+ * fell on a punctual light (which shares the table, after the emitters:
+ * callers that do not take punctual lights lose that share, which their
+ * densities, summing over emitter points only, already leave out). */
+INLINE int emitter_sample(const SceneView *sc, float u_sel, float u1, float u2, V3 *p, V3 *n,
+			  float *pdf_a)
+{
+	*pdf_a = 0.0f;
+	*p = v3(0.0f, 0.0f, 0.0f);
+	*n = v3(0.0f, 0.0f, 1.0f);
+	int k = light_pick(sc, u_sel);
+	if (k < 0 || k >= sc->params->num_emitters)
+		return -1;
+	return emitter_point(sc, k, u1, u2, p, n, pdf_a);
+}
+
+/* What punctual light `l` sends to point x: *wi (unit, from x toward the
+ * light), *dist (AJAR_INF for a directional light) and the irradiance it
+ * gives a surface perpendicular to wi: I(-wi) / d^2 with the spec's
+ * windows (KHR_lights_punctual: spot t^2, t = clamp((cos - cos outer) /
+ * (cos inner - cos outer)), range clamp(1 - (d / range)^4, 0, 1)), or E. */
+INLINE V3 punctual_arrive(GLOBAL const PunctualLight *l, V3 x, V3 *wi, float *dist)
+{
+	V3 zero = v3(0.0f, 0.0f, 0.0f);
+	if (l->type == LIGHT_DIRECTIONAL) {
+		*wi = v3_neg(l->dir);
+		*dist = AJAR_INF;
+		return l->intensity;
+	}
+	V3 to = v3_sub(l->pos, x);
+	float d2 = v3_len2(to);
+	*dist = sqrt(d2);
+	*wi = v3(0.0f, 0.0f, 1.0f);
+	if (!(d2 > 0.0f))
+		return zero;
+	*wi = v3_scale(to, 1.0f / *dist);
+	float k = 1.0f / d2;
+	if (l->type == LIGHT_SPOT) {
+		float t = fmin(fmax((-v3_dot(*wi, l->dir) - l->cos_outer) * l->cone_scale, 0.0f), 1.0f);
+		k *= t * t;
+	}
+	if (l->range > 0.0f) {
+		float r = *dist / l->range, r2 = r * r;
+		k *= fmin(fmax(1.0f - r2 * r2, 0.0f), 1.0f);
+	}
+	return v3_scale(l->intensity, k);
 }
 
 typedef struct {
@@ -58,6 +106,9 @@ typedef struct {
 	float pdf_w; /* solid angle at x, selection included */
 	int is_env;
 	int tri;     /* the emitter triangle, -1 for the environment */
+	int light;   /* the punctual light, -1 for others */
+	int delta;   /* a punctual light: Le is irradiance (W/m^2 perpendicular to wi),
+		      * pdf_w the probability of the choice; no other strategy samples it */
 } LightSample;
 
 /* The emitter half of light_sample: an emitter by power (u), a uniform
@@ -67,9 +118,27 @@ INLINE int light_sample_emitter(const SceneView *sc, V3 x, float u, float u1, fl
 {
 	float pdf_a;
 	V3 p, n;
-	int tri = emitter_sample(sc, u, u1, u2, &p, &n, &pdf_a);
-	if (tri < 0)
+	ls->light = -1;
+	ls->delta = 0;
+	int k = light_pick(sc, u);
+	if (k < 0)
 		return 0;
+	if (k >= sc->params->num_emitters) {
+		/* A punctual light: its position or direction is fixed. */
+		GLOBAL const PunctualLight *l = &sc->punctual[k - sc->params->num_emitters];
+		ls->Le = punctual_arrive(l, x, &ls->wi, &ls->dist);
+		if (!(l->pdf_select > 0.0f) || v3_is_zero(ls->Le))
+			return 0;
+		ls->is_env = 0;
+		ls->tri = -1;
+		ls->light = k - sc->params->num_emitters;
+		ls->delta = 1;
+		ls->p = l->type == LIGHT_DIRECTIONAL ? x : l->pos;
+		ls->n = v3_neg(ls->wi);
+		ls->pdf_w = p_emitters * l->pdf_select;
+		return 1;
+	}
+	int tri = emitter_point(sc, k, u1, u2, &p, &n, &pdf_a);
 	V3 to = v3_sub(p, x);
 	float dist2 = v3_len2(to);
 	if (!(dist2 > 0.0f))
@@ -101,6 +170,8 @@ CALLED int light_sample(const SceneView *sc, V3 x, V3 n, float u_sel, float u1, 
 	float ps = sc->params->env_pdf_select;
 	ls->is_env = 0;
 	ls->tri = -1;
+	ls->light = -1;
+	ls->delta = 0;
 	ls->pdf_w = 0.0f;
 	ls->Le = v3(0.0f, 0.0f, 0.0f);
 	if (u_sel < ps) {
