@@ -9,6 +9,7 @@
 #include "sampling.h"
 #include "bvh.h"
 #include "env_portal.h"
+#include "portal_geometry.h"
 
 /* Radiance leaving triangle `tri` in direction w (any length): the
  * material's emission on the front face, 0 behind it or if not emissive. */
@@ -65,14 +66,29 @@ INLINE int emitter_sample(const SceneView *sc, float u_sel, float u1, float u2, 
 	return emitter_point(sc, k, u1, u2, p, n, pdf_a);
 }
 
+/* Radiant intensity (W/sr) of point or spot light `l` toward unit w at
+ * distance d, with the spec's windows (KHR_lights_punctual): a spot's
+ * t^2, t = clamp((cos - cos outer) / (cos inner - cos outer), 0, 1), and
+ * `range`'s clamp(1 - (d / range)^4, 0, 1). */
+INLINE V3 punctual_intensity(GLOBAL const PunctualLight *l, V3 w, float d)
+{
+	float k = 1.0f;
+	if (l->type == LIGHT_SPOT) {
+		float t = fmin(fmax((v3_dot(w, l->dir) - l->cos_outer) * l->cone_scale, 0.0f), 1.0f);
+		k = t * t;
+	}
+	if (l->range > 0.0f) {
+		float r = d / l->range, r2 = r * r;
+		k *= fmin(fmax(1.0f - r2 * r2, 0.0f), 1.0f);
+	}
+	return v3_scale(l->intensity, k);
+}
+
 /* What punctual light `l` sends to point x: *wi (unit, from x toward the
  * light), *dist (AJAR_INF for a directional light) and the irradiance it
- * gives a surface perpendicular to wi: I(-wi) / d^2 with the spec's
- * windows (KHR_lights_punctual: spot t^2, t = clamp((cos - cos outer) /
- * (cos inner - cos outer)), range clamp(1 - (d / range)^4, 0, 1)), or E. */
+ * gives a surface perpendicular to wi: I(-wi) / d^2, or E. */
 INLINE V3 punctual_arrive(GLOBAL const PunctualLight *l, V3 x, V3 *wi, float *dist)
 {
-	V3 zero = v3(0.0f, 0.0f, 0.0f);
 	if (l->type == LIGHT_DIRECTIONAL) {
 		*wi = v3_neg(l->dir);
 		*dist = AJAR_INF;
@@ -83,18 +99,92 @@ INLINE V3 punctual_arrive(GLOBAL const PunctualLight *l, V3 x, V3 *wi, float *di
 	*dist = sqrt(d2);
 	*wi = v3(0.0f, 0.0f, 1.0f);
 	if (!(d2 > 0.0f))
-		return zero;
+		return v3(0.0f, 0.0f, 0.0f);
 	*wi = v3_scale(to, 1.0f / *dist);
-	float k = 1.0f / d2;
-	if (l->type == LIGHT_SPOT) {
-		float t = fmin(fmax((-v3_dot(*wi, l->dir) - l->cos_outer) * l->cone_scale, 0.0f), 1.0f);
-		k *= t * t;
+	return v3_scale(punctual_intensity(l, v3_neg(*wi), *dist), 1.0f / d2);
+}
+
+/* Solid-angle density with which a light subpath leaves point or spot
+ * light `l` in unit direction w: uniform on the sphere, or uniform in the
+ * spot's outer cone (its light is zero outside). */
+INLINE float punctual_dir_pdf(GLOBAL const PunctualLight *l, V3 w)
+{
+	if (l->type != LIGHT_SPOT)
+		return pdf_uniform_sphere_w();
+	if (!(v3_dot(w, l->dir) >= l->cos_outer))
+		return 0.0f;
+	return 1.0f / (2.0f * AJAR_PI * (1.0f - l->cos_outer));
+}
+
+/* A light subpath's direction from point or spot light `l` (density
+ * punctual_dir_pdf). */
+INLINE V3 punctual_dir_sample(GLOBAL const PunctualLight *l, float u1, float u2)
+{
+	if (l->type != LIGHT_SPOT)
+		return sample_uniform_sphere(u1, u2);
+	float c = 1.0f - u1 * (1.0f - l->cos_outer);
+	float sn = sqrt(fmax(0.0f, 1.0f - c * c)), phi = 2.0f * AJAR_PI * u2;
+	V3 t, b;
+	v3_basis(l->dir, &t, &b);
+	return v3_from_local(v3(sn * cos(phi), sn * sin(phi), c), t, b, l->dir);
+}
+
+/* A directional light's light subpaths are parallel rays along l->dir.
+ * Without portals their lines cross a disk of the scene's radius
+ * perpendicular to it uniformly; with portals each line passes through a
+ * point on a portal triangle (picked by portal_cdf, uniform on it), so
+ * only light that comes in through an opening is traced. The density per
+ * unit area perpendicular to l->dir of the line through x: 1 / (pi R^2),
+ * or the sum over the portal triangles the whole line crosses of
+ * p_A / |cos| (p_A = pdf_select / area, cos between its normal and the
+ * light). */
+INLINE float sun_line_pdf(const SceneView *sc, GLOBAL const PunctualLight *l, V3 x)
+{
+	int np = sc->params->num_portals;
+	if (np == 0)
+		return 1.0f / (AJAR_PI * l->disk_radius * l->disk_radius);
+	/* The line from behind the scene's bounding sphere, as a segment. */
+	float r = sc->params->scene_radius, t;
+	V3 o = v3_sub(x, v3_scale(l->dir, v3_dot(v3_sub(x, sc->params->scene_center), l->dir) + 2.0f * r));
+	V3 d = v3_scale(l->dir, 4.0f * r);
+	float p = 0.0f;
+	for (int i = 0; i < np; i++) {
+		GLOBAL const PortalTri *pt = &sc->portals[i];
+		float c = fabs(v3_dot(pt->n, l->dir));
+		if (c > 0.0f && pt->area > 0.0f && portal_tri_crossing(o, d, 1.0f, pt->p0, pt->p1, pt->p2, &t))
+			p += pt->pdf_select / (pt->area * c);
 	}
-	if (l->range > 0.0f) {
-		float r = *dist / l->range, r2 = r * r;
-		k *= fmin(fmax(1.0f - r2 * r2, 0.0f), 1.0f);
+	return p;
+}
+
+/* Samples a line of directional light `l`: *o, a point on it behind the
+ * scene's bounding sphere (the ray o + t l->dir, t > 0, meets everything
+ * the light reaches along it), and its density *pdf_perp (sun_line_pdf).
+ * Returns 0 if there is none. */
+INLINE int sun_line_sample(const SceneView *sc, GLOBAL const PunctualLight *l, float u_sel, float u1, float u2, V3 *o,
+			   float *pdf_perp)
+{
+	GLOBAL const Params *prm = sc->params;
+	float r = prm->scene_radius;
+	V3 x;
+	if (prm->num_portals == 0) {
+		float dx, dy;
+		V3 t, b;
+		v3_basis(l->dir, &t, &b);
+		sample_concentric_disk(u1, u2, &dx, &dy);
+		x = v3_add(prm->scene_center, v3_add(v3_scale(t, dx * l->disk_radius), v3_scale(b, dy * l->disk_radius)));
+	} else {
+		float p_sel, u_rest;
+		int k = sample_cdf(sc->portal_cdf, prm->num_portals, u_sel, &p_sel, &u_rest);
+		if (k < 0)
+			return 0;
+		GLOBAL const PortalTri *pt = &sc->portals[k];
+		V3 n;
+		sample_triangle_point(pt->p0, pt->p1, pt->p2, u1, u2, &x, &n);
 	}
-	return v3_scale(l->intensity, k);
+	*pdf_perp = sun_line_pdf(sc, l, x);
+	*o = v3_sub(x, v3_scale(l->dir, v3_dot(v3_sub(x, prm->scene_center), l->dir) + 1.001f * r));
+	return *pdf_perp > 0.0f;
 }
 
 typedef struct {

@@ -44,11 +44,18 @@ INLINE float mis_balance(float a, float b)
 typedef struct {
 	float pf, pr;
 	float pn;     /* x_0 only: its density as a next-event sample from x_1 */
-	int delta;    /* scattered by a delta lobe: never a connection end */
+	int delta;    /* scattered by a delta lobe: never a connection end; on x_0, a
+		       * punctual light: s = 0 is impossible, s = 1 (next-event estimation)
+		       * is not, but for a path to the camera alone (the light unseen) */
 	int infinite; /* the environment: cannot connect to the camera */
 } MisVertex;
 
 INLINE float mis_remap0(float p) { return p > 0.0f ? p : 1.0f; }
+
+/* A punctual light's pf_1 is never a delta lobe's: 0 there means that no
+ * light subpath reaches x_1 (a directional light's lines start on the
+ * portals, lights.h), so the strategies s >= 2 cannot make the path. */
+INLINE int mis_no_light_paths(const MisVertex *v) { return v[0].delta && !(v[1].pf > 0.0f); }
 
 INLINE float mis_term(float r, int heuristic) { return heuristic == MIS_BALANCE ? r : r * r; }
 
@@ -62,11 +69,14 @@ CALLED float mis_path_weight(const MisVertex *v, int k, int s, int heuristic)
 	float pn_pf = mis_remap0(v[0].pn) / mis_remap0(v[0].pf);
 	float sum = 1.0f, r = 1.0f;
 	for (int i = s; i < k - 1; i++) { /* s' = i + 1: x_i moves to the light side */
+		if (i == 1 && mis_no_light_paths(v))
+			break;
 		if (i == 0)
 			r *= mis_remap0(v[0].pn) / mis_remap0(v[0].pr);
 		else
 			r *= mis_remap0(v[i].pf) / mis_remap0(v[i].pr) / (i == 1 ? pn_pf : 1.0f);
-		if (!v[i].delta && !v[i + 1].delta && !(v[i].infinite && i + 1 == k - 1))
+		if ((i == 0 || !v[i].delta) && !v[i + 1].delta &&
+		    !((v[i].infinite || v[i].delta) && i + 1 == k - 1))
 			sum += mis_term(r, heuristic);
 	}
 	r = 1.0f;
@@ -75,7 +85,7 @@ CALLED float mis_path_weight(const MisVertex *v, int k, int s, int heuristic)
 			r *= mis_remap0(v[0].pr) / mis_remap0(v[0].pn);
 		else
 			r *= mis_remap0(v[i].pr) / mis_remap0(v[i].pf) * (i == 1 ? pn_pf : 1.0f);
-		if (!v[i].delta && (i == 0 || !v[i - 1].delta))
+		if (!v[i].delta && (i <= 1 || !v[i - 1].delta))
 			sum += mis_term(r, heuristic);
 	}
 	return 1.0f / sum;
@@ -118,10 +128,10 @@ typedef struct {
 INLINE int mis_bdpt_valid(const MisVertex *v, int k, int s)
 {
 	if (s == 0)
-		return 1;
-	if (s >= k || v[s - 1].delta || v[s].delta)
+		return !v[0].delta;
+	if (s >= k || (s >= 2 && (v[s - 1].delta || mis_no_light_paths(v))) || v[s].delta)
 		return 0;
-	return !(v[s - 1].infinite && s == k - 1);
+	return !((v[s - 1].infinite || v[s - 1].delta) && s == k - 1);
 }
 
 /* Logs of the remapped densities of x_0 .. x_{n-1}: lf stays 0 unless
