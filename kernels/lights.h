@@ -131,21 +131,30 @@ INLINE V3 punctual_dir_sample(GLOBAL const PunctualLight *l, float u1, float u2)
 
 /* A directional light's light subpaths are parallel rays along l->dir.
  * Without portals their lines cross a disk of the scene's radius
- * perpendicular to it uniformly; with portals each line passes through a
- * point on a portal triangle (picked by portal_cdf, uniform on it), so
- * only light that comes in through an opening is traced. The density per
- * unit area perpendicular to l->dir of the line through x: 1 / (pi R^2),
- * or the sum over the portal triangles the whole line crosses of
- * p_A / |cos| (p_A = pdf_select / area, cos between its normal and the
- * light). */
+ * perpendicular to it uniformly. With portals, all but SUN_DISK_SHARE of
+ * them pass through a point on a portal triangle (picked by portal_cdf,
+ * uniform on it), so that light subpaths go where an opening lets the
+ * light in; the share on the disk keeps every line the light sends into
+ * the scene at a positive density (a sunlit outside wall, an opening
+ * without a portal), so a zero density always means a zero contribution,
+ * as the MIS weights assume. The density per unit area perpendicular to
+ * l->dir of the line through x: SUN_DISK_SHARE / (pi R^2) within the disk
+ * (all of it without portals), plus (1 - SUN_DISK_SHARE) times the sum
+ * over the portal triangles the whole line crosses of p_A / |cos| (p_A =
+ * pdf_select / area, cos between its normal and the light). */
+#define SUN_DISK_SHARE 0.1f
+
 INLINE float sun_line_pdf(const SceneView *sc, GLOBAL const PunctualLight *l, V3 x)
 {
 	int np = sc->params->num_portals;
+	float r = sc->params->scene_radius, R = l->disk_radius, t;
+	V3 q = v3_sub(x, sc->params->scene_center);
+	V3 perp = v3_sub(q, v3_scale(l->dir, v3_dot(q, l->dir)));
+	float disk = v3_len2(perp) <= R * R ? 1.0f / (AJAR_PI * R * R) : 0.0f;
 	if (np == 0)
-		return 1.0f / (AJAR_PI * l->disk_radius * l->disk_radius);
+		return disk;
 	/* The line from behind the scene's bounding sphere, as a segment. */
-	float r = sc->params->scene_radius, t;
-	V3 o = v3_sub(x, v3_scale(l->dir, v3_dot(v3_sub(x, sc->params->scene_center), l->dir) + 2.0f * r));
+	V3 o = v3_sub(x, v3_scale(l->dir, v3_dot(q, l->dir) + 2.0f * r));
 	V3 d = v3_scale(l->dir, 4.0f * r);
 	float p = 0.0f;
 	for (int i = 0; i < np; i++) {
@@ -154,7 +163,7 @@ INLINE float sun_line_pdf(const SceneView *sc, GLOBAL const PunctualLight *l, V3
 		if (c > 0.0f && pt->area > 0.0f && portal_tri_crossing(o, d, 1.0f, pt->p0, pt->p1, pt->p2, &t))
 			p += pt->pdf_select / (pt->area * c);
 	}
-	return p;
+	return SUN_DISK_SHARE * disk + (1.0f - SUN_DISK_SHARE) * p;
 }
 
 /* Samples a line of directional light `l`: *o, a point on it behind the
@@ -167,7 +176,7 @@ INLINE int sun_line_sample(const SceneView *sc, GLOBAL const PunctualLight *l, f
 	GLOBAL const Params *prm = sc->params;
 	float r = prm->scene_radius;
 	V3 x;
-	if (prm->num_portals == 0) {
+	if (prm->num_portals == 0 || u_sel < SUN_DISK_SHARE) {
 		float dx, dy;
 		V3 t, b;
 		v3_basis(l->dir, &t, &b);
@@ -175,7 +184,8 @@ INLINE int sun_line_sample(const SceneView *sc, GLOBAL const PunctualLight *l, f
 		x = v3_add(prm->scene_center, v3_add(v3_scale(t, dx * l->disk_radius), v3_scale(b, dy * l->disk_radius)));
 	} else {
 		float p_sel, u_rest;
-		int k = sample_cdf(sc->portal_cdf, prm->num_portals, u_sel, &p_sel, &u_rest);
+		float u = fmin((u_sel - SUN_DISK_SHARE) / (1.0f - SUN_DISK_SHARE), 0.99999994f);
+		int k = sample_cdf(sc->portal_cdf, prm->num_portals, u, &p_sel, &u_rest);
 		if (k < 0)
 			return 0;
 		GLOBAL const PortalTri *pt = &sc->portals[k];

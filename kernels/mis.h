@@ -52,11 +52,6 @@ typedef struct {
 
 INLINE float mis_remap0(float p) { return p > 0.0f ? p : 1.0f; }
 
-/* A punctual light's pf_1 is never a delta lobe's: 0 there means that no
- * light subpath reaches x_1 (a directional light's lines start on the
- * portals, lights.h), so the strategies s >= 2 cannot make the path. */
-INLINE int mis_no_light_paths(const MisVertex *v) { return v[0].delta && !(v[1].pf > 0.0f); }
-
 INLINE float mis_term(float r, int heuristic) { return heuristic == MIS_BALANCE ? r : r * r; }
 
 /* Weight of strategy s (light vertices x_0..x_{s-1}) for the k-vertex path
@@ -69,8 +64,6 @@ CALLED float mis_path_weight(const MisVertex *v, int k, int s, int heuristic)
 	float pn_pf = mis_remap0(v[0].pn) / mis_remap0(v[0].pf);
 	float sum = 1.0f, r = 1.0f;
 	for (int i = s; i < k - 1; i++) { /* s' = i + 1: x_i moves to the light side */
-		if (i == 1 && mis_no_light_paths(v))
-			break;
 		if (i == 0)
 			r *= mis_remap0(v[0].pn) / mis_remap0(v[0].pr);
 		else
@@ -129,7 +122,7 @@ INLINE int mis_bdpt_valid(const MisVertex *v, int k, int s)
 {
 	if (s == 0)
 		return !v[0].delta;
-	if (s >= k || (s >= 2 && (v[s - 1].delta || mis_no_light_paths(v))) || v[s].delta)
+	if (s >= k || (s >= 2 && v[s - 1].delta) || v[s].delta)
 		return 0;
 	return !((v[s - 1].infinite || v[s - 1].delta) && s == k - 1);
 }
@@ -250,7 +243,8 @@ INLINE float mis_union_sum(const MisVertex *v, int k, int n, const float *PF, co
 		float base = lpsum[m] + beta * (set.lrate - lcur);
 		/* s in [0, m] with a valid light connection ... */
 		for (int s = max(0, m + 1 - set.sp_max); s <= m && s <= set.s_max; s++) {
-			if (s > 0 && (v[s - 1].delta || v[s].delta))
+			/* x_0's delta flag: a punctual light, for s = 1 only (mis.h, MisVertex) */
+			if ((s == 0 && v[0].delta) || (s >= 2 && v[s - 1].delta) || (s > 0 && v[s].delta))
 				continue;
 			float left = base + beta * (mis_lpf(PF, lpn, s) + PR[m] - PR[s]);
 			/* ... and t' >= 1 with m + t' <= k - 2 and a valid eye connection. */

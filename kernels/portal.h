@@ -52,7 +52,12 @@ INLINE int portal_guided_sample(const SceneView *sc, GLOBAL const PortalTri *pt,
 		return 1;
 	}
 	LightSample ls;
-	if (!light_sample_emitter(sc, w0, fmin((u_sel - ps) / (1.0f - ps), 0.99999994f), u1, u2, 1.0f - ps, &ls))
+	/* Not at a punctual light: its light reaches the <- half by next-event
+	 * estimation and light subpaths; a guided direction at it would be a
+	 * delta direction that no other strategy samples. That share of the
+	 * guided samples is lost, which portal_direction_psa leaves out. */
+	if (!light_sample_emitter(sc, w0, fmin((u_sel - ps) / (1.0f - ps), 0.99999994f), u1, u2, 1.0f - ps, &ls) ||
+	    ls.delta)
 		return 0;
 	*wl = ls.wi;
 	*dist = ls.dist;

@@ -65,14 +65,6 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	if (s->nmaterials == 0)
 		return err_set(AJAR_ERROR_BAD_INPUT, "%s: the scene has no materials", s->source);
 
-	/* The portal integrator's intermediate strategies do not take
-	 * punctual lights yet, so it refuses rather than render such a scene
-	 * wrongly (without portals it is bdpt, which does). */
-	if (s->nlights && o->integrator == INTEGRATOR_PORTAL && s->nportal_tris > 0)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT,
-			       "%s: %u punctual light%s (KHR_lights_punctual) and portals: the portal integrator does not "
-			       "render them yet (pt and bdpt do)",
-			       s->source, s->nlights, s->nlights == 1 ? "" : "s");
 	double t0 = seconds();
 	if ((st = bvh_build(s->tris, n, &d->bvh)) != AJAR_OK)
 		return st;

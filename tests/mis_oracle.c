@@ -22,8 +22,10 @@ static double punctual_pf1(const SceneView *sc, const PathVertex *x0, const Path
 	double dir[3] = {l->dir.x, l->dir.y, l->dir.z};
 	if (x0->type == VERTEX_SUN) {
 		double c1 = fabs(x1->ng.x * dir[0] + x1->ng.y * dir[1] + x1->ng.z * dir[2]);
+		/* Scene points lie within the disk. */
+		double disk = 1 / (M_PI * (double)l->disk_radius * l->disk_radius);
 		if (sc->params->num_portals == 0)
-			return c1 / (M_PI * (double)l->disk_radius * l->disk_radius);
+			return c1 * disk;
 		double o[3] = {x1->p.x - 1e3 * dir[0], x1->p.y - 1e3 * dir[1], x1->p.z - 1e3 * dir[2]}, p = 0, th;
 		for (int i = 0; i < sc->params->num_portals; i++) {
 			GLOBAL const PortalTri *t = &sc->portals[i];
@@ -31,7 +33,7 @@ static double punctual_pf1(const SceneView *sc, const PathVertex *x0, const Path
 			if (crosses(o, dir, 2e3, t->p0, t->p1, t->p2, &th))
 				p += t->pdf_select / (t->area * c);
 		}
-		return p * c1;
+		return (SUN_DISK_SHARE * disk + (1 - SUN_DISK_SHARE) * p) * c1;
 	}
 	double d[3] = {x1->p.x - x0->p.x, x1->p.y - x0->p.y, x1->p.z - x0->p.z};
 	double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
@@ -135,8 +137,6 @@ int strategy_valid(const MisVertex *v, int k, int s)
 		return !v[0].delta;
 	if ((s >= 2 && v[s - 1].delta) || v[s].delta)
 		return 0;
-	if (s >= 2 && v[0].delta && v[1].pf == 0) /* no light subpath of a punctual light reaches x_1 */
-		return 0;
 	return !((v[s - 1].infinite || (s == 1 && v[0].delta)) && s == k - 1);
 }
 
@@ -203,7 +203,9 @@ static double direction_psa(const SceneView *sc, GLOBAL const PortalTri *pt, con
 {
 	double to[3], guided = 0, n[3] = {pt->n.x, pt->n.y, pt->n.z};
 	double ps = sc->params->env_pdf_select;
-	if (a->type == VERTEX_ENV) {
+	if (a->type == VERTEX_SUN) { /* the guided half never aims at a punctual light */
+		to[0] = a->p.x, to[1] = a->p.y, to[2] = a->p.z;
+	} else if (a->type == VERTEX_ENV) {
 		to[0] = a->p.x, to[1] = a->p.y, to[2] = a->p.z;
 		double pe = env_pdf_w(sc, a->p);
 		if (pt->env_side != 0) {
@@ -217,7 +219,7 @@ static double direction_psa(const SceneView *sc, GLOBAL const PortalTri *pt, con
 		double dist = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
 		for (int c = 0; c < 3; c++)
 			to[c] = d[c] / dist;
-		int tri = emitter_at(sc, a->p);
+		int tri = a->type == VERTEX_PUNCTUAL ? -1 : emitter_at(sc, a->p);
 		if (tri >= 0) {
 			V3 fn = v3_norm(tri_normal(&sc->tris[tri]));
 			double cos_l = -(fn.x * to[0] + fn.y * to[1] + fn.z * to[2]);
@@ -234,9 +236,9 @@ int oracle_pair_logs(const SceneView *sc, const PathVertex *a, const PathVertex 
 		     int max)
 {
 	double o[3], d[3], tmax = 1;
-	const PathVertex *p = a->type == VERTEX_ENV ? b : a;
-	if (a->type == VERTEX_ENV || b->type == VERTEX_ENV) {
-		const PathVertex *env = a->type == VERTEX_ENV ? a : b;
+	const PathVertex *p = at_infinity(a) ? b : a;
+	if (at_infinity(a) || at_infinity(b)) {
+		const PathVertex *env = at_infinity(a) ? a : b;
 		o[0] = p->p.x, o[1] = p->p.y, o[2] = p->p.z;
 		d[0] = env->p.x, d[1] = env->p.y, d[2] = env->p.z;
 		tmax = 1e30;
@@ -245,7 +247,7 @@ int oracle_pair_logs(const SceneView *sc, const PathVertex *a, const PathVertex 
 		d[0] = b->p.x - a->p.x, d[1] = b->p.y - a->p.y, d[2] = b->p.z - a->p.z;
 	}
 	double g;
-	if (a->type == VERTEX_ENV) {
+	if (at_infinity(a)) {
 		g = fabs(v3_dot(b->ng, a->p));
 	} else {
 		double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];

@@ -423,7 +423,8 @@ static void test_sun_lines(void **state)
 	assert_int_equal(ajar_scene_add_portal(s, &m2), AJAR_OK);
 	host_scene_open(&h, NULL, s, 1, 1, INTEGRATOR_PT, 8);
 	assert_int_equal(h.view.params->num_portals, 4);
-	check_lines("directional light through two portals", &h.view, &h.view.punctual[0], -1.2, 1.2);
+	float R = h.view.punctual[0].disk_radius * 1.01f;
+	check_lines("directional light through two portals", &h.view, &h.view.punctual[0], -R, R);
 	h.scene = NULL;
 	host_scene_close(&h);
 	ajar_scene_destroy(&s);
