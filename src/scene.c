@@ -315,9 +315,9 @@ ajar_status scene_add_light(Scene *s, const char *what, const ajar_light *l)
 	*o = *l;
 	if (v3_len2(d) > 1e-20f) {
 		d = v3_norm(d);
-		o->direction[0] = d.x;
-		o->direction[1] = d.y;
-		o->direction[2] = d.z;
+		o->direction[0] = d.x + 0.0f; /* no -0, which would print as -0.000 */
+		o->direction[1] = d.y + 0.0f;
+		o->direction[2] = d.z + 0.0f;
 	} else {
 		o->direction[0] = o->direction[1] = 0.0f;
 		o->direction[2] = -1.0f;
