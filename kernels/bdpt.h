@@ -14,7 +14,15 @@
  *
  * Light subpaths leave an emitter by power, a uniform point on it and a
  * cosine direction, or the environment by its importance, from a disk of
- * the scene's bounding radius perpendicular to the direction. The camera
+ * the scene's bounding radius perpendicular to the direction, or a
+ * punctual light (KHR_lights_punctual, chosen in the emitters' table):
+ * a point or spot light in a direction on the sphere or in the outer
+ * cone, a directional light along a line through the portals or the disk
+ * (lights.h, sun_line_sample). A punctual light is a delta in position or
+ * direction: no ray hits it (no s = 0), the camera does not see it (no
+ * s = 1, t = 1, as in pt), and next-event estimation (s = 1) and light
+ * subpaths (s >= 2) both reach it with the probability of its choice,
+ * which cancels in the MIS ratios (mis.h). The camera
  * direction density is that of a uniform point on the whole image (camera.h):
  * with one light path per pixel sample, light tracing takes W H times as
  * many samples per pixel as each eye strategy and has W H times smaller

@@ -1,7 +1,8 @@
 /* lights.h — evaluating and sampling what emits light: emissive triangles
- * (one-sided, front = CCW) and the environment (env.h, env_portal.h), for
- * next-event estimation, and the portal triangles where intermediate
- * subpaths start. Tables come from src/lights.c and src/portal_flux.c.
+ * (one-sided, front = CCW), punctual lights (KHR_lights_punctual: point,
+ * spot, directional) and the environment (env.h, env_portal.h), for
+ * next-event estimation and light subpaths, and the portal triangles where
+ * intermediate subpaths start. Tables come from src/lights.c and src/portal_flux.c.
  * Every pdf names its measure: _a area, _w solid angle. */
 #ifndef AJAR_KERNEL_LIGHTS_H
 #define AJAR_KERNEL_LIGHTS_H
@@ -211,8 +212,9 @@ typedef struct {
 		      * pdf_w the probability of the choice; no other strategy samples it */
 } LightSample;
 
-/* The emitter half of light_sample: an emitter by power (u), a uniform
- * point on it (u1, u2), chosen in all with probability p_emitters. */
+/* The emitter half of light_sample: an emitter or a punctual light by
+ * power (u), a uniform point on an emitter (u1, u2), chosen in all with
+ * probability p_emitters. */
 INLINE int light_sample_emitter(const SceneView *sc, V3 x, float u, float u1, float u2, float p_emitters,
 				LightSample *ls)
 {
@@ -261,8 +263,9 @@ INLINE int light_sample_emitter(const SceneView *sc, V3 x, float u, float u1, fl
 
 /* Next-event estimation from shading point x with normal n: the
  * environment with probability Params.env_pdf_select (through the portals
- * that show x the sky, weighed by n, env_portal.h), else an emitter by
- * power and a uniform point on it. Returns 0 when there is nothing to
+ * that show x the sky, weighed by n, env_portal.h), else an emitter or a
+ * punctual light by power (a uniform point on an emitter; a punctual
+ * light's own position or direction, ls->delta). Returns 0 when there is nothing to
  * sample or the sample cannot carry light (emitter seen from behind or
  * edge-on, zero distance, zero density); the caller then adds nothing. */
 CALLED int light_sample(const SceneView *sc, V3 x, V3 n, float u_sel, float u1, float u2, LightSample *ls)

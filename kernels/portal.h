@@ -13,6 +13,9 @@
  * light subpath (s >= 2), to a fresh light sample (s = 1), or are the light
  * (s = 0). The -> half traces w, like a light subpath, and its vertices
  * connect to the eye subpath (t >= 2) or to the camera (t = 1, splatted).
+ * Punctual lights reach the <- half only by next-event estimation (s = 1)
+ * and light subpaths (s >= 2): the half never hits one, and a guided
+ * direction never aims at one (portal_guided_sample).
  * The portal is invisible, so w_0 is no path vertex: the pair x_m, x_{m+1}
  * (the first hits of the two halves) has density p_A q(w) G(x_m, x_{m+1})
  * and the contribution carries 1 / (p_A q(w)).

@@ -10,8 +10,8 @@
  *     a lone plane has no other light path, so these are exact up to
  *     float rounding;
  *   - the light choice: the plane lit by a point light, a directional
- *     light, an emissive triangle's absence notwithstanding, and the sky,
- *     all at once, has the sum of their images (within its noise);
+ *     light and the sky at once has the sum of their images (within its
+ *     noise), the lights sharing the emitters' table and the sky's share;
  *   - light subpaths' sampling against the densities MIS reads
  *     (chi-square): directions from point and spot lights, the lines of a
  *     directional light on the scene's disk and through two overlapping
