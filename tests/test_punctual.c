@@ -16,8 +16,8 @@
  *     (chi-square): directions from point and spot lights, the lines of a
  *     directional light on the scene's disk and through two overlapping
  *     portals;
- *   - the portal integrator refuses scenes with punctual lights and
- *     portals (its intermediate strategies do not take them yet). */
+ *   - every integrator prepares a scene with punctual lights, with and
+ *     without portals. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -430,10 +430,10 @@ static void test_sun_lines(void **state)
 	ajar_scene_destroy(&s);
 }
 
-/* The portal integrator (with portals) refuses punctual lights, which its
- * intermediate strategies do not take yet; bdpt, and portal in a scene
- * without portals (which is bdpt), render them. */
-static void test_portal_refuses(void **state)
+/* Every integrator takes punctual lights, with portals in the scene or
+ * without (portal without portals is bdpt), and the portal integrator
+ * then traces light subpaths. */
+static void test_every_integrator_prepares(void **state)
 {
 	ajar_scene *s = plane_scene();
 	ajar_light l;
@@ -441,18 +441,21 @@ static void test_portal_refuses(void **state)
 	l.position[1] = 1.0f;
 	assert_int_equal(ajar_scene_add_light(s, &l), AJAR_OK);
 	SceneData d;
-	for (int integ = INTEGRATOR_BDPT; integ <= INTEGRATOR_PORTAL; integ++) {
-		PrepareOptions po = {8, 8, integ, 8, 1, MIS_POWER, 0, 0, 0};
-		assert_int_equal(prepare_scene(s, &po, &d), AJAR_OK);
-		prepare_free(&d);
-	}
 	const float w[12] = {-0.5f, 1, -0.5f, -0.5f, 1, 0.5f, 0.5f, 1, 0.5f, 0.5f, 1, -0.5f};
 	const uint32_t quad[6] = {0, 1, 2, 0, 2, 3};
 	ajar_mesh m = {w, NULL, NULL, 4, quad, 2, 0, NULL};
-	assert_int_equal(ajar_scene_add_portal(s, &m), AJAR_OK);
-	PrepareOptions po = {8, 8, INTEGRATOR_PORTAL, 8, 1, MIS_POWER, 0, 0, 0};
-	assert_int_equal(prepare_scene(s, &po, &d), AJAR_ERROR_INVALID_ARGUMENT);
-	assert_non_null(strstr(ajar_last_error(), "the portal integrator does not render them yet"));
+	for (int portals = 0; portals < 2; portals++) {
+		if (portals)
+			assert_int_equal(ajar_scene_add_portal(s, &m), AJAR_OK);
+		for (int integ = INTEGRATOR_PT; integ <= INTEGRATOR_PORTAL; integ++) {
+			PrepareOptions po = {8, 8, integ, 8, 1, MIS_POWER, 0, 0, 0};
+			if (prepare_scene(s, &po, &d) != AJAR_OK)
+				fail_msg("integrator %d, portals %d: %s", integ, portals, ajar_last_error());
+			assert_int_equal(d.params->num_lights, 1);
+			assert_true(d.params->light_paths);
+			prepare_free(&d);
+		}
+	}
 	ajar_scene_destroy(&s);
 }
 
@@ -466,7 +469,7 @@ int main(void)
 		cmocka_unit_test(test_light_choice),
 		cmocka_unit_test(test_emission_directions),
 		cmocka_unit_test(test_sun_lines),
-		cmocka_unit_test(test_portal_refuses),
+		cmocka_unit_test(test_every_integrator_prepares),
 	};
 	return cmocka_run_group_tests_name("punctual", tests, NULL, NULL);
 }
