@@ -8,12 +8,13 @@ strength is multiplied by (1 - Backfacing), and the material's emission
 sampling is FRONT. The world is the uniform environment (black if none), or
 the sky image: an Environment Texture with "Closest" interpolation (Ajar's
 lookup is nearest-texel), fed the world direction through a Mapping node
-turning it by -(90 + rotation) degrees about Blender's Z. Ajar's lookup
-u = 0.5 + atan2(x, -z) / 2 pi in glTF axes is Cycles' equirectangular
-u = 0.5 - atan2(y, x) / 2 pi turned by -90 degrees (Blender's importer maps
-glTF (x, y, z) to (x, -z, y)), and the sky's rotation about glTF +Y is one
-about Blender +Z, the lookup turning the other way (checked with a sky of
-numbered columns seen straight on). Its negative pixels are clamped to 0,
+with Euler rotation (90, 0, -(90 + rotation)) degrees. The scene is built
+in glTF's axes (+Y up), so the X turn first takes the direction to
+Blender's (x, -z, y), where Cycles' equirectangular lookup
+u = 0.5 - atan2(y, x) / 2 pi is Ajar's u = 0.5 + atan2(x, -z) / 2 pi turned
+by -90 degrees about Z, and the sky's rotation about glTF +Y is one about
+Blender +Z, the lookup turning the other way (checked with a sky of
+numbered columns seen straight on, and by the converged means). Its negative pixels are clamped to 0,
 as Ajar does. KHR_lights_punctual lights become Blender lamps with the
 importer's "Standard" units: sun strength = lux / 683 W/m^2, point and
 spot power = candela x 4 pi / 683 W, spot size = 2 x outer cone angle,
@@ -105,7 +106,8 @@ def sky_world(bpy, nt, bg, sky):
 	tc = nt.nodes.new("ShaderNodeTexCoord")
 	mp = nt.nodes.new("ShaderNodeMapping")
 	mp.vector_type = "POINT"
-	mp.inputs["Rotation"].default_value = (0.0, 0.0, math.radians(-90.0 - sky["rotation"]))
+	# Euler XYZ: the X turn applies first.
+	mp.inputs["Rotation"].default_value = (math.radians(90.0), 0.0, math.radians(-90.0 - sky["rotation"]))
 	et = nt.nodes.new("ShaderNodeTexEnvironment")
 	et.image = img
 	et.interpolation = "Closest"
@@ -116,9 +118,9 @@ def sky_world(bpy, nt, bg, sky):
 	bg.inputs["Strength"].default_value = float(sky["strength"])
 
 
-def blender_vec(mathutils, v):
-	"""glTF axes to Blender's, as its importer maps them."""
-	return mathutils.Vector((float(v[0]), float(-v[2]), float(v[1])))
+def vec(mathutils, v):
+	"""The scene stays in glTF's axes here (+Y up), so vectors go in as they are."""
+	return mathutils.Vector((float(v[0]), float(v[1]), float(v[2])))
 
 
 def add_lamps(bpy, mathutils, sc, lights):
@@ -138,8 +140,8 @@ def add_lamps(bpy, mathutils, sc, lights):
 		lamp.color = tuple(float(c) for c in color)
 		lamp.use_shadow = True
 		ob = bpy.data.objects.new(f"light{k}", lamp)
-		rot = blender_vec(mathutils, li["direction"]).to_track_quat("-Z", "Y").to_matrix().to_4x4()
-		ob.matrix_world = mathutils.Matrix.Translation(blender_vec(mathutils, li["position"])) @ rot
+		rot = vec(mathutils, li["direction"]).to_track_quat("-Z", "Y").to_matrix().to_4x4()
+		ob.matrix_world = mathutils.Matrix.Translation(vec(mathutils, li["position"])) @ rot
 		sc.collection.objects.link(ob)
 
 
