@@ -215,6 +215,20 @@ ajar_status ajar_read_exr(const char *path, float **rgba, uint32_t *width, uint3
 /* Tone-mapped (exposure, sRGB) 8-bit PNG of float RGBA. */
 ajar_status ajar_write_png(const char *path, const float *rgba, uint32_t width, uint32_t height);
 
+/* ---- Appended API: scene files kept in their folder ------------------------ */
+
+/* How ajar_scene_load_with reads a scene. By default every file the scene
+ * names (buffer and image URIs, the environment image in its extras) must
+ * resolve, after ".." and symbolic links, inside the scene file's folder;
+ * anything else fails with AJAR_ERROR_BAD_INPUT naming the URI. A render
+ * service that renders other people's files keeps this default. */
+typedef struct {
+	int allow_outside_files; /* 1: files anywhere may be read (trusted scenes) */
+} ajar_load_options;
+void ajar_load_options_default(ajar_load_options *o);
+/* ajar_scene_load is ajar_scene_load_with(path, NULL, out): confined. */
+ajar_status ajar_scene_load_with(const char *path, const ajar_load_options *o, ajar_scene **out);
+
 #ifdef __cplusplus
 }
 #endif

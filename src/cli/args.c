@@ -123,6 +123,10 @@ int args_parse_render(int argc, char **argv, RenderArgs *a)
 			a->opt.strategy_unweighted = 1;
 			continue;
 		}
+		if (!strcmp(arg, "--allow-outside-files")) {
+			a->allow_outside_files = 1;
+			continue;
+		}
 		/* Every other option takes a value: "--opt value" or "--opt=value". */
 		char name[32];
 		const char *val, *eq = strchr(arg, '=');

@@ -27,6 +27,7 @@ typedef struct {
 	ajar_options opt;  /* spp, time_limit, size, integrator, depth, seed, device */
 	int quiet;
 	int help;          /* --help was given: print render help, nothing else */
+	int allow_outside_files; /* --allow-outside-files */
 } RenderArgs;
 
 /* Parses the arguments after `render`. Returns EXIT_OK or EXIT_USAGE

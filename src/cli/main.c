@@ -72,6 +72,9 @@ static const char usage_render[] =
 	"                         sum to the image of paths of up to N segments\n"
 	"  --unweighted           the strategy layers without MIS weights\n"
 	"  --seed N               random seed (same seed, device and options: same image)\n"
+	"  --allow-outside-files  let the scene read files outside its folder (by default\n"
+	"                         every URI and the environment image must resolve, after\n"
+	"                         '..' and symbolic links, inside the scene file's folder)\n"
 	"  --device SELECTOR      platform:device index (e.g. 0:1), cpu, gpu, a part of the\n"
 	"                         device name, a comma-separated list of these, or all:\n"
 	"                         several devices render at once; see 'ajar devices'\n"
@@ -114,9 +117,12 @@ static void report(ajar_status st, const char *file)
 
 /* Loads a scene; a scene that cannot be read is bad input (exit 2) even
  * when the library calls it an I/O error: exit 4 is for outputs. */
-static int load_scene(const char *path, ajar_scene **scene)
+static int load_scene(const char *path, int allow_outside_files, ajar_scene **scene)
 {
-	ajar_status st = ajar_scene_load(path, scene);
+	ajar_load_options lo;
+	ajar_load_options_default(&lo);
+	lo.allow_outside_files = allow_outside_files;
+	ajar_status st = ajar_scene_load_with(path, &lo, scene);
 	if (st == AJAR_OK)
 		return EXIT_OK;
 	report(st, path);
@@ -288,7 +294,7 @@ static int cmd_render(int argc, char **argv)
 
 	ajar_scene *scene = NULL;
 	ajar_renderer *r = NULL;
-	if ((rc = load_scene(a.scene, &scene)) != EXIT_OK)
+	if ((rc = load_scene(a.scene, a.allow_outside_files, &scene)) != EXIT_OK)
 		goto done;
 	if (g_interrupted) {
 		rc = interrupted_early();
@@ -405,15 +411,18 @@ static int cmd_devices(int argc, char **argv)
 static int cmd_info(int argc, char **argv)
 {
 	if (argc == 1 && (!strcmp(argv[0], "-h") || !strcmp(argv[0], "--help"))) {
-		fputs("usage: ajar info SCENE.gltf|SCENE.glb\n", stdout);
+		fputs("usage: ajar info [--allow-outside-files] SCENE.gltf|SCENE.glb\n", stdout);
 		return EXIT_OK;
 	}
+	int allow_outside_files = argc == 2 && !strcmp(argv[0], "--allow-outside-files");
+	argc -= allow_outside_files;
+	argv += allow_outside_files;
 	if (argc != 1)
 		return args_usage_error("info: expects one scene, got %d arguments", argc);
 	if (argv[0][0] == '-')
 		return args_usage_error("info: unknown option '%s'", argv[0]);
 	ajar_scene *scene = NULL;
-	int rc = load_scene(argv[0], &scene);
+	int rc = load_scene(argv[0], allow_outside_files, &scene);
 	if (rc != EXIT_OK)
 		return rc;
 	ajar_scene_info in;
