@@ -229,6 +229,37 @@ void ajar_load_options_default(ajar_load_options *o);
 /* ajar_scene_load is ajar_scene_load_with(path, NULL, out): confined. */
 ajar_status ajar_scene_load_with(const char *path, const ajar_load_options *o, ajar_scene **out);
 
+/* ---- Appended API: checkpoint and resume ----------------------------------- */
+
+/* A checkpoint holds a render's films (integer sums, splats, strategy
+ * layers), the sample ranges done, the seed, the options and hashes of the
+ * prepared scene and the render parameters. A render stopped and resumed
+ * any number of times gives the same bits as an uninterrupted one on the
+ * same kind of device. Files are written atomically (temporary name, fsync,
+ * rename): a write that fails keeps the previous file. */
+
+/* Writes r's state to `path`. Not while ajar_renderer_render runs (use
+ * ajar_renderer_set_checkpoint for that); call it after a render returns,
+ * whatever its status, to keep the samples done. */
+ajar_status ajar_renderer_write_checkpoint(ajar_renderer *r, const char *path);
+/* During ajar_renderer_render: write a checkpoint to `path` every
+ * `every_seconds` (0: only when a device is dropped) and when a device is
+ * dropped; the devices wait while it is written. A failed write is a
+ * warning (log callback) and the render goes on. NULL path: none. */
+ajar_status ajar_renderer_set_checkpoint(ajar_renderer *r, const char *path, double every_seconds);
+/* The options a checkpoint was made with (device NULL, width and height
+ * resolved) and, if spp_done is not NULL, the samples per pixel it holds
+ * (then the whole file is checked, else only its header). */
+ajar_status ajar_checkpoint_options(const char *path, ajar_options *o, uint32_t *spp_done);
+/* A renderer that continues the checkpoint at `path`. o NULL: the
+ * checkpoint's options; else o must equal them (ajar_checkpoint_options)
+ * except spp, time_limit (total seconds, the checkpoint's time included)
+ * and device. A checkpoint of another scene, version or parameter set, or
+ * a truncated or corrupted one, is AJAR_ERROR_BAD_INPUT; the file is only
+ * read. */
+ajar_status ajar_renderer_resume(const ajar_scene *scene, const char *path, const ajar_options *o,
+				 ajar_renderer **out);
+
 #ifdef __cplusplus
 }
 #endif
