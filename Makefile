@@ -50,6 +50,7 @@ DEPS_test_cli := $(BUILD)/libajar.a
 DEPS_test_multidevice := $(BUILD)/libajar.a
 DEPS_test_integrators := $(BUILD)/libajar.a
 DEPS_test_traversal := $(BUILD)/libajar.a
+DEPS_test_checkpoint := $(BUILD)/libajar.a
 
 .PHONY: all lib cli tests test test-unit asan demo bench bench-peers install uninstall clean deps help
 all: lib cli

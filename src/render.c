@@ -115,6 +115,7 @@ struct ajar_renderer {
 	int pausing;          /* under the lock: no device takes a new range */
 	int hashed;
 	uint64_t scene_hash, params_hash;
+	uint32_t pass_cap; /* test hook AJAR_TEST_PASS_SPP: at most this many samples per pass */
 };
 
 static double seconds(void)
@@ -373,6 +374,10 @@ static ajar_status renderer_new(const ajar_scene *scene, const ajar_options *opt
 	r->strategy_len = (int)opt->strategy_len;
 	r->opt = *opt;
 	r->opt.device = NULL;
+	/* Test hook: AJAR_TEST_PASS_SPP=N caps every pass at N samples per
+	 * pixel, so tests can stop a render at many points. */
+	const char *cap = getenv("AJAR_TEST_PASS_SPP");
+	r->pass_cap = cap ? (uint32_t)strtoul(cap, NULL, 10) : 0;
 	r->opt.width = r->width;
 	r->opt.height = r->height;
 	snprintf(r->scene_name, sizeof r->scene_name, "%s", scene->source ? scene->source : "");
@@ -541,6 +546,8 @@ static int take_range(ajar_renderer *r, RenderDevice *rd, Range *g)
 				count = (uint32_t)share;
 		}
 	}
+	if (r->pass_cap && count > r->pass_cap)
+		count = r->pass_cap;
 	if (r->holes.n) {
 		Range *h = &r->holes.r[r->holes.n - 1];
 		g->first = h->first;
@@ -1099,7 +1106,7 @@ ajar_status ajar_checkpoint_options(const char *path, ajar_options *o, uint32_t 
 	if (!path || !o)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_checkpoint_options: NULL argument");
 	Checkpoint c;
-	ajar_status st = checkpoint_read(path, &c, spp_done != NULL);
+	ajar_status st = checkpoint_read(path, &c, spp_done == NULL);
 	if (st != AJAR_OK)
 		return st;
 	options_from_checkpoint(&c, o);
