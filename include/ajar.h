@@ -142,6 +142,7 @@ typedef struct {
 	const char *device;      /* selector ("0:0", "cpu", "gpu", name substring), a comma-
 				  * separated list of them or "all" (render on several
 				  * devices at once), or NULL for the first CPU device */
+	uint32_t aov;            /* AJAR_AOV_* bits: first-hit outputs for denoisers */
 } ajar_options;
 void ajar_options_default(ajar_options *o);
 
@@ -228,6 +229,24 @@ typedef struct {
 void ajar_load_options_default(ajar_load_options *o);
 /* ajar_scene_load is ajar_scene_load_with(path, NULL, out): confined. */
 ajar_status ajar_scene_load_with(const char *path, const ajar_load_options *o, ajar_scene **out);
+
+/* ---- Appended API: outputs a denoiser takes ------------------------------- */
+
+/* ajar_options.aov bits. Each AOV is an unbiased pixel average (the same
+ * jittered camera rays as the image), identical across devices, passes,
+ * resumes and integrators. Albedo and normal are those of the first
+ * non-specular hit, through mirrors and smooth glass (as Open Image Denoise
+ * asks); an escaped ray adds zeros. */
+#define AJAR_AOV_ALBEDO 1u   /* base colour (textured), linear RGB */
+#define AJAR_AOV_NORMAL 2u   /* world-space shading normal, toward the viewer */
+#define AJAR_AOV_DEPTH 4u    /* distance from the camera to the first hit */
+#define AJAR_AOV_VARIANCE 8u /* variance of the pixel mean of the pixel's own samples */
+#define AJAR_AOV_ALL 15u
+/* The AOV images: width * height * 10 floats, row-major, top row first:
+ * albedo RGB, normal XYZ, depth, variance RGB (zeros for AOVs not asked
+ * for). ajar_renderer_write_exr adds the asked ones to the EXR as
+ * albedo.R/G/B, normal.X/Y/Z, depth.Z, variance.R/G/B. */
+ajar_status ajar_renderer_aovs(ajar_renderer *r, float *px);
 
 /* ---- Appended API: checkpoint and resume ----------------------------------- */
 

@@ -38,6 +38,7 @@
 #include "scene.h"
 #include "render_info.h"
 #include "upload.h"
+#include "../kernels/aov_layout.h"
 #include "../kernels/compat.h"
 #include "../kernels/film.h"
 #include "../kernels/strategies.h"
@@ -185,6 +186,8 @@ static ajar_status check_options(const ajar_options *in, ajar_options *out)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "set a sample count or a time limit");
 	if (o->time_limit < 0 || o->time_limit != o->time_limit)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "time limit must be positive");
+	if (o->aov & ~AJAR_AOV_ALL)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "aov: unknown bits 0x%x", o->aov & ~AJAR_AOV_ALL);
 	return AJAR_OK;
 }
 
@@ -208,8 +211,18 @@ static size_t film_bytes(const ajar_renderer *r)
 	return sizeof(cl_long) * 3 * (size_t)r->width * r->height;
 }
 
-/* The splat film, followed by bdpt's per-strategy layers if asked for. */
-static size_t splat_bytes(const ajar_renderer *r) { return film_bytes(r) * (1 + (size_t)r->nlayers); }
+/* Longs before the AOV film in the splat buffer: the splats and layers. */
+static size_t aov_offset(const ajar_renderer *r) { return 3 * (size_t)r->width * r->height * (1 + (size_t)r->nlayers); }
+
+/* The splat film, followed by bdpt's per-strategy layers if asked for and
+ * the first-hit AOVs (aov.h) if asked for: own-pixel sums, but kept here
+ * so every path that reads, salvages, sums and checkpoints films has them. */
+static size_t splat_count(const ajar_renderer *r)
+{
+	return aov_offset(r) + (r->opt.aov ? (size_t)AOV_CHANNELS * r->width * r->height : 0);
+}
+
+static size_t splat_bytes(const ajar_renderer *r) { return sizeof(cl_long) * splat_count(r); }
 
 /* Context, program, scene and films on one device. */
 static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_id plat, cl_device_id id)
@@ -248,6 +261,9 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 	CL_TRY(d, clEnqueueFillBuffer(d->queue, rd->splat, &zero, sizeof zero, 0, sbytes, 0, NULL, NULL));
 	CL_TRY(d, clSetKernelArg(rd->k_render, rd->arg_first, sizeof(cl_mem), &rd->accum));
 	CL_TRY(d, clSetKernelArg(rd->k_render, rd->arg_first + 1, sizeof(cl_mem), &rd->splat));
+	/* The AOV film: the same buffer, after the layers (the kernel adds aov_at). */
+	cl_ulong aov_at = r->opt.aov ? aov_offset(r) : 0;
+	CL_TRY(d, clSetKernelArg(rd->k_render, rd->arg_first + 4, sizeof aov_at, &aov_at));
 	CL_TRY(d, clFinish(d->queue));
 	/* An explicit work-group size, measured on PoCL 3.1's CPU device (2
 	 * cores, 128x128 path tracing, first pass = PoCL's cold work-group
@@ -390,7 +406,7 @@ static ajar_status renderer_new(const ajar_scene *scene, const ajar_options *opt
 	if ((st = open_devices(r, opt->device)) != AJAR_OK)
 		goto fail;
 	r->film = calloc(3 * (size_t)r->width * r->height, sizeof *r->film);
-	r->film_splat = calloc(3 * (size_t)r->width * r->height * (1 + (size_t)r->nlayers), sizeof *r->film_splat);
+	r->film_splat = calloc(splat_count(r), sizeof *r->film_splat);
 	if (!r->film || !r->film_splat) {
 		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory for a %ux%u image", r->width, r->height);
 		goto fail;
@@ -627,7 +643,7 @@ static int read_films(RenderDevice *rd, long **accum, long **splat)
 /* Adds a dropped device's films to the salvage (under the lock); 0 if out of memory. */
 static int salvage_add(ajar_renderer *r, const long *accum, const long *splat)
 {
-	size_t n = 3 * (size_t)r->width * r->height, ns = n * (1 + (size_t)r->nlayers);
+	size_t n = 3 * (size_t)r->width * r->height, ns = splat_count(r);
 	if (!r->salvage) {
 		r->salvage = calloc(n, sizeof *r->salvage);
 		r->salvage_splat = calloc(ns, sizeof *r->salvage_splat);
@@ -882,11 +898,44 @@ ajar_status ajar_renderer_image(ajar_renderer *r, float *rgba, uint32_t *width, 
 	return AJAR_OK;
 }
 
+ajar_status ajar_renderer_aovs(ajar_renderer *r, float *px)
+{
+	if (!r || !px)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_aovs: NULL argument");
+	if (!r->opt.aov)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "the renderer keeps no AOVs (set ajar_options.aov)");
+	ajar_status st = reduce(r);
+	if (st != AJAR_OK)
+		return st;
+	size_t npix = (size_t)r->width * r->height;
+	const long *a = r->film_splat + aov_offset(r);
+	double n = r->spp_done, inv = n > 0 ? 1.0 / ((double)FILM_SCALE * n) : 0.0;
+	double inv_sq = n > 0 ? 1.0 / ((double)AOV_SQ_SCALE * n) : 0.0;
+	static const uint32_t bit[AOV_CHANNELS] = {AJAR_AOV_ALBEDO, AJAR_AOV_ALBEDO, AJAR_AOV_ALBEDO,
+						   AJAR_AOV_NORMAL, AJAR_AOV_NORMAL, AJAR_AOV_NORMAL,
+						   AJAR_AOV_DEPTH,  AJAR_AOV_VARIANCE, AJAR_AOV_VARIANCE,
+						   AJAR_AOV_VARIANCE};
+	for (size_t i = 0; i < npix; i++) {
+		const long *p = a + AOV_CHANNELS * i;
+		float *o = px + AOV_CHANNELS * i;
+		for (int c = 0; c < 7; c++)
+			o[c] = (r->opt.aov & bit[c]) ? (float)((double)p[c] * inv) : 0.0f;
+		/* Sample variance of the pixel's own estimates over n, from
+		 * sum(x) (the own-pixel film) and sum(x^2). */
+		for (int c = 0; c < 3; c++) {
+			double m = (double)r->film[3 * i + c] * inv, m2 = (double)p[7 + c] * inv_sq;
+			o[7 + c] = (r->opt.aov & AJAR_AOV_VARIANCE) && n > 1 ? (float)(fmax(0.0, m2 - m * m) / (n - 1))
+									       : 0.0f;
+		}
+	}
+	return AJAR_OK;
+}
+
 /* Sums the salvage and every live device's films into r->film and
  * r->film_splat: integer sums, the same bits whatever the device count. */
 static ajar_status reduce(ajar_renderer *r)
 {
-	size_t n = 3 * (size_t)r->width * r->height, ns = n * (1 + (size_t)r->nlayers);
+	size_t n = 3 * (size_t)r->width * r->height, ns = splat_count(r);
 	long *sum = r->film, *sum_splat = r->film_splat;
 	if (r->salvage) {
 		memcpy(sum, r->salvage, n * sizeof *sum);
@@ -936,6 +985,7 @@ void render_info(const ajar_renderer *r, RenderInfo *info)
 	info->strategy_len = r->strategy_len;
 	info->strategy_unweighted = r->strategy_unweighted;
 	info->layers = r->film_splat + 3 * (size_t)r->width * r->height;
+	info->aov = r->opt.aov;
 }
 
 ajar_status ajar_devices(ajar_device_info *out, uint32_t capacity, uint32_t *count)
@@ -999,6 +1049,7 @@ static ajar_status checkpoint_gather(ajar_renderer *r, Checkpoint *c)
 	c->strategy_len = o->strategy_len;
 	c->strategy_unweighted = (uint32_t)o->strategy_unweighted;
 	c->spp = r->spp_target;
+	c->aov = o->aov;
 	c->time_limit = r->time_limit;
 	c->elapsed = r->elapsed;
 	size_t n = r->base.n;
@@ -1033,7 +1084,9 @@ static ajar_status checkpoint_gather(ajar_renderer *r, Checkpoint *c)
 	c->film[CKPT_ACCUM] = r->film;
 	c->nfilm[CKPT_ACCUM] = 3 * (size_t)r->width * r->height;
 	c->film[CKPT_SPLAT] = r->film_splat;
-	c->nfilm[CKPT_SPLAT] = c->nfilm[CKPT_ACCUM] * (1 + (size_t)r->nlayers);
+	c->nfilm[CKPT_SPLAT] = aov_offset(r);
+	c->film[CKPT_AOV] = r->film_splat + aov_offset(r);
+	c->nfilm[CKPT_AOV] = splat_count(r) - aov_offset(r);
 	return AJAR_OK;
 }
 
@@ -1099,6 +1152,7 @@ static void options_from_checkpoint(const Checkpoint *c, ajar_options *o)
 	o->mis = (ajar_mis)c->mis;
 	o->strategy_len = c->strategy_len;
 	o->strategy_unweighted = (int)c->strategy_unweighted;
+	o->aov = c->aov;
 }
 
 ajar_status ajar_checkpoint_options(const char *path, ajar_options *o, uint32_t *spp_done)
@@ -1138,9 +1192,14 @@ static ajar_status checkpoint_check(ajar_renderer *r, const Checkpoint *c, const
 
 static ajar_status checkpoint_apply(ajar_renderer *r, Checkpoint *c, const char *path)
 {
-	size_t n = 3 * (size_t)r->width * r->height, ns = n * (1 + (size_t)r->nlayers);
-	if (c->nfilm[CKPT_ACCUM] != n || c->nfilm[CKPT_SPLAT] != ns || c->nfilm[CKPT_AOV] != 0)
+	size_t n = 3 * (size_t)r->width * r->height, ns = aov_offset(r);
+	if (c->nfilm[CKPT_ACCUM] != n || c->nfilm[CKPT_SPLAT] != ns || c->nfilm[CKPT_AOV] != splat_count(r) - ns)
 		return err_set(AJAR_ERROR_BAD_INPUT, "%s: checkpoint is corrupted (film sizes)", path);
+	long *splat = realloc(c->film[CKPT_SPLAT], sizeof *splat * (splat_count(r) ? splat_count(r) : 1));
+	if (!splat)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory");
+	memcpy(splat + ns, c->film[CKPT_AOV], sizeof *splat * (splat_count(r) - ns));
+	c->film[CKPT_SPLAT] = splat;
 	uint32_t end = 0;
 	uint64_t done = 0;
 	for (uint32_t i = 0; i < c->nranges; i++) {
@@ -1190,6 +1249,7 @@ ajar_status ajar_renderer_resume(const ajar_scene *scene, const char *path, cons
 				      : o->mis != want.mis				 ? "mis"
 				      : o->strategy_len != want.strategy_len		 ? "strategy_len"
 				      : o->strategy_unweighted != want.strategy_unweighted ? "strategy_unweighted"
+				      : o->aov != want.aov				 ? "aov"
 											   : NULL;
 		if (differs) {
 			checkpoint_free(&c);

@@ -48,7 +48,7 @@ static ajar_scene *load(const char *path)
 	return s;
 }
 
-static ajar_options options(ajar_integrator integrator, uint32_t strategy_len)
+static ajar_options options(ajar_integrator integrator, uint32_t strategy_len, uint32_t aov)
 {
 	ajar_options o;
 	ajar_options_default(&o);
@@ -59,6 +59,7 @@ static ajar_options options(ajar_integrator integrator, uint32_t strategy_len)
 	o.integrator = integrator;
 	o.strategy_len = strategy_len;
 	o.max_depth = 6;
+	o.aov = aov;
 	return o;
 }
 
@@ -98,10 +99,11 @@ static void same_films(const char *a, const char *b)
 }
 
 /* Straight, then stopped at two random passes and resumed each time. */
-static void resume_equals_straight(const char *scene_path, ajar_integrator integrator, uint32_t strategy_len)
+static void resume_equals_straight(const char *scene_path, ajar_integrator integrator, uint32_t strategy_len,
+				   uint32_t aov)
 {
 	ajar_scene *s = load(scene_path);
-	ajar_options o = options(integrator, strategy_len);
+	ajar_options o = options(integrator, strategy_len, aov);
 	ajar_renderer *r = NULL;
 	char *straight = tmp("straight.ck"), *ck = tmp("resumed.ck");
 	assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_OK);
@@ -147,19 +149,19 @@ static void resume_equals_straight(const char *scene_path, ajar_integrator integ
 static void test_resume_pt(void **state)
 {
 	(void)state;
-	resume_equals_straight(SCENE("cornell/cornell.gltf"), AJAR_INTEGRATOR_PT, 0);
+	resume_equals_straight(SCENE("cornell/cornell.gltf"), AJAR_INTEGRATOR_PT, 0, 0);
 }
 
 static void test_resume_bdpt_layers(void **state)
 {
 	(void)state;
-	resume_equals_straight(SCENE("cornell/cornell.gltf"), AJAR_INTEGRATOR_BDPT, 3);
+	resume_equals_straight(SCENE("cornell/cornell.gltf"), AJAR_INTEGRATOR_BDPT, 3, AJAR_AOV_ALL);
 }
 
 static void test_resume_portal_layers(void **state)
 {
 	(void)state;
-	resume_equals_straight(SCENE("door-ajar/door-ajar.gltf"), AJAR_INTEGRATOR_PORTAL, 3);
+	resume_equals_straight(SCENE("door-ajar/door-ajar.gltf"), AJAR_INTEGRATOR_PORTAL, 3, AJAR_AOV_ALL);
 }
 
 /* ---- Refusals -------------------------------------------------------------- */
@@ -210,7 +212,7 @@ static void test_refused(void **state)
 {
 	(void)state;
 	ajar_scene *s = load(SCENE("cornell/cornell.gltf")), *other = load(SCENE("door-ajar/door-ajar.gltf"));
-	ajar_options o = options(AJAR_INTEGRATOR_PT, 0);
+	ajar_options o = options(AJAR_INTEGRATOR_PT, 0, 0);
 	o.spp = 2;
 	ajar_renderer *r = NULL;
 	char *good = tmp("good.ck"), *bad = tmp("bad.ck");
@@ -308,7 +310,7 @@ static void test_failed_write_keeps_old(void **state)
 {
 	(void)state;
 	ajar_scene *s = load(SCENE("cornell/cornell.gltf"));
-	ajar_options o = options(AJAR_INTEGRATOR_PT, 0);
+	ajar_options o = options(AJAR_INTEGRATOR_PT, 0, 0);
 	o.spp = 2;
 	ajar_renderer *r = NULL;
 	char *dir = tmp("keep"), *ck = test_path(dir, "render.ck");
@@ -365,7 +367,7 @@ static void test_device_lost(void **state)
 {
 	(void)state;
 	ajar_scene *s = load(SCENE("cornell/cornell.gltf"));
-	ajar_options o = options(AJAR_INTEGRATOR_PT, 0);
+	ajar_options o = options(AJAR_INTEGRATOR_PT, 0, 0);
 	ajar_renderer *r = NULL;
 	char *ck = tmp("lost.ck");
 	assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_OK);
@@ -456,7 +458,7 @@ static void test_cli_sigint(void **state)
 	(void)state;
 	/* The straight render through the API: the EXR holds the same floats. */
 	ajar_scene *s = load(SCENE("cornell/cornell.gltf"));
-	ajar_options o = options(AJAR_INTEGRATOR_BDPT, 2);
+	ajar_options o = options(AJAR_INTEGRATOR_BDPT, 2, AJAR_AOV_ALL);
 	o.width = 24;
 	o.height = 24;
 	o.spp = 1000;
@@ -472,7 +474,7 @@ static void test_cli_sigint(void **state)
 	char *exr = tmp("cli.exr"), *strat = tmp("cli-strategies.exr"), *ck = tmp("cli.ck");
 	const char *first[] = {"render", SCENE("cornell/cornell.gltf"), "-o", exr, "--size", "24x24", "--spp", "1000",
 			       "--seed", "11", "--integrator", "bdpt", "--max-depth", "6", "--strategies", strat,
-			       "--strategy-len", "2", "--checkpoint", ck, "-q", NULL};
+			       "--strategy-len", "2", "--aov", "albedo,normal,depth,variance", "--checkpoint", ck, "-q", NULL};
 	const char *again[] = {"render", SCENE("cornell/cornell.gltf"), "-o", exr, "--resume", ck, "--strategies",
 			       strat, "-q", NULL};
 	int interrupted = 0, runs = 0;
@@ -498,6 +500,18 @@ static void test_cli_sigint(void **state)
 	assert_int_equal(w, 24);
 	assert_memory_equal(got, want, sizeof(float) * 4 * 24 * 24);
 	free(got);
+
+	/* The films, AOVs and layers too: the program's last checkpoint against
+	 * the straight render's. */
+	char *straight = tmp("cli-straight.ck");
+	assert_int_equal(ajar_renderer_create(s = load(SCENE("cornell/cornell.gltf")), &o, &r), AJAR_OK);
+	assert_int_equal(ajar_renderer_render(r, NULL, NULL), AJAR_OK);
+	assert_int_equal(ajar_renderer_write_checkpoint(r, straight), AJAR_OK);
+	ajar_renderer_destroy(&r);
+	ajar_scene_destroy(&s);
+	same_films(ck, straight);
+	unlink(straight);
+	free(straight);
 
 	/* A conflicting option names itself; a corrupted file is refused and kept. */
 	const char *conflict[] = {"render", SCENE("cornell/cornell.gltf"), "-o", exr, "--resume", ck, "--seed", "12",

@@ -91,6 +91,30 @@ static int parse_integrator(const char *opt, const char *s, ajar_integrator *out
 	return args_usage_error("%s: '%s' is not one of pt, bdpt, portal", opt, s);
 }
 
+/* --aov: a comma-separated list of albedo, normal, depth, variance. */
+static int parse_aov(const char *opt, const char *s, uint32_t *out)
+{
+	static const struct {
+		const char *name;
+		uint32_t bit;
+	} aovs[] = {{"albedo", AJAR_AOV_ALBEDO}, {"normal", AJAR_AOV_NORMAL}, {"depth", AJAR_AOV_DEPTH},
+		    {"variance", AJAR_AOV_VARIANCE}};
+	*out = 0;
+	for (const char *p = s; *p;) {
+		size_t n = strcspn(p, ",");
+		size_t k = 0;
+		while (k < sizeof aovs / sizeof aovs[0] && (strlen(aovs[k].name) != n || strncmp(p, aovs[k].name, n)))
+			k++;
+		if (k == sizeof aovs / sizeof aovs[0])
+			return args_usage_error("%s: '%.*s' is not one of albedo, normal, depth, variance", opt, (int)n, p);
+		*out |= aovs[k].bit;
+		p += n;
+		if (*p == ',' && *++p == '\0')
+			return args_usage_error("%s: '%s' ends with a comma", opt, s);
+	}
+	return EXIT_OK;
+}
+
 int args_parse_render(int argc, char **argv, RenderArgs *a)
 {
 	memset(a, 0, sizeof *a);
@@ -145,7 +169,7 @@ int args_parse_render(int argc, char **argv, RenderArgs *a)
 		static const char *const known[] = {"-o", "--output", "--spp", "--time", "--size", "--integrator",
 						    "--max-depth", "--seed", "--device", "--png", "--min-depth",
 						    "--mis", "--strategies", "--strategy-len", "--exposure",
-						    "--checkpoint", "--checkpoint-every", "--resume"};
+						    "--checkpoint", "--checkpoint-every", "--resume", "--aov"};
 		size_t k = 0;
 		while (k < sizeof known / sizeof known[0] && strcmp(name, known[k]) != 0)
 			k++;
@@ -169,6 +193,8 @@ int args_parse_render(int argc, char **argv, RenderArgs *a)
 			a->checkpoint = val;
 		else if (!strcmp(name, "--resume"))
 			a->resume = val;
+		else if (!strcmp(name, "--aov"))
+			rc = parse_aov(name, val, &a->opt.aov);
 		else if (!strcmp(name, "--checkpoint-every"))
 			rc = parse_seconds(name, val, &a->checkpoint_every);
 		else if (!strcmp(name, "--spp")) {
@@ -214,7 +240,7 @@ int args_parse_render(int argc, char **argv, RenderArgs *a)
 			    {"--max-depth", GIVEN_MAX_DEPTH}, {"--min-depth", GIVEN_MIN_DEPTH},
 			    {"--seed", GIVEN_SEED},	    {"--mis", GIVEN_MIS},
 			    {"--strategy-len", GIVEN_STRATEGY_LEN}, {"--spp", GIVEN_SPP},
-			    {"--time", GIVEN_TIME}};
+			    {"--time", GIVEN_TIME}, {"--aov", GIVEN_AOV}};
 		for (size_t b = 0; b < sizeof bits / sizeof bits[0]; b++)
 			if (!strcmp(name, bits[b].name))
 				a->given |= bits[b].bit;

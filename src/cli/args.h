@@ -45,7 +45,8 @@ enum {
 	GIVEN_STRATEGY_LEN = 1 << 6,
 	GIVEN_UNWEIGHTED = 1 << 7,
 	GIVEN_SPP = 1 << 8,
-	GIVEN_TIME = 1 << 9
+	GIVEN_TIME = 1 << 9,
+	GIVEN_AOV = 1 << 10
 };
 
 /* Parses the arguments after `render`. Returns EXIT_OK or EXIT_USAGE

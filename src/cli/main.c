@@ -72,6 +72,11 @@ static const char usage_render[] =
 	"                         sum to the image of paths of up to N segments\n"
 	"  --unweighted           the strategy layers without MIS weights\n"
 	"  --seed N               random seed (same seed, device and options: same image)\n"
+	"  --aov LIST             add channels a denoiser takes to the EXR, any of\n"
+	"                         albedo (albedo.R/G/B), normal (normal.X/Y/Z), depth\n"
+	"                         (depth.Z) and variance (variance.R/G/B), comma-separated;\n"
+	"                         albedo and normal of the first non-specular hit\n"
+	"                         (through mirrors and glass), depth of the first hit\n"
 	"  --checkpoint FILE      keep the render resumable: write its state to FILE every\n"
 	"                         --checkpoint-every SECONDS (default 60), when a device\n"
 	"                         fails and when the render stops (also on Ctrl-C)\n"
@@ -302,6 +307,7 @@ static int resume_options(RenderArgs *a)
 	CONFLICT(GIVEN_MIN_DEPTH, "--min-depth", o->min_depth != ck.min_depth, "%u", o->min_depth, ck.min_depth);
 	CONFLICT(GIVEN_SEED, "--seed", o->seed != ck.seed, "%u", o->seed, ck.seed);
 	CONFLICT(GIVEN_MIS, "--mis", o->mis != ck.mis, "%s", mis_name(o->mis), mis_name(ck.mis));
+	CONFLICT(GIVEN_AOV, "--aov", o->aov != ck.aov, "(0x%x)", o->aov, ck.aov);
 	CONFLICT(GIVEN_STRATEGY_LEN, "--strategy-len", o->strategy_len != ck.strategy_len, "%u", o->strategy_len,
 		 ck.strategy_len);
 #undef CONFLICT
