@@ -1029,11 +1029,11 @@ static int range_before(const void *a, const void *b)
  * borrowed from r). Devices must be idle. */
 static ajar_status checkpoint_gather(ajar_renderer *r, Checkpoint *c)
 {
+	memset(c, 0, sizeof *c);
 	ajar_status st = reduce(r);
 	if (st != AJAR_OK)
 		return st;
 	ensure_hashes(r);
-	memset(c, 0, sizeof *c);
 	snprintf(c->version, sizeof c->version, "%s", AJAR_VERSION_STRING);
 	snprintf(c->scene, sizeof c->scene, "%s", r->scene_name);
 	c->scene_hash = r->scene_hash;
@@ -1108,7 +1108,9 @@ ajar_status ajar_renderer_write_checkpoint(ajar_renderer *r, const char *path)
 }
 
 /* From the render loop, under the lock: waits until no pass is in flight,
- * writes, lets the devices go on. A failed write keeps the previous file. */
+ * sums the films, lets the devices go on and writes the file meanwhile
+ * (the sums are the main thread's own arrays). A failed write keeps the
+ * previous file. */
 static void checkpoint_during(ajar_renderer *r)
 {
 	r->pausing = 1;
@@ -1116,11 +1118,19 @@ static void checkpoint_during(ajar_renderer *r)
 		pthread_cond_wait(&r->cond, &r->lock);
 	pthread_mutex_unlock(&r->lock);
 	r->elapsed = seconds() - r->t0;
-	if (write_checkpoint(r, r->ckpt_path) != AJAR_OK)
+	Checkpoint c;
+	ajar_status st = checkpoint_gather(r, &c);
+	pthread_mutex_lock(&r->lock);
+	r->pausing = 0;
+	pthread_cond_broadcast(&r->cond);
+	pthread_mutex_unlock(&r->lock);
+	if (st == AJAR_OK)
+		st = checkpoint_write(r->ckpt_path, &c);
+	free(c.ranges);
+	if (st != AJAR_OK)
 		log_msg(AJAR_LOG_WARNING, "checkpoint not written (the previous one is kept): %s", ajar_last_error());
 	r->ckpt_last = seconds();
 	pthread_mutex_lock(&r->lock);
-	r->pausing = 0;
 }
 
 ajar_status ajar_renderer_set_checkpoint(ajar_renderer *r, const char *path, double every)
