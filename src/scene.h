@@ -47,6 +47,9 @@ typedef struct ajar_scene {
 	float env_strength;
 	uint32_t env_width, env_height;
 	float *env_rgb;          /* env_width * env_height * 3, row 0 = top (+Y) */
+
+	ajar_light *lights;      /* punctual lights, glTF units, direction unit */
+	uint32_t nlights, cap_lights;
 } Scene;
 
 ajar_status scene_new(const char *source, Scene **out);
@@ -68,6 +71,10 @@ ajar_status scene_set_camera(Scene *s, V3 pos, V3 forward, V3 up, float yfov, fl
 void scene_set_env_color(Scene *s, V3 rgb);
 /* Takes ownership of rgb (malloc'ed, w * h * 3 floats). */
 ajar_status scene_set_env_image(Scene *s, uint32_t w, uint32_t h, float *rgb, float strength);
+
+/* Validates and appends a punctual light (`what` names it for messages);
+ * the direction is normalised. */
+ajar_status scene_add_light(Scene *s, const char *what, const ajar_light *l);
 
 /* Bounds of all renderable triangles (portals included). */
 void scene_bounds(const Scene *s, V3 *bmin, V3 *bmax);
