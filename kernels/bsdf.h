@@ -20,7 +20,14 @@
  *           specular = 0 gives exactly base_color / pi (KHR_materials_specular
  *           scales the whole Fresnel term, as glTF does);
  *   glass   weight (1 - metallic) transmission: rough dielectric (Walter et
- *           al. 2007) with exact Fresnel, transmission tinted by base_color.
+ *           al. 2007) with exact Fresnel, transmission tinted by base_color,
+ *           plus Kulla and Conty's multiple scattering for dielectrics: four
+ *           cosine-shaped lobes (reflection outside and inside, refraction
+ *           each way) c (1 - G(mu_o)) (1 - G'(mu_i)) / pi, G and G' the
+ *           single-scattering albedos (reflection + refraction) of wo's and
+ *           wi's sides, the constants c solved in bsdf_setup so that a white
+ *           glass loses nothing from either side and the pair of refraction
+ *           lobes obeys the adjoint relation (bsdf_glass_ms).
  * GGX alpha = roughness^2. Metal and glass with alpha < BSDF_DELTA_ALPHA are
  * delta lobes (mirror, smooth glass); the plastic coat never is: its alpha is
  * clamped to >= BSDF_MIN_ALPHA. Microfacet terms: height-correlated Smith G2
@@ -33,15 +40,18 @@
  * normals); both must also lie on the right side of the shading normal n, or
  * the BSDF is 0. Glass's outside (ior on the far side) is the side ng points to.
  *
- * E1 and Es come from bsdf_tables.h (src/tools/bsdf_tables.c integrates them
- * from microfacet.h at build time), bilinear in sqrt(alpha) and sqrt(mu);
+ * E1, Es and G come from bsdf_tables.h (src/tools/bsdf_tables.c integrates
+ * them from microfacet.h at build time), bilinear in sqrt(alpha) and
+ * sqrt(mu) (glass: trilinear, with (ior - 1) / (ior + 1));
  * the averages are those of the interpolated tables, so the compensation
  * is exact for the tables as read.
  *
  * Lobe selection for sampling is proportional to weight x albedo estimate at
- * the outgoing direction (the two cosine-distributed lobes, diffuse base and
- * metal multiple scattering, are sampled alike); pdf_w is the mixture over all non-delta lobes, so
- * sampling and bsdf_eval agree, and integrates to 1 - P(delta lobes). */
+ * the outgoing direction (the cosine-shaped lobes, diffuse base and the
+ * metal's and glass's multiple-scattering reflection, are sampled alike;
+ * the glass's multiple-scattering refraction by a cosine on the far side);
+ * pdf_w is the mixture over all non-delta lobes, so sampling and bsdf_eval
+ * agree, and integrates to 1 - P(delta lobes). */
 #ifndef AJAR_BSDF_H
 #define AJAR_BSDF_H
 #include "types.h"
@@ -84,8 +94,9 @@ typedef struct {
 	int delta;
 } BsdfSample;
 
-/* Selection probabilities of the five sampled lobes for one outgoing
- * direction, and the albedos at it that bsdf_eval_local reuses. */
+/* Selection probabilities of the seven sampled lobes for one outgoing
+ * direction (ms: the metal's multiple scattering; glass_r, glass_t: the
+ * glass's), and the albedos at it that bsdf_eval_local reuses. */
 typedef struct {
 	float metal, coat, diffuse, glass, ms, glass_r, glass_t;
 	float e_metal, e_coat, e_glass; /* E1 at alpha, Es, Go or Gi */
@@ -177,7 +188,9 @@ INLINE void bsdf_setup(Bsdf *bs, GLOBAL const Material *m, V3 base_color, V3 ns,
 		bs->coat_sw = bs->specular - bs->coat_s1;
 		bs->coat_eavg = bs->coat_s1 * bsdf_tab1(bsdf_tab_e1avg, a) + bs->coat_sw * bsdf_tab1(bsdf_tab_ewavg, a);
 	}
-	bs->glass_x = bs->glass_y = 0.0f;
+	bs->glass_k = bs->glass_i = 0;
+	bs->glass_wk = bs->glass_wr = bs->glass_x = bs->glass_y = 0.0f;
+	bs->glass_c[0] = bs->glass_c[1] = bs->glass_c[2] = bs->glass_c[3] = 0.0f;
 	if (bsdf_w_glass(bs) > 0.0f && !bsdf_smooth(bs)) {
 		float q = (bs->ior - 1.0f) / (bs->ior + 1.0f) * ((BSDF_TAB_GE - 1) / BSDF_TAB_GT_MAX);
 		float x = bsdf_clamp01(sqrt(bs->alpha)) * (BSDF_TAB_GR - 1);
@@ -250,6 +263,8 @@ INLINE float bsdf_metal_albedo(const Bsdf *bs, float mu) { return bsdf_tab2(bsdf
 /* The diffuse base's factor (1 - Es(mu_o)) (1 - Es(mu_i)) / (pi (1 - Esavg)). */
 INLINE float bsdf_base_factor(const Bsdf *bs, float e_o, float mu_i)
 {
+	if (!(bs->specular > 0.0f))
+		return AJAR_INV_PI; /* no coat: exactly Lambertian */
 	return (1.0f - e_o) * (1.0f - bsdf_coat_albedo(bs, mu_i)) * AJAR_INV_PI / (1.0f - bs->coat_eavg);
 }
 
@@ -292,7 +307,7 @@ INLINE BsdfLobes bsdf_lobes(const Bsdf *bs, float cos_o, float eta)
 	BsdfLobes p;
 	float wm = bsdf_w_metal(bs), wp = bsdf_w_plastic(bs);
 	p.e_metal = wm > 0.0f && !bsdf_smooth(bs) ? bsdf_metal_albedo(bs, cos_o) : 1.0f;
-	p.e_coat = wp > 0.0f ? bsdf_coat_albedo(bs, cos_o) : 0.0f;
+	p.e_coat = wp > 0.0f && bs->specular > 0.0f ? bsdf_coat_albedo(bs, cos_o) : 0.0f; /* 0 without a coat */
 	p.metal = wm * v3_avg(bsdf_fresnel_metal(bs, cos_o)) * p.e_metal;
 	p.ms = wm * v3_avg(bs->metal_fms) * (1.0f - p.e_metal);
 	p.coat = wp * p.e_coat;
