@@ -36,6 +36,7 @@ import base64
 import json
 import math
 import os
+import shutil
 import struct
 
 import numpy as np
@@ -372,8 +373,10 @@ def write_lambert_variant(scene, out_path, pbr=False):
 	if scene.environment is not None:
 		scene_extras["environment"] = {"color": scene.environment}
 	if scene.sky is not None:
-		rel = os.path.relpath(scene.sky["path"], os.path.dirname(os.path.abspath(out_path)))
-		scene_extras["environment"] = {"image": rel, "strength": scene.sky["strength"],
+		# A copy beside the variant: Ajar reads no file outside a scene's folder.
+		sky = os.path.splitext(os.path.basename(out_path))[0] + "-sky" + os.path.splitext(scene.sky["path"])[1]
+		shutil.copyfile(scene.sky["path"], os.path.join(os.path.dirname(os.path.abspath(out_path)), sky))
+		scene_extras["environment"] = {"image": sky, "strength": scene.sky["strength"],
 					       "rotation": scene.sky["rotation"]}
 	used = ["KHR_materials_specular", "KHR_materials_emissive_strength"]
 	light_defs = []
