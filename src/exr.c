@@ -39,6 +39,10 @@ static const char *exr_why(exr_result_t rv)
 	return exr_msg[0] ? exr_msg : exr_get_default_error_message(rv);
 }
 
+/* Why our DWA decompressor (exr_dwa.c) refused a chunk, more specific than
+ * the pipeline's "unable to decompress data". */
+static _Thread_local char dwa_msg[EXR_DWA_MSG];
+
 /* ---- Atomic output files ------------------------------------------------ */
 
 ajar_status image_tmp_open(const char *path, char **tmp_path, int *fd)
@@ -321,6 +325,12 @@ static void exr_close(ExrReader *r)
 typedef struct {
 	int slot[64];
 	int have_rgb, have_y, have_a;
+	/* OpenEXR Core 3.1's special cases for four half channels into
+	 * interleaved floats put the channels in reverse order (fixed in later
+	 * releases): with four channels, all read, G and B are decoded to each
+	 * other's place, which keeps Core on its generic routine, and swapped
+	 * back after. */
+	int swap_gb;
 } ChannelMap;
 
 static ajar_status exr_map_channels(const char *path, const exr_attr_chlist_t *cl, ChannelMap *m)
@@ -355,6 +365,9 @@ static ajar_status exr_map_channels(const char *path, const exr_attr_chlist_t *c
 				m->slot[c] = -1;
 	if (!m->have_rgb && !m->have_y)
 		return err_set(AJAR_ERROR_BAD_INPUT, "%s: no R, G, B or Y channel", path);
+	m->swap_gb = cl->num_channels == 4;
+	for (int c = 0; c < cl->num_channels; c++)
+		m->swap_gb &= m->slot[c] >= 0;
 	return AJAR_OK;
 }
 
@@ -372,6 +385,8 @@ static exr_result_t exr_decode_chunk(exr_context_t ctxt, const exr_chunk_info_t 
 	for (int c = 0; c < dec->channel_count; c++) {
 		exr_coding_channel_info_t *ch = &dec->channels[c];
 		int slot = m->slot[c];
+		if (m->swap_gb && (slot == 1 || slot == 2))
+			slot = 3 - slot;
 		if (slot < 0) {
 			ch->decode_to_ptr = NULL;
 			continue;
@@ -383,6 +398,12 @@ static exr_result_t exr_decode_chunk(exr_context_t ctxt, const exr_chunk_info_t 
 		ch->decode_to_ptr = (uint8_t *)(rgba + ((size_t)y0 * width + (size_t)x0) * 4 + slot);
 	}
 	rv = exr_decoding_choose_default_routines(ctxt, 0, dec);
+	exr_compression_t comp;
+	if (rv == EXR_ERR_SUCCESS && exr_get_compression(ctxt, 0, &comp) == EXR_ERR_SUCCESS &&
+	    (comp == EXR_COMPRESSION_DWAA || comp == EXR_COMPRESSION_DWAB)) {
+		dec->decompress_fn = exr_dwa_decompress;
+		dec->decoding_user_data = dwa_msg;
+	}
 	if (rv == EXR_ERR_SUCCESS)
 		rv = exr_decoding_run(ctxt, 0, dec);
 	return rv;
@@ -459,12 +480,6 @@ ajar_status ajar_read_exr(const char *path, float **rgba, uint32_t *width, uint3
 	st = exr_map_channels(path, cl, &map);
 	if (st != AJAR_OK)
 		goto done;
-	exr_compression_t comp;
-	if (exr_get_compression(r.ctxt, 0, &comp) == EXR_ERR_SUCCESS &&
-	    (comp == EXR_COMPRESSION_DWAA || comp == EXR_COMPRESSION_DWAB)) {
-		exr_close(&r);
-		return exr_read_dwa(path, rgba, width, height);
-	}
 	if ((uint64_t)w * (uint64_t)h > SIZE_MAX / (4 * sizeof(float))) {
 		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: %lldx%lld image too large", path, (long long)w,
 			     (long long)h);
@@ -477,6 +492,7 @@ ajar_status ajar_read_exr(const char *path, float **rgba, uint32_t *width, uint3
 		goto done;
 	}
 	exr_msg[0] = '\0';
+	dwa_msg[0] = '\0';
 	rv = exr_read_pixels(r.ctxt, storage, &dw, &map, px, (uint32_t)w, (uint32_t)h);
 	if (rv != EXR_ERR_SUCCESS) {
 		free(px);
@@ -486,10 +502,15 @@ ajar_status ajar_read_exr(const char *path, float **rgba, uint32_t *width, uint3
 			st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory decoding pixels", path);
 		else
 			st = err_set(AJAR_ERROR_BAD_INPUT, "%s: truncated or corrupt pixel data: %s", path,
-				     exr_why(rv));
+				     dwa_msg[0] ? dwa_msg : exr_why(rv));
 		goto done;
 	}
 	for (size_t i = 0, n = (size_t)w * (size_t)h; i < n; i++) {
+		if (map.swap_gb) {
+			float g = px[4 * i + 2];
+			px[4 * i + 2] = px[4 * i + 1];
+			px[4 * i + 1] = g;
+		}
 		if (!map.have_rgb)
 			px[4 * i + 1] = px[4 * i + 2] = px[4 * i];
 		if (!map.have_a)
