@@ -411,6 +411,41 @@ static void test_read_dwa_fixtures(void **state)
 	}
 }
 
+/* Four half channels of which one is skipped (R renamed Z, so the list
+ * stays sorted): OpenEXR Core 3.1's special-case routine would write
+ * through the skipped channel's NULL pointer. G, B, A are as before. */
+static void test_read_four_half_one_skipped(void **state)
+{
+	size_t n;
+	unsigned char *buf = slurp("tests/data/dwa/zip_rgba.exr", &n);
+	unsigned char *chl = memmem(buf, n, "chlist", 6);
+	assert_non_null(chl);
+	unsigned char *r = memmem(chl, n - (size_t)(chl - buf), "\0R\0", 3);
+	assert_non_null(r);
+	r[1] = 'Z';
+	char *dir = test_tmpdir();
+	char *path = test_path(dir, "abgz.exr");
+	spill(path, buf, n);
+	float *want, *got;
+	uint32_t w, h, w2, h2;
+	assert_int_equal(ajar_read_exr("tests/data/dwa/zip_rgba.exr", &want, &w, &h), AJAR_OK);
+	if (ajar_read_exr(path, &got, &w2, &h2) != AJAR_OK)
+		fail_msg("%s", ajar_last_error());
+	assert_int_equal(w2, w);
+	assert_int_equal(h2, h);
+	for (size_t i = 0; i < (size_t)w * h; i++) {
+		assert_true(got[4 * i] == 0.0f);
+		for (int c = 1; c < 4; c++)
+			assert_true(got[4 * i + c] == want[4 * i + c]);
+	}
+	free(want);
+	free(got);
+	free(buf);
+	free(path);
+	test_remove_tree(dir);
+	free(dir);
+}
+
 /* The nonlinear -> linear half table is computed at start-up; it must be
  * the table OpenEXR 3.1.5 ships (dwaLookups.h, hashed from its library). */
 static void test_dwa_to_linear_table(void **state)
@@ -736,6 +771,7 @@ int main(void)
 		cmocka_unit_test(test_read_dwab),
 		cmocka_unit_test(test_read_dwa_fixtures),
 		cmocka_unit_test(test_dwa_to_linear_table),
+		cmocka_unit_test(test_read_four_half_one_skipped),
 		cmocka_unit_test(test_read_dwa_corrupt),
 		cmocka_unit_test(test_read_errors),
 		cmocka_unit_test(test_write_errors),
