@@ -76,7 +76,7 @@ static float half_bits_to_float(uint16_t h)
  * picks how an otherwise-empty payload is kept a NaN: the hardware
  * conversion (vcvtps2ph, which the C++ library uses for whole blocks) sets
  * the quiet bit, Imath's software one (its constant-block path) sets bit 0. */
-static uint16_t float_to_half(float f, int quiet_nan)
+static inline uint16_t float_to_half(float f, int quiet_nan)
 {
 	uint32_t v;
 	memcpy(&v, &f, sizeof v);
@@ -199,7 +199,7 @@ typedef struct {
 } BitReader;
 
 /* The next `n` (1..57) bits from bit `pos`, zero past the end. */
-static uint64_t bits_peek(const BitReader *br, uint64_t pos, int n)
+static inline uint64_t bits_peek(const BitReader *br, uint64_t pos, int n)
 {
 	size_t byte = (size_t)(pos >> 3);
 	uint64_t w = 0;
@@ -216,13 +216,11 @@ static uint64_t bits_peek(const BitReader *br, uint64_t pos, int n)
 typedef struct {
 	uint8_t len[HUF_SYMS];
 	uint64_t code[HUF_SYMS];
-	/* fast[prefix]: a code of at most HUF_FASTBITS bits (len, sym), or
-	 * the head of a list of longer codes sharing that prefix (len 0,
-	 * head + 1 in `sym`, 0 for none), linked through `next`. */
-	struct {
-		uint8_t len;
-		uint32_t sym;
-	} fast[1 << HUF_FASTBITS];
+	/* fast[prefix]: a code of at most HUF_FASTBITS bits (its length in
+	 * bits 24..29, its symbol in bits 0..16), or (length 0) the head + 1
+	 * of a list of longer codes sharing that prefix, 0 for none, linked
+	 * through `next`. 4 bytes each, so the table stays in cache. */
+	uint32_t fast[1 << HUF_FASTBITS];
 	uint32_t next[HUF_SYMS];
 } HufTable;
 
@@ -296,21 +294,20 @@ static exr_result_t huf_decode(const uint8_t *in, size_t n, uint16_t *out, size_
 		if (l <= HUF_FASTBITS) {
 			uint32_t lo = (uint32_t)(code << (HUF_FASTBITS - l)), cnt = 1u << (HUF_FASTBITS - l);
 			for (uint32_t k = lo; k < lo + cnt; k++) {
-				if (t->fast[k].len || t->fast[k].sym) {
+				if (t->fast[k]) {
 					rv = CORRUPT("Huffman code table is not a prefix code");
 					goto done;
 				}
-				t->fast[k].len = (uint8_t)l;
-				t->fast[k].sym = s;
+				t->fast[k] = (uint32_t)l << 24 | s;
 			}
 		} else {
 			uint32_t k = (uint32_t)(code >> (l - HUF_FASTBITS));
-			if (t->fast[k].len) {
+			if (t->fast[k] >> 24) {
 				rv = CORRUPT("Huffman code table is not a prefix code");
 				goto done;
 			}
-			t->next[s] = t->fast[k].sym;
-			t->fast[k].sym = s + 1;
+			t->next[s] = t->fast[k];
+			t->fast[k] = s + 1;
 		}
 	}
 	/* Symbols. */
@@ -320,11 +317,11 @@ static exr_result_t huf_decode(const uint8_t *in, size_t n, uint16_t *out, size_
 	size_t o = 0;
 	for (pos = 0; pos < br.nbits;) {
 		uint32_t k = (uint32_t)bits_peek(&br, pos, HUF_FASTBITS), s;
-		int l = t->fast[k].len;
+		int l = (int)(t->fast[k] >> 24);
 		if (l) {
-			s = t->fast[k].sym;
+			s = t->fast[k] & 0x1ffffu;
 		} else {
-			for (s = t->fast[k].sym; s; s = t->next[s - 1]) {
+			for (s = t->fast[k]; s; s = t->next[s - 1]) {
 				l = t->len[s - 1];
 				if (bits_peek(&br, pos, l) == t->code[s - 1])
 					break;
@@ -628,7 +625,8 @@ static exr_result_t dwa_lossy(DwaChannel *const *ch, int ncomp, Coeffs *co, cons
 	for (int c = 0; c < ncomp; c++)
 		dc[c] = co->dc + (size_t)c * nblocks;
 	co->dc += nblocks * (size_t)ncomp;
-	uint16_t *row_block = malloc((size_t)ncomp * (size_t)bx_n * 64 * sizeof *row_block);
+	uint16_t *row_block = malloc(((size_t)ncomp * (size_t)bx_n * 64 + (size_t)w) * sizeof *row_block);
+	uint16_t *line = row_block ? row_block + (size_t)ncomp * (size_t)bx_n * 64 : NULL; /* one row */
 	if (!row_block)
 		return dwa_fail(err, EXR_ERR_OUT_OF_MEMORY, "out of memory for a row of DCT blocks");
 	float dct[3][64];
@@ -688,17 +686,18 @@ static exr_result_t dwa_lossy(DwaChannel *const *ch, int ncomp, Coeffs *co, cons
 			for (int32_t yy = 0; yy < y_n; yy++) {
 				uint8_t *dst = out + cd->rows[by * 8 + yy];
 				const uint16_t *src = row_block + (size_t)c * (size_t)bx_n * 64 + (size_t)yy * 8;
+				for (int32_t x = 0; x < w; x++)
+					line[x] = src[(size_t)(x >> 3) * 64 + (size_t)(x & 7)];
+				if (to_linear)
+					for (int32_t x = 0; x < w; x++)
+						line[x] = to_linear[line[x]];
 				/* Little-endian half or float samples, as they are
 				 * in memory on this host (asserted above). */
-				for (int32_t x = 0; x < w; x++) {
-					uint16_t v = src[(size_t)(x >> 3) * 64 + (size_t)(x & 7)];
-					if (to_linear)
-						v = to_linear[v];
-					if (cd->type == EXR_PIXEL_FLOAT)
-						memcpy(dst + 4 * (size_t)x, &half_float[v], 4);
-					else
-						memcpy(dst + 2 * (size_t)x, &v, 2);
-				}
+				if (cd->type == EXR_PIXEL_FLOAT)
+					for (int32_t x = 0; x < w; x++)
+						memcpy(dst + 4 * (size_t)x, &half_float[line[x]], 4);
+				else
+					memcpy(dst, line, 2 * (size_t)w);
 			}
 		}
 	}
