@@ -219,6 +219,91 @@ static void test_living_room(void **state)
 	ajar_scene_destroy(&s);
 }
 
+/* Warnings sent to the log callback while a test loads something. */
+static int warnings;
+static char last_warning[2048];
+
+static void count_warnings(ajar_log_level level, const char *message, void *user)
+{
+	if (level != AJAR_LOG_WARNING)
+		return;
+	warnings++;
+	snprintf(last_warning, sizeof last_warning, "%s", message);
+}
+
+/* The sky-lit variants (scenes/skies/make_sky_scenes.py): the rooms'
+ * geometry, the sky image with its slightly negative pixels clamped (one
+ * warning), and the sun where the scene's notes put it: the ray from the
+ * sun's pixel, turned by the scene's rotation (right-handed about +Y,
+ * worked out here again), through a window's centre lands on the surface
+ * named. */
+static void sun_landing(const Scene *s, V3 from, V3 *hit, float plane, int axis)
+{
+	size_t best = 0;
+	for (size_t i = 0; i < (size_t)s->env_width * s->env_height; i++)
+		if (s->env_rgb[3 * i] + s->env_rgb[3 * i + 1] > s->env_rgb[3 * best] + s->env_rgb[3 * best + 1])
+			best = i;
+	double u = ((double)(best % s->env_width) + 0.5) / s->env_width;
+	double v = ((double)(best / s->env_width) + 0.5) / s->env_height;
+	double phi = 2.0 * M_PI * (u - 0.5), th = M_PI * v, a = s->env_rotation;
+	double dx = sin(th) * sin(phi), dy = cos(th), dz = -sin(th) * cos(phi);
+	/* Turned: x' = c x + s z, z' = c z - s x. */
+	double tx = cos(a) * dx + sin(a) * dz, tz = cos(a) * dz - sin(a) * dx;
+	double dir[3] = {-tx, -dy, -tz}, o[3] = {from.x, from.y, from.z};
+	double t = (plane - o[axis]) / dir[axis];
+	assert_true(t > 0.0);
+	*hit = v3((float)(o[0] + t * dir[0]), (float)(o[1] + t * dir[1]), (float)(o[2] + t * dir[2]));
+}
+
+static void test_sky_scenes(void **state)
+{
+	static const struct {
+		const char *path;
+		uint64_t triangles;
+		int negative;
+		float rotation; /* degrees, as make_sky_scenes.py printed */
+	} scenes[] = {
+		{SCENE("window-room-sunset/window-room-sunset.gltf"), 28, 4, 45.5352f},
+		{SCENE("window-room-forest/window-room-forest.gltf"), 28, 826, 55.6836f},
+		{SCENE("living-room-forest/living-room-forest.gltf"), 143163, 826, 140.6836f},
+	};
+	for (int k = 0; k < 3; k++) {
+		warnings = 0;
+		last_warning[0] = '\0';
+		ajar_set_log_callback(count_warnings, NULL);
+		ajar_scene_info in;
+		Scene *s = load_shipped(scenes[k].path, &in);
+		ajar_set_log_callback(NULL, NULL);
+		char want[64];
+		snprintf(want, sizeof want, "%d negative pixel values", scenes[k].negative);
+		assert_int_equal(warnings, 1);
+		if (!strstr(last_warning, want))
+			fail_msg("%s: warning \"%s\"", scenes[k].path, last_warning);
+		assert_int_equal(in.triangles, scenes[k].triangles);
+		assert_int_equal(in.environment, 2);
+		assert_int_equal(s->env_width, 1024);
+		assert_int_equal(s->env_height, 512);
+		assert_float_equal(s->env_rotation, scenes[k].rotation * M_PI / 180.0, 1e-5);
+		V3 p;
+		if (k == 0) {
+			/* Low sun: on the far wall z = 3, right of the window, high up. */
+			sun_landing(s, v3(2.0f, 1.4f, 0.0f), &p, 3.0f, 2);
+			assert_true(p.x > 2.3f && p.x < 2.7f && p.y > 1.1f && p.y < 1.3f);
+		} else if (k == 1) {
+			/* The forest's sun: beyond the far wall's foot (y < 0 at z = 3),
+			 * so it lights the wall's bottom and the floor before it. */
+			sun_landing(s, v3(2.0f, 1.4f, 0.0f), &p, 3.0f, 2);
+			assert_true(p.y > -0.2f && p.y < 0.3f && p.x > 2.5f && p.x < 3.5f);
+		} else {
+			/* Through the window at x = -0.436 (z in [-1.04, -0.15]) onto the
+			 * floor, in front of the camera (x 1.5..5.1, z in the room). */
+			sun_landing(s, v3(-0.436f, 1.58f, -0.595f), &p, 0.0f, 1);
+			assert_true(p.x > 1.5f && p.x < 5.1f && p.z > -3.6f && p.z < 0.0f);
+		}
+		ajar_scene_destroy(&s);
+	}
+}
+
 static void test_bathroom(void **state)
 {
 	ajar_scene_info in;
@@ -710,18 +795,6 @@ static void test_environment_image(void **state)
 	load_fails("envmissing.gltf", AJAR_ERROR_IO, "scenes[0].extras.environment.image");
 }
 
-/* Warnings sent to the log callback while a test loads something. */
-static int warnings;
-static char last_warning[2048];
-
-static void count_warnings(ajar_log_level level, const char *message, void *user)
-{
-	if (level != AJAR_LOG_WARNING)
-		return;
-	warnings++;
-	snprintf(last_warning, sizeof last_warning, "%s", message);
-}
-
 /* An 8x4 EXR of 0.5 with `bad` at the pixels listed (x, y pairs). */
 static void write_sky(const char *name, float bad, const int *xy, int n)
 {
@@ -976,6 +1049,7 @@ int main(void)
 		cmocka_unit_test(test_cornell),
 		cmocka_unit_test(test_window_room),
 		cmocka_unit_test(test_living_room),
+		cmocka_unit_test(test_sky_scenes),
 		cmocka_unit_test(test_bathroom),
 		cmocka_unit_test(test_api_scene),
 		cmocka_unit_test(test_hierarchy_trs),
