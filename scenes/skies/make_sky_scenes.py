@@ -89,7 +89,7 @@ VARIANTS = {
 	# front of the camera.
 	"living-room-forest": {"room": "living-room", "sky": "forest", "phi": -105.0},
 	# A directional lamp as the sun, higher than either sky's (32 degrees),
-	# onto the floor in view, left of the box (azimuth 15 degrees: light
+	# onto the floor in view, on the -X side of the box (azimuth 15 degrees: light
 	# travelling +Z and toward -X); the forest sun's irradiance, and the
 	# forest's average sky without its sun as a constant sky.
 	"window-room-sun": {"room": "window-room", "lamp": (32.0, 15.0)},
