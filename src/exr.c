@@ -39,6 +39,10 @@ static const char *exr_why(exr_result_t rv)
 	return exr_msg[0] ? exr_msg : exr_get_default_error_message(rv);
 }
 
+/* Why our DWA decompressor (exr_dwa.c) refused a chunk, more specific than
+ * the pipeline's "unable to decompress data". */
+static _Thread_local char dwa_msg[EXR_DWA_MSG];
+
 /* ---- Atomic output files ------------------------------------------------ */
 
 ajar_status image_tmp_open(const char *path, char **tmp_path, int *fd)
@@ -321,6 +325,13 @@ static void exr_close(ExrReader *r)
 typedef struct {
 	int slot[64];
 	int have_rgb, have_y, have_a;
+	/* Floats per decoded pixel: 4, or 5 for a part of four channels.
+	 * OpenEXR Core 3.1 has special routines for four half channels into
+	 * 16-byte pixels that put the channels in reverse order and, when one
+	 * channel is skipped, write through its NULL pointer (fixed in later
+	 * releases); a 20-byte pixel keeps Core on its generic routine, and
+	 * the image is packed to 4 floats after. */
+	int stride;
 } ChannelMap;
 
 static ajar_status exr_map_channels(const char *path, const exr_attr_chlist_t *cl, ChannelMap *m)
@@ -355,6 +366,7 @@ static ajar_status exr_map_channels(const char *path, const exr_attr_chlist_t *c
 				m->slot[c] = -1;
 	if (!m->have_rgb && !m->have_y)
 		return err_set(AJAR_ERROR_BAD_INPUT, "%s: no R, G, B or Y channel", path);
+	m->stride = cl->num_channels == 4 ? 5 : 4;
 	return AJAR_OK;
 }
 
@@ -376,13 +388,19 @@ static exr_result_t exr_decode_chunk(exr_context_t ctxt, const exr_chunk_info_t 
 			ch->decode_to_ptr = NULL;
 			continue;
 		}
-		ch->user_pixel_stride = 4 * sizeof(float);
-		ch->user_line_stride = (int32_t)(width * 4 * sizeof(float));
+		ch->user_pixel_stride = m->stride * (int32_t)sizeof(float);
+		ch->user_line_stride = (int32_t)(width * (uint32_t)m->stride * sizeof(float));
 		ch->user_bytes_per_element = sizeof(float);
 		ch->user_data_type = EXR_PIXEL_FLOAT;
-		ch->decode_to_ptr = (uint8_t *)(rgba + ((size_t)y0 * width + (size_t)x0) * 4 + slot);
+		ch->decode_to_ptr = (uint8_t *)(rgba + ((size_t)y0 * width + (size_t)x0) * (size_t)m->stride + slot);
 	}
 	rv = exr_decoding_choose_default_routines(ctxt, 0, dec);
+	exr_compression_t comp;
+	if (rv == EXR_ERR_SUCCESS && exr_get_compression(ctxt, 0, &comp) == EXR_ERR_SUCCESS &&
+	    (comp == EXR_COMPRESSION_DWAA || comp == EXR_COMPRESSION_DWAB)) {
+		dec->decompress_fn = exr_dwa_decompress;
+		dec->decoding_user_data = dwa_msg;
+	}
 	if (rv == EXR_ERR_SUCCESS)
 		rv = exr_decoding_run(ctxt, 0, dec);
 	return rv;
@@ -450,7 +468,7 @@ ajar_status ajar_read_exr(const char *path, float **rgba, uint32_t *width, uint3
 		goto done;
 	}
 	int64_t w = (int64_t)dw.max.x - dw.min.x + 1, h = (int64_t)dw.max.y - dw.min.y + 1;
-	if (w <= 0 || h <= 0 || w > INT_MAX / 16 || h > INT_MAX) {
+	if (w <= 0 || h <= 0 || w > INT_MAX / 20 || h > INT_MAX) {
 		st = err_set(AJAR_ERROR_BAD_INPUT, "%s: data window [%d,%d]-[%d,%d] is empty or too large", path,
 			     dw.min.x, dw.min.y, dw.max.x, dw.max.y);
 		goto done;
@@ -459,24 +477,19 @@ ajar_status ajar_read_exr(const char *path, float **rgba, uint32_t *width, uint3
 	st = exr_map_channels(path, cl, &map);
 	if (st != AJAR_OK)
 		goto done;
-	exr_compression_t comp;
-	if (exr_get_compression(r.ctxt, 0, &comp) == EXR_ERR_SUCCESS &&
-	    (comp == EXR_COMPRESSION_DWAA || comp == EXR_COMPRESSION_DWAB)) {
-		exr_close(&r);
-		return exr_read_dwa(path, rgba, width, height);
-	}
-	if ((uint64_t)w * (uint64_t)h > SIZE_MAX / (4 * sizeof(float))) {
+	if ((uint64_t)w * (uint64_t)h > SIZE_MAX / (5 * sizeof(float))) {
 		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: %lldx%lld image too large", path, (long long)w,
 			     (long long)h);
 		goto done;
 	}
-	float *px = calloc((size_t)w * (size_t)h * 4, sizeof(float));
+	float *px = calloc((size_t)w * (size_t)h * (size_t)map.stride, sizeof(float));
 	if (!px) {
 		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory for a %lldx%lld image", path,
 			     (long long)w, (long long)h);
 		goto done;
 	}
 	exr_msg[0] = '\0';
+	dwa_msg[0] = '\0';
 	rv = exr_read_pixels(r.ctxt, storage, &dw, &map, px, (uint32_t)w, (uint32_t)h);
 	if (rv != EXR_ERR_SUCCESS) {
 		free(px);
@@ -486,14 +499,20 @@ ajar_status ajar_read_exr(const char *path, float **rgba, uint32_t *width, uint3
 			st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory decoding pixels", path);
 		else
 			st = err_set(AJAR_ERROR_BAD_INPUT, "%s: truncated or corrupt pixel data: %s", path,
-				     exr_why(rv));
+				     dwa_msg[0] ? dwa_msg : exr_why(rv));
 		goto done;
 	}
 	for (size_t i = 0, n = (size_t)w * (size_t)h; i < n; i++) {
+		if (map.stride != 4) /* packing forward never overwrites what is still to come */
+			memmove(px + 4 * i, px + (size_t)map.stride * i, 4 * sizeof(float));
 		if (!map.have_rgb)
 			px[4 * i + 1] = px[4 * i + 2] = px[4 * i];
 		if (!map.have_a)
 			px[4 * i + 3] = 1.0f;
+	}
+	if (map.stride != 4) {
+		float *packed = realloc(px, (size_t)w * (size_t)h * 4 * sizeof(float));
+		px = packed ? packed : px;
 	}
 	*rgba = px;
 	*width = (uint32_t)w;

@@ -22,9 +22,17 @@ ajar_status exr_read_attr(const char *path, const char *name, char *value, size_
 ajar_status exr_write_channels(const char *path, const float *px, int nch, const char *const *names, uint32_t width,
 			       uint32_t height, const char *const *attrs, uint32_t nattrs);
 
-/* Reads a DWAA or DWAB file, which OpenEXR's C Core cannot decode, through
- * its C++ library (exr_dwa.cpp); called by ajar_read_exr, same result. */
-ajar_status exr_read_dwa(const char *path, float **rgba, uint32_t *width, uint32_t *height);
+/* The decompress step of OpenEXR Core's decode pipeline for DWAA and DWAB
+ * chunks, which Core 3.1 cannot decompress (exr_dwa.c): set it as the
+ * pipeline's decompress_fn. It turns dec->packed_buffer into the chunk's
+ * uncompressed layout in dec->unpacked_buffer; if dec->decoding_user_data
+ * is not NULL it is a char[EXR_DWA_MSG] that gets why a chunk is refused.
+ * Returns an exr_result_t. */
+#define EXR_DWA_MSG 192
+struct _exr_decode_pipeline;
+int32_t exr_dwa_decompress(struct _exr_decode_pipeline *dec);
+/* DWA's table from stored (nonlinear) half values to linear half values. */
+const uint16_t *exr_dwa_to_linear_table(void);
 
 /* Atomic output, shared by the EXR and PNG writers: image_tmp_open creates
  * a new file next to `path` (*tmp_path is malloc'd); image_tmp_finish
