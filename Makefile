@@ -35,10 +35,10 @@ obj = $(addprefix $(BUILD)/src/,$(addsuffix .o,$(1)))
 DEPS_test_bsdf := $(call obj,error)
 DEPS_test_sampling := $(call obj,error)
 DEPS_test_bvh := $(call obj,error scene bvh gltf exr)
-DEPS_test_lights := $(call obj,error scene lights)
+DEPS_test_lights := $(call obj,error scene lights portal_sky)
 DEPS_test_scene := $(call obj,error scene scene_api gltf exr)
 DEPS_test_exr := $(call obj,error exr png)
-DEPS_test_bdpt := $(BUILD)/tests/kernel_host.o $(BUILD)/tests/mis_oracle.o $(call obj,error scene scene_api gltf exr bvh lights prepare portal_flux)
+DEPS_test_bdpt := $(BUILD)/tests/kernel_host.o $(BUILD)/tests/mis_oracle.o $(call obj,error scene scene_api gltf exr bvh lights prepare portal_flux portal_sky)
 DEPS_test_portal := $(DEPS_test_bdpt)
 # Tests that render need the whole library.
 DEPS_test_layout := $(BUILD)/libajar.a

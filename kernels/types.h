@@ -85,6 +85,25 @@ typedef struct {
 	int env_side;     /* +1 / -1: the side of n the environment lies behind; 0 none */
 } PortalTri; /* 64 */
 
+/* Planar portal: coplanar, connected portal triangles with the sky behind
+ * them, for next-event estimation of an environment image through them
+ * (kernels/portal_sky.h, src/portal_sky.c). Frame (t, b, n): n unit toward
+ * the sky, t along the longest edge; the triangles lie within the rectangle
+ * [a0, a1] x [b0, b1] of (t, b) coordinates about o. `table` is the first
+ * float of its summed-area table in portal_sky. */
+typedef struct {
+	V3 o;
+	float a0;
+	V3 t;
+	float a1;
+	V3 b;
+	float b0;
+	V3 n;
+	float b1;
+	int table;
+	int pad0, pad1, pad2;
+} PortalPlane; /* 80 */
+
 #define ENV_NONE 0
 #define ENV_COLOR 1
 #define ENV_IMAGE 2
@@ -149,7 +168,7 @@ typedef struct {
 	int light_paths;        /* 192, portal: 0 = no light subpaths (bdpt's s >= 2 and t = 1 left out) */
 	int portal_t_max;       /* intermediate strategies use at most this many eye vertices */
 	float portal_rate;      /* 200, probability that a pixel sample traces an intermediate subpath */
-	int pad1;
+	int num_portal_planes;  /* planar portals with sky tables (env_portal.h), 0 = none */
 } Params; /* 208 */
 
 /* Layout of the float array `env`: for an ENV_IMAGE of W x H,
@@ -176,6 +195,8 @@ typedef struct {
 	X(float, env)             \
 	X(PortalTri, portals)     \
 	X(float, portal_cdf)      \
+	X(PortalPlane, portal_planes) \
+	X(float, portal_sky)      \
 	X(Params, params)
 
 /* What device code sees of the scene: one pointer per array. */

@@ -12,6 +12,7 @@
 
 #include "error.h"
 #include "portal_flux.h"
+#include "portal_sky.h"
 
 static double seconds(void)
 {
@@ -192,6 +193,17 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 		prepare_free(d);
 		return st;
 	}
+	/* Sky images are sampled through the planar portals by their radiance
+	 * (kernels/portal_sky.h); AJAR_PORTAL_SKY=0 keeps the triangles' solid
+	 * angle instead, for comparisons. */
+	const char *sky = getenv("AJAR_PORTAL_SKY");
+	if (!(sky && strcmp(sky, "0") == 0) &&
+	    (st = portal_sky_build(&view, d->portals, (uint32_t)d->n_portals, &d->portal_planes, &d->n_portal_planes,
+				   &d->portal_sky, &d->n_portal_sky)) != AJAR_OK) {
+		prepare_free(d);
+		return st;
+	}
+	p->num_portal_planes = (int)d->n_portal_planes;
 	if (p->num_emitters == 0 && p->env_type == ENV_NONE)
 		log_msg(AJAR_LOG_WARNING, "%s: no emissive triangles and no environment: the image is black",
 			s->source);
@@ -205,6 +217,8 @@ void prepare_free(SceneData *d)
 	free(d->shade);
 	free(d->params);
 	free(d->portals);
+	free(d->portal_planes);
+	free(d->portal_sky);
 	bvh_free(&d->bvh);
 	lights_free(&d->lights);
 	memset(d, 0, sizeof *d);
