@@ -745,26 +745,6 @@ static void test_light_sample_env_portal_grid(void **state)
 
 /* ---- Sky images through planar portals (kernels/portal_sky.h) ---------- */
 
-/* A w x h sky: a smooth gradient (bluer and brighter toward the zenith,
- * dim ground) and a small, very bright sun disc of angular radius
- * `radius` about unit `sun`. */
-static float *sun_sky(uint32_t w, uint32_t h, V3 sun, float radius, float sun_l)
-{
-	float *rgb = malloc(sizeof(float) * 3 * w * h);
-	for (uint32_t y = 0; y < h; y++)
-		for (uint32_t x = 0; x < w; x++) {
-			V3 d = env_dir((x + 0.5f) / w, (y + 0.5f) / h);
-			float base = d.y > 0.0f ? 0.3f + 0.7f * d.y : 0.1f + 0.05f * d.y;
-			float *p = rgb + 3 * (y * w + x);
-			p[0] = 0.8f * base;
-			p[1] = 0.9f * base + 0.1f * d.x * d.x;
-			p[2] = 1.2f * base;
-			if (v3_dot(d, sun) > cosf(radius))
-				p[0] = p[1] = p[2] = sun_l;
-		}
-	return rgb;
-}
-
 /* Plane k's (U, V) sampler from x against its density, exactly: the
  * density is constant on each table cell within x's rectangle, so a bin
  * of whole cells expects the sum of density times area. Also the
@@ -834,7 +814,7 @@ static void test_light_sample_sky_portals(void **state)
 	Lit l;
 	build_light_scene(&l);
 	V3 sun = v3_norm(v3(0.15f, 0.5f, 1.0f)); /* seen from x through the window */
-	assert_int_equal(scene_set_env_image(l.s, 128, 64, sun_sky(128, 64, sun, 0.06f, 300.0f), 0.05f), AJAR_OK);
+	assert_int_equal(scene_set_env_image(l.s, 128, 64, test_sun_sky(128, 64, sun.x, sun.y, sun.z, 0.06f, 300.0f), 0.05f), AJAR_OK);
 	add_window_portals(&l);
 	V3 x = v3(0.1f, 0.2f, 0.05f);
 	for (int j = 0; j < 5; j++) {
@@ -877,7 +857,7 @@ static void test_light_sample_sky_grid(void **state)
 	Lit l;
 	build_light_scene(&l);
 	V3 sun = v3_norm(v3(-0.2f, 0.3f, 1.0f));
-	assert_int_equal(scene_set_env_image(l.s, 128, 64, sun_sky(128, 64, sun, 0.05f, 500.0f), 0.05f), AJAR_OK);
+	assert_int_equal(scene_set_env_image(l.s, 128, 64, test_sun_sky(128, 64, sun.x, sun.y, sun.z, 0.05f, 500.0f), 0.05f), AJAR_OK);
 	enum { NV = GRID_NV, NT = GRID_NT };
 	float pos[3 * NV + 9];
 	uint32_t idx[3 * NT + 3];
