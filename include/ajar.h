@@ -102,8 +102,15 @@ typedef struct {
 } ajar_camera;
 ajar_status ajar_scene_set_camera(ajar_scene *s, const ajar_camera *c);
 ajar_status ajar_scene_set_environment_color(ajar_scene *s, const float rgb[3]);
-/* Equirectangular OpenEXR, +Y up, importance-sampled. */
+/* Equirectangular OpenEXR (any compression) or Radiance .hdr (told by its
+ * header), +Y up, importance-sampled. Negative pixel values become 0 with
+ * one warning; NaN or Inf is refused, naming the pixel. */
 ajar_status ajar_scene_set_environment_image(ajar_scene *s, const char *exr_path, float strength);
+/* Turns the environment by `degrees` about +Y, right-handed: positive is
+ * counter-clockwise seen from above, so what the unturned image shows
+ * toward +X moves toward -Z at 90. For either kind of environment, set
+ * before or after; default 0. */
+ajar_status ajar_scene_set_environment_rotation(ajar_scene *s, float degrees);
 
 typedef struct {
 	uint64_t triangles;

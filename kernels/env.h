@@ -3,7 +3,13 @@
  *
  * Convention: a unit direction d pointing from the scene out to the sky
  * maps to u = 0.5 + atan2(d.x, -d.z) / (2 pi), v = acos(d.y) / pi, row 0
- * at the top (+Y), so the image centre looks down -Z. Radiance is
+ * at the top (+Y), so the image centre looks down -Z. That is the image
+ * frame; the sky is turned by Params.env_rotation (radians) about +Y,
+ * right-handed (positive = counter-clockwise seen from above, so +X turns
+ * toward -Z): a feature at image-frame direction d is seen in the scene at
+ * R(a) d. Every direction meets the image through env_texel (world to
+ * image, R(-a)) and env_dir (image to world, R(a)); a rotation leaves
+ * solid angles, hence every density below, unchanged. Radiance is
  * piecewise constant per texel (nearest texel); a texel is sampled
  * uniformly in (u, v), so the solid-angle density is
  * p_row p_col W H / (2 pi^2 sin(theta)), and env_sample reports exactly
@@ -13,17 +19,29 @@
 #include "types.h"
 #include "sampling.h"
 
-/* Direction of equirect coordinates (u, v) in [0,1]^2. */
-INLINE V3 env_dir(float u, float v)
+/* d turned by `sign` x the environment's rotation about +Y. Exactly d
+ * when there is no rotation, so unrotated skies keep their bits. */
+INLINE V3 env_turn(GLOBAL const Params *prm, V3 d, float sign)
+{
+	float a = prm->env_rotation;
+	if (a == 0.0f)
+		return d;
+	float c = cos(a), s = sign * sin(a);
+	return v3(c * d.x + s * d.z, d.y, c * d.z - s * d.x);
+}
+
+/* Scene direction of equirect coordinates (u, v) in [0,1]^2. */
+INLINE V3 env_dir(GLOBAL const Params *prm, float u, float v)
 {
 	float phi = 2.0f * AJAR_PI * (u - 0.5f), theta = AJAR_PI * v;
 	float st = sin(theta);
-	return v3(st * sin(phi), cos(theta), -st * cos(phi));
+	return env_turn(prm, v3(st * sin(phi), cos(theta), -st * cos(phi)), 1.0f);
 }
 
-/* Texel (row, col) under unit direction d; returns sin(theta) of d. */
+/* Texel (row, col) under unit scene direction d; returns sin(theta) of d. */
 INLINE float env_texel(GLOBAL const Params *prm, V3 d, int *row, int *col)
 {
+	d = env_turn(prm, d, -1.0f);
 	float y = fmin(fmax(d.y, -1.0f), 1.0f);
 	float u = 0.5f + atan2(d.x, -d.z) * AJAR_INV_2PI;
 	float v = acos(y) * AJAR_INV_PI;
@@ -91,7 +109,7 @@ INLINE V3 env_sample(const SceneView *sc, float u1, float u2, V3 *d, float *pdf_
 	int col = sample_cdf(sc->env + ENV_CONDITIONAL(w, h) + row * (w + 1), w, u2, &p_col, &uc);
 	if (col < 0)
 		return v3(0.0f, 0.0f, 0.0f);
-	*d = env_dir(((float)col + uc) / (float)w, ((float)row + ur) / (float)h);
+	*d = env_dir(prm, ((float)col + uc) / (float)w, ((float)row + ur) / (float)h);
 	/* Density and radiance from d's own texel, exactly what env_pdf_w
 	 * and env_radiance return for d, even where rounding put a sample on
 	 * a texel edge into the neighbour. */

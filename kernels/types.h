@@ -168,8 +168,10 @@ typedef struct {
 	int light_paths;        /* 192, portal: 0 = no light subpaths (bdpt's s >= 2 and t = 1 left out) */
 	int portal_t_max;       /* intermediate strategies use at most this many eye vertices */
 	float portal_rate;      /* 200, probability that a pixel sample traces an intermediate subpath */
-	int num_portal_planes;  /* planar portals with sky tables (env_portal.h), 0 = none */
-} Params; /* 208 */
+	float env_rotation;     /* radians about +Y, right-handed (env.h) */
+	int num_portal_planes;  /* 208, planar portals with sky tables (env_portal.h), 0 = none */
+	int pad2, pad3, pad4;
+} Params; /* 224 */
 
 /* Layout of the float array `env`: for an ENV_IMAGE of W x H,
  *   [0, 3WH)                    linear RGB radiance, row-major, row 0 = top

@@ -459,6 +459,12 @@ ajar_status ajar_read_exr(const char *path, float **rgba, uint32_t *width, uint3
 	st = exr_map_channels(path, cl, &map);
 	if (st != AJAR_OK)
 		goto done;
+	exr_compression_t comp;
+	if (exr_get_compression(r.ctxt, 0, &comp) == EXR_ERR_SUCCESS &&
+	    (comp == EXR_COMPRESSION_DWAA || comp == EXR_COMPRESSION_DWAB)) {
+		exr_close(&r);
+		return exr_read_dwa(path, rgba, width, height);
+	}
 	if ((uint64_t)w * (uint64_t)h > SIZE_MAX / (4 * sizeof(float))) {
 		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: %lldx%lld image too large", path, (long long)w,
 			     (long long)h);

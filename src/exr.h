@@ -22,6 +22,10 @@ ajar_status exr_read_attr(const char *path, const char *name, char *value, size_
 ajar_status exr_write_channels(const char *path, const float *px, int nch, const char *const *names, uint32_t width,
 			       uint32_t height, const char *const *attrs, uint32_t nattrs);
 
+/* Reads a DWAA or DWAB file, which OpenEXR's C Core cannot decode, through
+ * its C++ library (exr_dwa.cpp); called by ajar_read_exr, same result. */
+ajar_status exr_read_dwa(const char *path, float **rgba, uint32_t *width, uint32_t *height);
+
 /* Atomic output, shared by the EXR and PNG writers: image_tmp_open creates
  * a new file next to `path` (*tmp_path is malloc'd); image_tmp_finish
  * closes it and, if `status` is AJAR_OK, renames it to `path`, else removes

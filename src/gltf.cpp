@@ -437,23 +437,25 @@ ajar_status read_environment(Loader &L, const tg::Value &extras, const char *whe
 			return fail(L, AJAR_ERROR_BAD_INPUT, "%s.extras.environment.strength must be a number >= 0", where);
 		strength = v->GetNumberAsDouble();
 	}
+	if (const tg::Value *v = value_member(*env, "rotation")) {
+		if (!v->IsNumber() || !std::isfinite(v->GetNumberAsDouble()))
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s.extras.environment.rotation must be a number (degrees)",
+				    where);
+		ajar_status st = scene_set_env_rotation(L.s, v->GetNumberAsDouble());
+		if (st)
+			return st;
+	}
 	if (const tg::Value *img = value_member(*env, "image")) {
 		if (!img->IsString() || img->Get<std::string>().empty())
 			return fail(L, AJAR_ERROR_BAD_INPUT, "%s.extras.environment.image is not a file name", where);
 		std::string name = img->Get<std::string>();
 		std::string path = name[0] == '/' ? name : L.dir + "/" + name;
-		float *rgba = nullptr;
-		uint32_t w = 0, h = 0;
-		ajar_status st = ajar_read_exr(path.c_str(), &rgba, &w, &h);
+		ajar_status st = scene_load_env_image(L.s, path.c_str(), (float)strength);
 		if (st) {
 			std::string msg = ajar_last_error();
 			return fail(L, st, "%s.extras.environment.image: %s", where, msg.c_str());
 		}
-		size_t n = (size_t)w * h;
-		for (size_t i = 0; i < n; i++)
-			for (int c = 0; c < 3; c++)
-				rgba[3 * i + (size_t)c] = rgba[4 * i + (size_t)c];
-		return scene_set_env_image(L.s, w, h, rgba, (float)strength);
+		return AJAR_OK;
 	}
 	const tg::Value *col = value_member(*env, "color");
 	float rgb[3];

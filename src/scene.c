@@ -12,6 +12,8 @@
 #include <string.h>
 
 #include "error.h"
+#include "exr.h"
+#include "hdr.h"
 
 /* Device code indexes with int, so no array may pass INT32_MAX entries. */
 #define SCENE_MAX_ITEMS ((size_t)INT32_MAX)
@@ -318,33 +320,92 @@ void scene_set_env_color(Scene *s, V3 rgb)
 	s->env_strength = 1.0f;
 }
 
-ajar_status scene_set_env_image(Scene *s, uint32_t w, uint32_t h, float *rgb, float strength)
+/* Refuses NaN and Inf, naming the pixel, and clamps negative values to 0
+ * with one warning that counts them (filtered or compressed skies from
+ * real tools carry a few tiny negatives). `file` names the image for
+ * messages, or NULL for pixels that came from the API. */
+static ajar_status env_pixels_check(const Scene *s, const char *file, uint32_t w, float *rgb, size_t n)
+{
+	const char *who = file ? file : s->source;
+	size_t negative = 0;
+	float lowest = 0.0f;
+	for (size_t i = 0; i < n; i++) {
+		if (!isfinite(rgb[i])) {
+			size_t px = i / 3;
+			return err_set(AJAR_ERROR_BAD_INPUT,
+				       "%s: environment: pixel (%zu, %zu) channel %c is %g (must be finite)", who,
+				       px % w, px / w, "RGB"[i % 3], rgb[i]);
+		}
+		if (rgb[i] < 0.0f) {
+			negative++;
+			lowest = fminf(lowest, rgb[i]);
+			rgb[i] = 0.0f;
+		}
+	}
+	if (negative)
+		log_msg(AJAR_LOG_WARNING, "%s: environment: %zu negative pixel value%s (lowest %g) clamped to 0", who,
+			negative, negative == 1 ? "" : "s", lowest);
+	return AJAR_OK;
+}
+
+static ajar_status set_env_image(Scene *s, const char *file, uint32_t w, uint32_t h, float *rgb, float strength)
 {
 	if (!rgb || w == 0 || h == 0) {
 		free(rgb);
-		return err_set(AJAR_ERROR_BAD_INPUT, "%s: environment: empty image (%ux%u)", s->source, w, h);
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: environment: empty image (%ux%u)", file ? file : s->source, w,
+			       h);
 	}
 	if (!(strength >= 0.0f) || !isfinite(strength)) {
 		free(rgb);
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: environment: strength %g is not >= 0", s->source,
 			       strength);
 	}
-	size_t n = (size_t)w * h * 3;
-	for (size_t i = 0; i < n; i++)
-		if (!(rgb[i] >= 0.0f) || !isfinite(rgb[i])) {
-			size_t px = i / 3;
-			float bad = rgb[i];
-			free(rgb);
-			return err_set(AJAR_ERROR_BAD_INPUT,
-				       "%s: environment: pixel (%zu, %zu) has value %g (must be finite and >= 0)",
-				       s->source, px % w, px / w, bad);
-		}
+	ajar_status st = env_pixels_check(s, file, w, rgb, (size_t)w * h * 3);
+	if (st != AJAR_OK) {
+		free(rgb);
+		return st;
+	}
 	free(s->env_rgb);
 	s->env_rgb = rgb;
 	s->env_width = w;
 	s->env_height = h;
 	s->env_strength = strength;
 	s->env_type = ENV_IMAGE;
+	return AJAR_OK;
+}
+
+ajar_status scene_set_env_image(Scene *s, uint32_t w, uint32_t h, float *rgb, float strength)
+{
+	return set_env_image(s, NULL, w, h, rgb, strength);
+}
+
+ajar_status scene_load_env_image(Scene *s, const char *path, float strength)
+{
+	float *rgba = NULL;
+	uint32_t w = 0, h = 0;
+	if (hdr_file(path)) {
+		ajar_status st = hdr_read(path, &rgba, &w, &h);
+		return st ? st : set_env_image(s, path, w, h, rgba, strength);
+	}
+	ajar_status st = ajar_read_exr(path, &rgba, &w, &h);
+	if (st)
+		return st;
+	/* Reuse the RGBA allocation for the packed RGB the scene keeps. */
+	size_t n = (size_t)w * h;
+	for (size_t i = 0; i < n; i++)
+		for (size_t c = 0; c < 3; c++)
+			rgba[3 * i + c] = rgba[4 * i + c];
+	return set_env_image(s, path, w, h, rgba, strength);
+}
+
+ajar_status scene_set_env_rotation(Scene *s, double degrees)
+{
+	if (!isfinite(degrees))
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: environment: rotation %g is not a finite angle",
+			       s->source, degrees);
+	/* Reduced in double, so large angles keep their precision. */
+	double r = fmod(degrees, 360.0);
+	s->env_rotation = (float)(r * (AJAR_PI / 180.0));
 	return AJAR_OK;
 }
 

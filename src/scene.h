@@ -47,6 +47,7 @@ typedef struct ajar_scene {
 	float env_strength;
 	uint32_t env_width, env_height;
 	float *env_rgb;          /* env_width * env_height * 3, row 0 = top (+Y) */
+	float env_rotation;      /* radians about +Y, right-handed (kernels/env.h) */
 } Scene;
 
 ajar_status scene_new(const char *source, Scene **out);
@@ -68,6 +69,15 @@ ajar_status scene_set_camera(Scene *s, V3 pos, V3 forward, V3 up, float yfov, fl
 void scene_set_env_color(Scene *s, V3 rgb);
 /* Takes ownership of rgb (malloc'ed, w * h * 3 floats). */
 ajar_status scene_set_env_image(Scene *s, uint32_t w, uint32_t h, float *rgb, float strength);
+/* Reads the equirectangular image at `path` (OpenEXR, or Radiance .hdr
+ * told by its header) and sets it; errors
+ * name the file. Negative pixels become 0 with one warning; NaN or Inf is
+ * refused, naming the pixel. */
+ajar_status scene_load_env_image(Scene *s, const char *path, float strength);
+/* Turns the sky by `degrees` about +Y, right-handed (counter-clockwise seen
+ * from above); must be finite. Applies to any environment set before or
+ * after. */
+ajar_status scene_set_env_rotation(Scene *s, double degrees);
 
 /* Bounds of all renderable triangles (portals included). */
 void scene_bounds(const Scene *s, V3 *bmin, V3 *bmax);

@@ -236,19 +236,14 @@ ajar_status ajar_scene_set_environment_image(ajar_scene *s, const char *exr_path
 	if (!in_range(strength, 0.0f, AJAR_INF))
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: environment strength %g must be finite and >= 0",
 			       s->source, strength);
-	float *rgba = NULL;
-	uint32_t w = 0, h = 0;
-	ajar_status st = ajar_read_exr(exr_path, &rgba, &w, &h);
-	if (st)
-		return st;
-	size_t n = (size_t)w * h;
-	/* Reuse the RGBA allocation for the packed RGB the scene keeps. */
-	for (size_t i = 0; i < n; i++) {
-		rgba[3 * i] = rgba[4 * i];
-		rgba[3 * i + 1] = rgba[4 * i + 1];
-		rgba[3 * i + 2] = rgba[4 * i + 2];
-	}
-	return scene_set_env_image(s, w, h, rgba, strength);
+	return scene_load_env_image(s, exr_path, strength);
+}
+
+ajar_status ajar_scene_set_environment_rotation(ajar_scene *s, float degrees)
+{
+	if (!s)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_scene_set_environment_rotation: NULL scene");
+	return scene_set_env_rotation(s, degrees);
 }
 
 ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info)

@@ -86,6 +86,7 @@ static void lit_build(Lit *l)
 	l->prm.env_width = (int)s->env_width;
 	l->prm.env_height = (int)s->env_height;
 	l->prm.env_strength = s->env_strength;
+	l->prm.env_rotation = s->env_rotation;
 	l->prm.env_color = s->env_color;
 	l->prm.env_pdf_select = l->lt.env_pdf_select;
 	memset(&l->sc, 0, sizeof(l->sc));
@@ -177,7 +178,7 @@ static void test_env_orientation(void **state)
 	/* env_dir is the inverse of the lookup at texel centres. */
 	for (uint32_t y = 0; y < h; y++)
 		for (uint32_t x = 0; x < w; x++) {
-			V3 d = env_dir((x + 0.5f) / w, (y + 0.5f) / h);
+			V3 d = env_dir(&l.prm, (x + 0.5f) / w, (y + 0.5f) / h);
 			assert_float_equal(v3_len(d), 1.0f, 1e-5f);
 			V3 L = env_radiance(&l.sc, d);
 			assert_float_equal(L.x, 2.0f * x, 0.0f);
@@ -186,15 +187,24 @@ static void test_env_orientation(void **state)
 	lit_free(&l);
 }
 
-/* Histogram of env_sample over 16 x 8 cells in (u, v), expected counts
- * from env_pdf_w integrated over each cell in solid angle. */
-static void test_env_sample_chi2(void **state)
+/* The unturned equirect direction of (u, v) (env.h's image frame). */
+static V3 uv_dir(float u, float v)
+{
+	float phi = 2.0f * AJAR_PI * (u - 0.5f), theta = AJAR_PI * v;
+	return v3(sinf(theta) * sinf(phi), cosf(theta), -sinf(theta) * cosf(phi));
+}
+
+/* Histogram of env_sample over 16 x 8 cells in the scene's (u, v) (those
+ * of an unturned sky), expected counts from env_pdf_w integrated over each
+ * cell in solid angle; the sky turned by `degrees`. */
+static void env_sample_chi2(double degrees)
 {
 	rng_state = 11;
 	Lit l;
 	assert_int_equal(scene_new("<test>", &l.s), AJAR_OK);
 	uint32_t w = 40, h = 20;
 	assert_int_equal(scene_set_env_image(l.s, w, h, synthetic_sky(w, h), 1.5f), AJAR_OK);
+	assert_int_equal(scene_set_env_rotation(l.s, degrees), AJAR_OK);
 	lit_build(&l);
 	assert_true(l.lt.env_power > 0.0f);
 	assert_float_equal(l.lt.env_pdf_select, 1.0f, 0.0f); /* no emitters */
@@ -212,7 +222,7 @@ static void test_env_sample_chi2(void **state)
 				for (int i = 0; i < SUB; i++) {
 					float u = (cu + (i + 0.5f) / SUB) / CU, v = (cv + (j + 0.5f) / SUB) / CV;
 					float st = sinf(AJAR_PI * v);
-					sum += env_pdf_w(&l.sc, env_dir(u, v)) * st;
+					sum += env_pdf_w(&l.sc, uv_dir(u, v)) * st;
 				}
 			double cell = sum * (2.0 * M_PI / (CU * SUB)) * (M_PI / (CV * SUB));
 			expct[cv * CU + cu] = cell * N;
@@ -246,16 +256,73 @@ static void test_env_sample_chi2(void **state)
 	}
 	assert_true(refused < N / 10000);
 	double p = chi2_test(obs, expct, CU * CV, 5.0);
-	printf("  env_sample: p = %.3f (%d refused)\n", p, refused);
+	printf("  env_sample, turned %g degrees: p = %.3f (%d refused)\n", degrees, p, refused);
 	assert_true(p > ALPHA);
 
 	/* Densities follow luminance: bright texel centres are denser. */
-	float bright = env_pdf_w(&l.sc, env_dir(0.3f, 0.2f)), dim = env_pdf_w(&l.sc, env_dir(0.9f, 0.5f));
+	float bright = env_pdf_w(&l.sc, env_dir(&l.prm, 0.3f, 0.2f)), dim = env_pdf_w(&l.sc, env_dir(&l.prm, 0.9f, 0.5f));
 	assert_true(bright > 10.0f * dim);
 	/* The black column and row are never sampled. */
-	assert_float_equal(env_pdf_w(&l.sc, env_dir(3.5f / w, 0.3f)), 0.0f, 0.0f);
-	assert_float_equal(env_pdf_w(&l.sc, env_dir(0.5f, (h / 2 + 1.5f) / h)), 0.0f, 0.0f);
+	assert_float_equal(env_pdf_w(&l.sc, env_dir(&l.prm, 3.5f / w, 0.3f)), 0.0f, 0.0f);
+	assert_float_equal(env_pdf_w(&l.sc, env_dir(&l.prm, 0.5f, (h / 2 + 1.5f) / h)), 0.0f, 0.0f);
 	lit_free(&l);
+}
+
+static void test_env_sample_chi2(void **state) { env_sample_chi2(0.0); }
+
+/* Turned by 11 texels (99 degrees): the sub-grid above still meets the
+ * texel edges (1/8 texel steps), so the expected counts stay exact. */
+static void test_env_sample_chi2_turned(void **state) { env_sample_chi2(99.0); }
+
+/* A 6 x 3 sky black but for texel (4, 1), centred on +X at the horizon.
+ * Turned by +90 degrees (counter-clockwise seen from above) it is found
+ * toward -Z, by -90 toward +Z, by every lookup and by sampling; 450 is 90. */
+static void test_env_rotation_sense(void **state)
+{
+	static const struct {
+		double degrees;
+		V3 want, away;
+	} cases[] = {{0.0, {1, 0, 0}, {0, 0, -1}},
+		     {90.0, {0, 0, -1}, {1, 0, 0}},
+		     {-90.0, {0, 0, 1}, {0, 0, -1}},
+		     {450.0, {0, 0, -1}, {-1, 0, 0}},
+		     {180.0, {-1, 0, 0}, {1, 0, 0}}};
+	for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+		Lit l;
+		assert_int_equal(scene_new("<test>", &l.s), AJAR_OK);
+		uint32_t w = 6, h = 3;
+		float *rgb = calloc(3 * w * h, sizeof(float));
+		assert_non_null(rgb);
+		rgb[3 * (1 * w + 4)] = rgb[3 * (1 * w + 4) + 1] = rgb[3 * (1 * w + 4) + 2] = 5.0f;
+		assert_int_equal(scene_set_env_image(l.s, w, h, rgb, 1.0f), AJAR_OK);
+		assert_int_equal(scene_set_env_rotation(l.s, cases[k].degrees), AJAR_OK);
+		lit_build(&l);
+		V3 want = cases[k].want, away = cases[k].away;
+		assert_float_equal(env_radiance(&l.sc, want).x, 5.0f, 0.0f);
+		assert_float_equal(env_radiance(&l.sc, away).x, 0.0f, 0.0f);
+		assert_true(env_pdf_w(&l.sc, want) > 0.0f);
+		assert_float_equal(env_pdf_w(&l.sc, away), 0.0f, 0.0f);
+		/* The texel centre maps to the turned direction. */
+		V3 c = env_dir(&l.prm, 4.5f / w, 0.5f);
+		assert_true(v3_len(v3_sub(c, want)) < 1e-5f);
+		/* Every sample lies within the texel (60 x 60 degrees) around it. */
+		for (int i = 0; i < 1000; i++) {
+			V3 d;
+			float pdf_w;
+			V3 L = env_sample(&l.sc, rnd(), rnd(), &d, &pdf_w);
+			if (!(pdf_w > 0.0f))
+				continue;
+			assert_float_equal(L.x, 5.0f, 0.0f);
+			assert_true(v3_dot(d, want) > cosf(AJAR_PI / 6.0f * 1.4143f));
+		}
+		lit_free(&l);
+	}
+	/* A turn must be a finite angle. */
+	Scene *s;
+	assert_int_equal(scene_new("<test>", &s), AJAR_OK);
+	assert_int_equal(scene_set_env_rotation(s, NAN), AJAR_ERROR_INVALID_ARGUMENT);
+	assert_int_equal(scene_set_env_rotation(s, INFINITY), AJAR_ERROR_INVALID_ARGUMENT);
+	scene_free(s);
 }
 
 static void test_env_black_and_color(void **state)
@@ -885,6 +952,8 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_env_orientation),
 		cmocka_unit_test(test_env_sample_chi2),
+		cmocka_unit_test(test_env_sample_chi2_turned),
+		cmocka_unit_test(test_env_rotation_sense),
 		cmocka_unit_test(test_env_black_and_color),
 		cmocka_unit_test(test_emitter_sampling),
 		cmocka_unit_test(test_portal_sampling),

@@ -2,6 +2,8 @@
  * answers known independently of Ajar:
  *   - furnaces with analytic radiance (a convex Lambertian box under a
  *     constant sky; a closed emissive Lambertian box with a depth limit);
+ *   - a turned sky seen directly: the column the device shows against one
+ *     worked out here from the rotation convention;
  *   - the Cornell box against Mitsuba 3's converged 8192-spp reference;
  *   - determinism (same seed, same bits) and cancellation.
  *
@@ -123,6 +125,63 @@ static void test_furnace_convex(void **state)
 	free(img);
 	ajar_scene_destroy(&s);
 	assert_null(s);
+}
+
+/* The device turns the sky as the host code does (kernels/env.h): a 4 x 2
+ * sky whose columns have red 1..4 and whose rows have green 1, 2; a narrow
+ * camera at each column centre's horizontal direction sees, with the sky
+ * turned by `deg`, the column found by turning the view back by -deg
+ * (right-handed about +Y, x' = c x - s z, z' = s x + c z), worked out
+ * here without env.h. A triangle far below keeps the scene non-empty. */
+static void test_sky_rotation(void **state)
+{
+	char *dir = test_tmpdir(), *sky = test_path(dir, "sky.exr");
+	float rgba[4 * 2 * 4];
+	for (int y = 0; y < 2; y++)
+		for (int x = 0; x < 4; x++) {
+			float *p = rgba + 4 * (y * 4 + x);
+			p[0] = (float)(x + 1);
+			p[1] = (float)(y + 1);
+			p[2] = 0.0f;
+			p[3] = 1.0f;
+		}
+	assert_int_equal(ajar_write_exr(sky, rgba, 4, 2, NULL, 0), AJAR_OK);
+	static const float degs[] = {0.0f, 90.0f, -90.0f, 30.0f};
+	for (size_t k = 0; k < sizeof degs / sizeof degs[0]; k++)
+		for (int view = 0; view < 4; view++) {
+			ajar_scene *s;
+			ajar_material m;
+			uint32_t mat;
+			assert_int_equal(ajar_scene_create(&s), AJAR_OK);
+			ajar_material_default(&m);
+			assert_int_equal(ajar_scene_add_material(s, &m, &mat), AJAR_OK);
+			float tri[9] = {0, -100, 0, 1, -100, 0, 0, -100, 1};
+			uint32_t idx[3] = {0, 1, 2};
+			ajar_mesh mesh = {tri, NULL, NULL, 3, idx, 1, mat, NULL};
+			assert_int_equal(ajar_scene_add_mesh(s, &mesh), AJAR_OK);
+			assert_int_equal(ajar_scene_set_environment_image(s, sky, 1.0f), AJAR_OK);
+			assert_int_equal(ajar_scene_set_environment_rotation(s, degs[k]), AJAR_OK);
+			/* View a little above the horizon, at column `view`'s centre. */
+			double phi = 2.0 * M_PI * ((view + 0.5) / 4.0 - 0.5);
+			float dx = (float)sin(phi), dz = (float)-cos(phi);
+			ajar_camera cam = {{0, 0, 0}, {dx, 0.3f, dz}, {0, 1, 0}, 0.02f, 0};
+			assert_int_equal(ajar_scene_set_camera(s, &cam), AJAR_OK);
+			float *img = render(s, 4, 4, 2, 1, 4);
+			double a = degs[k] * M_PI / 180.0, c = cos(a), sn = sin(a);
+			double ix = c * dx - sn * dz, iz = sn * dx + c * dz;
+			double u = 0.5 + atan2(ix, -iz) / (2.0 * M_PI);
+			int col = (int)floor(u * 4.0 + 1e-9) % 4;
+			for (int i = 0; i < 16; i++) {
+				if (fabsf(img[4 * i] - (float)(col + 1)) > 1e-5f || fabsf(img[4 * i + 1] - 1.0f) > 1e-5f)
+					fail_msg("turned %g, view %d: pixel %d is (%g, %g), want column %d (%d, 1)", degs[k],
+						 view, i, img[4 * i], img[4 * i + 1], col, col + 1);
+			}
+			free(img);
+			ajar_scene_destroy(&s);
+		}
+	free(sky);
+	test_remove_tree(dir);
+	free(dir);
 }
 
 /* Inside a closed box whose walls emit Le and reflect with albedo rho, a
@@ -342,6 +401,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_furnace_convex),
 		cmocka_unit_test(test_furnace_closed),
+		cmocka_unit_test(test_sky_rotation),
 		cmocka_unit_test(test_cornell_reference),
 		cmocka_unit_test(test_same_seed_same_bits),
 		cmocka_unit_test(test_portal_without_portals_is_bdpt),

@@ -219,6 +219,91 @@ static void test_living_room(void **state)
 	ajar_scene_destroy(&s);
 }
 
+/* Warnings sent to the log callback while a test loads something. */
+static int warnings;
+static char last_warning[2048];
+
+static void count_warnings(ajar_log_level level, const char *message, void *user)
+{
+	if (level != AJAR_LOG_WARNING)
+		return;
+	warnings++;
+	snprintf(last_warning, sizeof last_warning, "%s", message);
+}
+
+/* The sky-lit variants (scenes/skies/make_sky_scenes.py): the rooms'
+ * geometry, the sky image with its slightly negative pixels clamped (one
+ * warning), and the sun where the scene's notes put it: the ray from the
+ * sun's pixel, turned by the scene's rotation (right-handed about +Y,
+ * worked out here again), through a window's centre lands on the surface
+ * named. */
+static void sun_landing(const Scene *s, V3 from, V3 *hit, float plane, int axis)
+{
+	size_t best = 0;
+	for (size_t i = 0; i < (size_t)s->env_width * s->env_height; i++)
+		if (s->env_rgb[3 * i] + s->env_rgb[3 * i + 1] > s->env_rgb[3 * best] + s->env_rgb[3 * best + 1])
+			best = i;
+	double u = ((double)(best % s->env_width) + 0.5) / s->env_width;
+	double v = ((double)(best / s->env_width) + 0.5) / s->env_height;
+	double phi = 2.0 * M_PI * (u - 0.5), th = M_PI * v, a = s->env_rotation;
+	double dx = sin(th) * sin(phi), dy = cos(th), dz = -sin(th) * cos(phi);
+	/* Turned: x' = c x + s z, z' = c z - s x. */
+	double tx = cos(a) * dx + sin(a) * dz, tz = cos(a) * dz - sin(a) * dx;
+	double dir[3] = {-tx, -dy, -tz}, o[3] = {from.x, from.y, from.z};
+	double t = (plane - o[axis]) / dir[axis];
+	assert_true(t > 0.0);
+	*hit = v3((float)(o[0] + t * dir[0]), (float)(o[1] + t * dir[1]), (float)(o[2] + t * dir[2]));
+}
+
+static void test_sky_scenes(void **state)
+{
+	static const struct {
+		const char *path;
+		uint64_t triangles;
+		int negative;
+		float rotation; /* degrees, as make_sky_scenes.py printed */
+	} scenes[] = {
+		{SCENE("window-room-sunset/window-room-sunset.gltf"), 28, 4, 45.5352f},
+		{SCENE("window-room-forest/window-room-forest.gltf"), 28, 826, 55.6836f},
+		{SCENE("living-room-forest/living-room-forest.gltf"), 143163, 826, 140.6836f},
+	};
+	for (int k = 0; k < 3; k++) {
+		warnings = 0;
+		last_warning[0] = '\0';
+		ajar_set_log_callback(count_warnings, NULL);
+		ajar_scene_info in;
+		Scene *s = load_shipped(scenes[k].path, &in);
+		ajar_set_log_callback(NULL, NULL);
+		char want[64];
+		snprintf(want, sizeof want, "%d negative pixel values", scenes[k].negative);
+		assert_int_equal(warnings, 1);
+		if (!strstr(last_warning, want))
+			fail_msg("%s: warning \"%s\"", scenes[k].path, last_warning);
+		assert_int_equal(in.triangles, scenes[k].triangles);
+		assert_int_equal(in.environment, 2);
+		assert_int_equal(s->env_width, 1024);
+		assert_int_equal(s->env_height, 512);
+		assert_float_equal(s->env_rotation, scenes[k].rotation * M_PI / 180.0, 1e-5);
+		V3 p;
+		if (k == 0) {
+			/* Low sun: on the far wall z = 3, right of the window, high up. */
+			sun_landing(s, v3(2.0f, 1.4f, 0.0f), &p, 3.0f, 2);
+			assert_true(p.x > 2.3f && p.x < 2.7f && p.y > 1.1f && p.y < 1.3f);
+		} else if (k == 1) {
+			/* The forest's sun: beyond the far wall's foot (y < 0 at z = 3),
+			 * so it lights the wall's bottom and the floor before it. */
+			sun_landing(s, v3(2.0f, 1.4f, 0.0f), &p, 3.0f, 2);
+			assert_true(p.y > -0.2f && p.y < 0.3f && p.x > 2.5f && p.x < 3.5f);
+		} else {
+			/* Through the window at x = -0.436 (z in [-1.04, -0.15]) onto the
+			 * floor, in front of the camera (x 1.5..5.1, z in the room). */
+			sun_landing(s, v3(-0.436f, 1.58f, -0.595f), &p, 0.0f, 1);
+			assert_true(p.x > 1.5f && p.x < 5.1f && p.z > -3.6f && p.z < 0.0f);
+		}
+		ajar_scene_destroy(&s);
+	}
+}
+
 static void test_bathroom(void **state)
 {
 	ajar_scene_info in;
@@ -710,6 +795,166 @@ static void test_environment_image(void **state)
 	load_fails("envmissing.gltf", AJAR_ERROR_IO, "scenes[0].extras.environment.image");
 }
 
+/* An 8x4 EXR of 0.5 with `bad` at the pixels listed (x, y pairs). */
+static void write_sky(const char *name, float bad, const int *xy, int n)
+{
+	float rgba[8 * 4 * 4];
+	for (int i = 0; i < 8 * 4 * 4; i++)
+		rgba[i] = 0.5f;
+	for (int k = 0; k < n; k++)
+		rgba[4 * (xy[2 * k + 1] * 8 + xy[2 * k]) + (k % 3)] = bad;
+	char *exr = tmp_path(name);
+	assert_int_equal(ajar_write_exr(exr, rgba, 8, 4, NULL, 0), AJAR_OK);
+	free(exr);
+}
+
+static void test_environment_pixels(void **state)
+{
+	/* Tiny negatives (as filtering tools leave them) become 0 with one
+	 * warning that counts them and names the file. */
+	static const int neg[] = {1, 0, 5, 2, 7, 3};
+	write_sky("negsky.exr", -1e-4f, neg, 3);
+	write_tri_gltf("negsky.gltf", "0", "{\"mesh\":0}", ",\"extras\":{\"environment\":{\"image\":\"negsky.exr\"}}");
+	warnings = 0;
+	ajar_set_log_callback(count_warnings, NULL);
+	Scene *s = load_ok("negsky.gltf");
+	ajar_set_log_callback(NULL, NULL);
+	assert_int_equal(warnings, 1);
+	if (!strstr(last_warning, "negsky.exr") || !strstr(last_warning, "3 negative pixel values"))
+		fail_msg("warning \"%s\"", last_warning);
+	assert_int_equal(s->env_type, ENV_IMAGE);
+	assert_float_equal(s->env_rgb[3 * (0 * 8 + 1)], 0.0f, 0.0);
+	assert_float_equal(s->env_rgb[3 * (2 * 8 + 5) + 1], 0.0f, 0.0);
+	assert_float_equal(s->env_rgb[3 * (3 * 8 + 7) + 2], 0.0f, 0.0);
+	for (int i = 0; i < 8 * 4 * 3; i++)
+		assert_true(s->env_rgb[i] == 0.0f || s->env_rgb[i] == 0.5f);
+	ajar_scene_destroy(&s);
+
+	/* A clean sky: no warning. */
+	write_sky("cleansky.exr", 0.0f, neg, 0);
+	write_tri_gltf("cleansky.gltf", "0", "{\"mesh\":0}",
+		       ",\"extras\":{\"environment\":{\"image\":\"cleansky.exr\"}}");
+	warnings = 0;
+	ajar_set_log_callback(count_warnings, NULL);
+	s = load_ok("cleansky.gltf");
+	ajar_set_log_callback(NULL, NULL);
+	assert_int_equal(warnings, 0);
+	ajar_scene_destroy(&s);
+
+	/* NaN and Inf are refused, naming the file and the pixel; the glTF
+	 * loader adds the scene file and the element. */
+	static const int one[] = {6, 2};
+	write_sky("nansky.exr", NAN, one, 1);
+	write_tri_gltf("nansky.gltf", "0", "{\"mesh\":0}", ",\"extras\":{\"environment\":{\"image\":\"nansky.exr\"}}");
+	load_fails("nansky.gltf", AJAR_ERROR_BAD_INPUT, "nansky.exr: environment: pixel (6, 2) channel R is nan");
+	write_sky("infsky.exr", -INFINITY, one, 1);
+	write_tri_gltf("infsky.gltf", "0", "{\"mesh\":0}", ",\"extras\":{\"environment\":{\"image\":\"infsky.exr\"}}");
+	load_fails("infsky.gltf", AJAR_ERROR_BAD_INPUT, "infsky.exr: environment: pixel (6, 2) channel R is -inf");
+
+	/* Through the API: the same check, and the scene keeps no sky. */
+	ajar_scene *as = NULL;
+	assert_int_equal(ajar_scene_create(&as), AJAR_OK);
+	char *nan_exr = tmp_path("nansky.exr");
+	assert_int_equal(ajar_scene_set_environment_image(as, nan_exr, 1.0f), AJAR_ERROR_BAD_INPUT);
+	if (!strstr(ajar_last_error(), "nansky.exr: environment: pixel (6, 2)"))
+		fail_msg("\"%s\"", ajar_last_error());
+	free(nan_exr);
+	ajar_scene_info in;
+	assert_int_equal(ajar_scene_info_get(as, &in), AJAR_OK);
+	assert_int_equal(in.environment, 0);
+	ajar_scene_destroy(&as);
+}
+
+static void test_environment_rotation(void **state)
+{
+	/* Degrees in the extras, radians about +Y in the scene, reduced
+	 * modulo a turn; any number of degrees, of either sign. */
+	write_sky("rotsky.exr", 0.0f, NULL, 0);
+	write_tri_gltf("rot.gltf", "0", "{\"mesh\":0}",
+		       ",\"extras\":{\"environment\":{\"image\":\"rotsky.exr\",\"rotation\":-450}}");
+	Scene *s = load_ok("rot.gltf");
+	assert_float_equal(s->env_rotation, -0.5 * M_PI, 1e-6);
+	ajar_scene_destroy(&s);
+	write_tri_gltf("rotcol.gltf", "0", "{\"mesh\":0}",
+		       ",\"extras\":{\"environment\":{\"color\":[1,1,1],\"rotation\":30}}");
+	s = load_ok("rotcol.gltf");
+	assert_float_equal(s->env_rotation, M_PI / 6.0, 1e-6);
+	ajar_scene_destroy(&s);
+	write_tri_gltf("rotbad.gltf", "0", "{\"mesh\":0}",
+		       ",\"extras\":{\"environment\":{\"color\":[1,1,1],\"rotation\":\"east\"}}");
+	load_fails("rotbad.gltf", AJAR_ERROR_BAD_INPUT, "scenes[0].extras.environment.rotation must be a number");
+
+	ajar_scene *as = NULL;
+	assert_int_equal(ajar_scene_create(&as), AJAR_OK);
+	assert_float_equal(as->env_rotation, 0.0f, 0.0);
+	assert_int_equal(ajar_scene_set_environment_rotation(as, 90.0f), AJAR_OK);
+	assert_float_equal(as->env_rotation, 0.5 * M_PI, 1e-6);
+	assert_int_equal(ajar_scene_set_environment_rotation(as, NAN), AJAR_ERROR_INVALID_ARGUMENT);
+	assert_int_equal(ajar_scene_set_environment_rotation(NULL, 1.0f), AJAR_ERROR_INVALID_ARGUMENT);
+	assert_float_equal(as->env_rotation, 0.5 * M_PI, 1e-6);
+	ajar_scene_destroy(&as);
+}
+
+/* A flat (not run-length) 8x4 Radiance file: pixel i has mantissas
+ * (128 + i, 64, 0) and exponent byte 129, so RGB = (1 + i / 128, 0.5, 0). */
+static void write_hdr(const char *name)
+{
+	static const char head[] = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4 +X 8\n";
+	unsigned char data[sizeof head - 1 + 8 * 4 * 4];
+	memcpy(data, head, sizeof head - 1);
+	for (int i = 0; i < 8 * 4; i++) {
+		unsigned char *p = data + sizeof head - 1 + 4 * i;
+		p[0] = (unsigned char)(128 + i);
+		p[1] = 64;
+		p[2] = 0;
+		p[3] = 129;
+	}
+	write_bytes(name, data, sizeof data);
+}
+
+static void test_environment_hdr(void **state)
+{
+	/* Told by its header, not its name. */
+	write_hdr("sky.hdr");
+	write_hdr("sky-hdr.exr");
+	const char *names[2] = {"sky.hdr", "sky-hdr.exr"};
+	for (int k = 0; k < 2; k++) {
+		char extras[256];
+		snprintf(extras, sizeof extras, ",\"extras\":{\"environment\":{\"image\":\"%s\",\"strength\":2}}",
+			 names[k]);
+		write_tri_gltf("hdr.gltf", "0", "{\"mesh\":0}", extras);
+		Scene *s = load_ok("hdr.gltf");
+		assert_int_equal(s->env_type, ENV_IMAGE);
+		assert_int_equal(s->env_width, 8);
+		assert_int_equal(s->env_height, 4);
+		assert_float_equal(s->env_strength, 2.0f, 0.0);
+		for (int i = 0; i < 8 * 4; i++) {
+			assert_true(s->env_rgb[3 * i] == 1.0f + (float)i / 128.0f);
+			assert_true(s->env_rgb[3 * i + 1] == 0.5f);
+			assert_true(s->env_rgb[3 * i + 2] == 0.0f);
+		}
+		ajar_scene_destroy(&s);
+	}
+	ajar_scene *as = NULL;
+	assert_int_equal(ajar_scene_create(&as), AJAR_OK);
+	char *p = tmp_path("sky.hdr");
+	assert_int_equal(ajar_scene_set_environment_image(as, p, 1.0f), AJAR_OK);
+	free(p);
+	assert_int_equal(as->env_width, 8);
+	assert_true(as->env_rgb[3 * 9] == 1.0f + 9.0f / 128.0f);
+	ajar_scene_destroy(&as);
+
+	/* A Radiance header with a layout stb_image does not read, and one
+	 * cut short: refused, naming the file. */
+	write_text("sideways.hdr", "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n+X 8 -Y 4\n");
+	write_tri_gltf("hdrbad.gltf", "0", "{\"mesh\":0}",
+		       ",\"extras\":{\"environment\":{\"image\":\"sideways.hdr\"}}");
+	load_fails("hdrbad.gltf", AJAR_ERROR_BAD_INPUT, "sideways.hdr: not a readable Radiance HDR image");
+	write_text("cut.hdr", "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4 +X 8\n\x80\x40");
+	write_tri_gltf("hdrcut.gltf", "0", "{\"mesh\":0}", ",\"extras\":{\"environment\":{\"image\":\"cut.hdr\"}}");
+	load_fails("hdrcut.gltf", AJAR_ERROR_BAD_INPUT, "cut.hdr: not a readable Radiance HDR image");
+}
+
 /* ---- Broken files ------------------------------------------------------ */
 
 static void test_broken_files(void **state)
@@ -804,6 +1049,7 @@ int main(void)
 		cmocka_unit_test(test_cornell),
 		cmocka_unit_test(test_window_room),
 		cmocka_unit_test(test_living_room),
+		cmocka_unit_test(test_sky_scenes),
 		cmocka_unit_test(test_bathroom),
 		cmocka_unit_test(test_api_scene),
 		cmocka_unit_test(test_hierarchy_trs),
@@ -816,6 +1062,9 @@ int main(void)
 		cmocka_unit_test(test_glb),
 		cmocka_unit_test(test_portals_and_environment),
 		cmocka_unit_test(test_environment_image),
+		cmocka_unit_test(test_environment_pixels),
+		cmocka_unit_test(test_environment_rotation),
+		cmocka_unit_test(test_environment_hdr),
 		cmocka_unit_test(test_broken_files),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
