@@ -174,14 +174,6 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	}
 	if (!p->light_paths && p->portal_s_max > 1)
 		p->portal_s_max = 1; /* larger s needs light subpaths */
-	/* How often a pixel sample traces an intermediate subpath (mis.h,
-	 * MisPortalSet), chosen by measurement at equal time (README,
-	 * Results): with next-event estimation through the portals, the sky
-	 * needs them seldom; light from emitters behind an opening more often.
-	 * AJAR_PORTAL_RATE in (0, 1] overrides it. Layers without MIS weights
-	 * (tests) take every intermediate subpath. */
-	float rate = p->light_paths ? PORTAL_RATE_EMITTERS : PORTAL_RATE_SKY;
-	p->portal_rate = p->strategy_unweighted ? 1.0f : env_rate("AJAR_PORTAL_RATE", rate);
 	p->emitter_power = d->lights.emitter_power;
 	p->env_power = d->lights.env_power;
 	/* What lies behind each side of the portals, with the kernels' own
@@ -205,6 +197,19 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 		return st;
 	}
 	p->num_portal_planes = (int)d->n_portal_planes;
+	/* How often a pixel sample traces an intermediate subpath (mis.h,
+	 * MisPortalSet), chosen by measurement at equal time (README,
+	 * Results): with next-event estimation through the portals, the sky
+	 * needs them seldom; light from emitters behind an opening more often.
+	 * AJAR_PORTAL_RATE in (0, 1] overrides it. Layers without MIS weights
+	 * (tests) take every intermediate subpath. */
+	float rate = p->light_paths ? PORTAL_RATE_EMITTERS : PORTAL_RATE_SKY;
+	/* Under a sky image (with a sun), sampled through planar portals, the
+	 * <- halves guided by the sky's importance find the sun and the ->
+	 * halves the patch it lights: worth a higher rate than a constant sky. */
+	if (!p->light_paths && p->num_portal_planes > 0)
+		rate = PORTAL_RATE_SKY_IMAGE;
+	p->portal_rate = p->strategy_unweighted ? 1.0f : env_rate("AJAR_PORTAL_RATE", rate);
 	if (p->num_emitters == 0 && p->env_type == ENV_NONE)
 		log_msg(AJAR_LOG_WARNING, "%s: no emissive triangles and no environment: the image is black",
 			s->source);

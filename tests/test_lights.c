@@ -906,7 +906,9 @@ static void test_light_sample_sky_portals(void **state)
 	 * beside the triangle behind it; within that triangle's bounding
 	 * rectangle, which its frame along the hypotenuse makes larger). */
 	V3 x2 = v3(-0.6f, 0.5f, 0.2f), nx = v3_norm(v3(0.3f, -0.2f, 0.9f));
-	assert_true(sky_portal_pdf_w(&l.sc, x, nx, sun, sky_portal_total(&l.sc, x, nx)) > 0.0f);
+	SkyWeights sw;
+	sky_weights(&l.sc, x, nx, &sw);
+	assert_true(sky_portal_pdf_w(&l.sc, &sw, x, nx, sun) > 0.0f);
 	assert_int_equal(portal_crossings(&l.sc, x2, sun, 1), 0);
 	for (int k = 0; k < 4; k++)
 		if (sky_rect(&l.planes[k], x2, &r))
@@ -916,8 +918,8 @@ static void test_light_sample_sky_portals(void **state)
 }
 
 /* A window in a grid of 24 triangles (one plane), seen from close by and
- * off its centre, and a single-triangle portal (directions in its
- * bounding rectangle but outside it are valid samples of the plane). */
+ * off its centre, and single-triangle portals (directions in their
+ * bounding rectangles but outside them are valid samples of the plane). */
 static void test_light_sample_sky_grid(void **state)
 {
 	rng_state = 37;
@@ -926,21 +928,28 @@ static void test_light_sample_sky_grid(void **state)
 	V3 sun = v3_norm(v3(-0.2f, 0.3f, 1.0f));
 	assert_int_equal(scene_set_env_image(l.s, 128, 64, test_sun_sky(128, 64, sun.x, sun.y, sun.z, 0.05f, 500.0f), 0.05f), AJAR_OK);
 	enum { NV = GRID_NV, NT = GRID_NT };
-	float pos[3 * NV + 9];
-	uint32_t idx[3 * NT + 3];
+	float pos[3 * NV + 36];
+	uint32_t idx[3 * NT + 12];
 	grid_window(pos, idx);
-	/* A triangle in the plane x = 1.2, tilted against the grid. */
-	const float tri[9] = {1.2f, -0.5f, -0.5f, 1.2f, 0.9f, 0.2f, 1.2f, 0.0f, 0.8f};
-	memcpy(&pos[3 * NV], tri, sizeof tri);
-	idx[3 * NT] = NV;
-	idx[3 * NT + 1] = NV + 1;
-	idx[3 * NT + 2] = NV + 2;
-	assert_int_equal(scene_add_portal(l.s, "grid", pos, NV + 3, idx, NT + 1), AJAR_OK);
+	/* A triangle in the plane x = 1.2, tilted against the grid, and three
+	 * apart in the plane z = 1.6 behind it: more planes than the sampler
+	 * keeps weights for (SKY_KEPT), so the rest are weighed again. */
+	const float tri[4][9] = {{1.2f, -0.5f, -0.5f, 1.2f, 0.9f, 0.2f, 1.2f, 0.0f, 0.8f},
+				 {-0.6f, 0.2f, 1.6f, -0.3f, 0.2f, 1.6f, -0.4f, 0.5f, 1.6f},
+				 {0.1f, -0.3f, 1.6f, 0.4f, -0.3f, 1.6f, 0.3f, 0.0f, 1.6f},
+				 {0.5f, 0.4f, 1.6f, 0.8f, 0.4f, 1.6f, 0.7f, 0.7f, 1.6f}};
+	for (int k = 0; k < 4; k++) {
+		memcpy(&pos[3 * (NV + 3 * k)], tri[k], sizeof tri[k]);
+		for (int c = 0; c < 3; c++)
+			idx[3 * (NT + k) + c] = (uint32_t)(NV + 3 * k + c);
+	}
+	assert_int_equal(scene_add_portal(l.s, "grid", pos, NV + 12, idx, NT + 4), AJAR_OK);
 	lit_build(&l);
 	V3 x = v3(0.3f, 0.1f, 0.75f);
-	for (int j = 0; j <= NT; j++)
+	for (int j = 0; j < NT + 4; j++)
 		l.s->portals[j].env_side = v3_dot(v3_sub(x, l.s->portals[j].p0), l.s->portals[j].n) > 0 ? -1 : 1;
-	assert_int_equal(lit_planes(&l), 2);
+	assert_int_equal(lit_planes(&l), 5);
+	assert_true(5 > SKY_KEPT);
 	check_sky_uv(&l, 0, x, "near");
 	check_sky_uv(&l, 1, x, "triangle");
 	check_light_sample(&l, x, v3_norm(v3(0.2f, -0.3f, 0.9f)), "+ sky grid");

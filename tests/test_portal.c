@@ -771,8 +771,9 @@ static void test_portal_set(void **state)
 	unsetenv("AJAR_PORTAL_SET");
 }
 
-/* The rate of intermediate subpaths: 0.1 where the sky is the only light,
- * 1 with emitters, AJAR_PORTAL_RATE in (0, 1] overriding it, anything
+/* The rate of intermediate subpaths: 0.1 where a constant sky is the only
+ * light, 0.3 where a sky image is (sampled through planar portals), 1 with
+ * emitters, AJAR_PORTAL_RATE in (0, 1] overriding it, anything
  * else ignored with a warning. */
 static void test_portal_rate(void **state)
 {
@@ -782,6 +783,9 @@ static void test_portal_rate(void **state)
 	host_scene_close(&h);
 	host_scene_open(&h, SCENE("door-ajar/door-ajar.gltf"), NULL, 8, 8, INTEGRATOR_PORTAL, 8);
 	assert_float_equal(h.data.params->portal_rate, 1.0f, 0.0f);
+	host_scene_close(&h);
+	host_scene_open(&h, NULL, sun_room(0, 300.0f), 8, 8, INTEGRATOR_PORTAL, 8); /* a sky image */
+	assert_float_equal(h.data.params->portal_rate, 0.3f, 0.0f);
 	host_scene_close(&h);
 	const char *rates[] = {"0.25", "1", "0", "1.5", "0.3x", ""};
 	const float expect[] = {0.25f, 1.0f, 0.1f, 0.1f, 0.1f, 0.1f};
