@@ -806,6 +806,9 @@ static void test_wasted_fewer(void **state)
 	check_wasted(SCENE("window-room/window-room.gltf"), "window-room");
 	check_wasted(SCENE("living-room/living-room.gltf"), "living-room");
 	check_wasted(SCENE("door-ajar/door-ajar.gltf"), "door-ajar");
+	/* Sky images with a sun: guided <- halves aim at the sky's importance. */
+	check_wasted(SCENE("window-room-sunset/window-room-sunset.gltf"), "window-room-sunset");
+	check_wasted(SCENE("living-room-forest/living-room-forest.gltf"), "living-room-forest");
 }
 
 int main(void)
