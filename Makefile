@@ -41,6 +41,7 @@ DEPS_test_exr := $(call obj,error exr exr_dwa png)
 DEPS_test_confine := $(call obj,error scene scene_api gltf exr exr_dwa hdr png)
 DEPS_test_bdpt := $(BUILD)/tests/kernel_host.o $(BUILD)/tests/mis_oracle.o $(call obj,error scene scene_api gltf exr exr_dwa hdr bvh lights prepare portal_flux portal_sky)
 DEPS_test_portal := $(DEPS_test_bdpt)
+DEPS_test_punctual := $(DEPS_test_bdpt)
 # Tests that render need the whole library.
 DEPS_test_layout := $(BUILD)/libajar.a
 DEPS_test_render := $(BUILD)/libajar.a
@@ -139,7 +140,7 @@ test:
 	$(Q)sh tests/run.sh $(BUILD) $(TESTS)
 
 # Host tests that need no OpenCL device, under ASan + UBSan.
-ASAN_TESTS := test_bsdf test_sampling test_bvh test_lights test_scene test_exr test_bdpt test_portal test_confine
+ASAN_TESTS := test_bsdf test_sampling test_bvh test_lights test_scene test_exr test_bdpt test_portal test_confine test_punctual
 asan:
 	$(Q)$(MAKE) --no-print-directory deps
 	$(Q)$(MAKE) --no-print-directory MODE=asan $(ASAN_TESTS:%=build/asan/tests/%)

@@ -104,6 +104,26 @@ typedef struct {
 	int pad0, pad1, pad2;
 } PortalPlane; /* 80 */
 
+/* KHR_lights_punctual light (src/lights.c converts glTF's photometric
+ * units at 683 lm/W). A delta light: no ray hits it, next-event estimation
+ * and light subpaths reach it deterministically. Chosen by power in the
+ * same CDF as the emitters, after them (emitter_cdf[num_emitters + i]). */
+#define LIGHT_DIRECTIONAL 0
+#define LIGHT_POINT 1
+#define LIGHT_SPOT 2
+typedef struct {
+	V3 pos;           /* point, spot */
+	int type;         /* LIGHT_* */
+	V3 dir;           /* unit, the way the light travels */
+	float pdf_select; /* probability of choosing it in emitter_cdf */
+	V3 intensity;     /* W/sr (point, spot), W/m^2 perpendicular (directional) */
+	float range;      /* 0 = infinite */
+	float cos_outer;  /* spot: cosine of the outer cone angle (point: -1) */
+	float cone_scale; /* spot: 1 / max(0.001, cos inner - cos outer) */
+	float disk_radius;/* directional: radius of the disk light subpaths start on */
+	float pad0;
+} PunctualLight; /* 64 */
+
 #define ENV_NONE 0
 #define ENV_COLOR 1
 #define ENV_IMAGE 2
@@ -169,8 +189,10 @@ typedef struct {
 	int portal_t_max;       /* intermediate strategies use at most this many eye vertices */
 	float portal_rate;      /* 200, probability that a pixel sample traces an intermediate subpath */
 	float env_rotation;     /* radians about +Y, right-handed (env.h) */
-	int num_portal_planes;  /* 208, planar portals with sky tables (env_portal.h), 0 = none */
-	int pad2, pad3, pad4;
+	int num_lights;         /* 208, PunctualLight */
+	float light_power;      /* their total power estimate (src/lights.c) */
+	int num_portal_planes;  /* 216, planar portals with sky tables (env_portal.h), 0 = none */
+	int pad2;
 } Params; /* 224 */
 
 /* Layout of the float array `env`: for an ENV_IMAGE of W x H,
@@ -197,6 +219,7 @@ typedef struct {
 	X(float, env)             \
 	X(PortalTri, portals)     \
 	X(float, portal_cdf)      \
+	X(PunctualLight, punctual) \
 	X(PortalPlane, portal_planes) \
 	X(float, portal_sky)      \
 	X(Params, params)

@@ -48,6 +48,9 @@ typedef struct ajar_scene {
 	uint32_t env_width, env_height;
 	float *env_rgb;          /* env_width * env_height * 3, row 0 = top (+Y) */
 	float env_rotation;      /* radians about +Y, right-handed (kernels/env.h) */
+
+	ajar_light *lights;      /* punctual lights, glTF units, direction unit */
+	uint32_t nlights, cap_lights;
 } Scene;
 
 ajar_status scene_new(const char *source, Scene **out);
@@ -78,6 +81,10 @@ ajar_status scene_load_env_image(Scene *s, const char *path, float strength);
  * from above); must be finite. Applies to any environment set before or
  * after. */
 ajar_status scene_set_env_rotation(Scene *s, double degrees);
+
+/* Validates and appends a punctual light (`what` names it for messages);
+ * the direction is normalised. */
+ajar_status scene_add_light(Scene *s, const char *what, const ajar_light *l);
 
 /* Bounds of all renderable triangles (portals included). */
 void scene_bounds(const Scene *s, V3 *bmin, V3 *bmax);

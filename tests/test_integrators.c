@@ -76,20 +76,11 @@ static void agree(const char *what, const Estimate *a, const Estimate *b)
 	}
 }
 
-/* sun: 0 the scene's own environment, else a sky with a sun disc of
- * radiance 300 at elevation `sun` (radians) toward -z. */
-static void compare_sky(const char *path, float sun, uint32_t w, uint32_t h, uint32_t spp_pt, uint32_t spp_bdpt)
+static void compare_scene(ajar_scene *s, const char *path, uint32_t w, uint32_t h, uint32_t spp_pt, uint32_t spp_bdpt)
 {
-	ajar_scene *s;
 	Estimate pt, bdpt, portal;
 	char what[256];
 	const uint32_t depth = 12;
-	if (ajar_scene_load(path, &s) != AJAR_OK)
-		fail_msg("%s", ajar_last_error());
-	if (sun > 0.0f) {
-		float *sky = test_sun_sky(256, 128, 0.1f, sinf(sun), -cosf(sun), 0.04f, 300.0f);
-		assert_int_equal(scene_set_env_image(s, 256, 128, sky, 1.0f), AJAR_OK);
-	}
 	estimate(s, AJAR_INTEGRATOR_PT, w, h, spp_pt, depth, &pt);
 	estimate(s, AJAR_INTEGRATOR_BDPT, w, h, spp_bdpt, depth, &bdpt);
 	snprintf(what, sizeof what, "%s bdpt vs pt", path);
@@ -104,7 +95,59 @@ static void compare_sky(const char *path, float sun, uint32_t w, uint32_t h, uin
 
 static void compare(const char *path, uint32_t w, uint32_t h, uint32_t spp_pt, uint32_t spp_bdpt)
 {
-	compare_sky(path, 0.0f, w, h, spp_pt, spp_bdpt);
+	ajar_scene *s;
+	if (ajar_scene_load(path, &s) != AJAR_OK)
+		fail_msg("%s", ajar_last_error());
+	compare_scene(s, path, w, h, spp_pt, spp_bdpt);
+}
+
+/* `path` with a directional light along `dir` (intensity in lux), and a
+ * point light at p and a spot at q pointing down (candela), all in
+ * glTF's units (KHR_lights_punctual). */
+static void compare_punctual(const char *path, const char *what, const float dir[3], float lux, const float p[3],
+			     const float q[3], float cd, uint32_t w, uint32_t h, uint32_t spp_pt, uint32_t spp_bdpt)
+{
+	ajar_scene *s;
+	if (ajar_scene_load(path, &s) != AJAR_OK)
+		fail_msg("%s", ajar_last_error());
+	ajar_light l;
+	ajar_light_default(&l);
+	l.type = AJAR_LIGHT_DIRECTIONAL;
+	for (int k = 0; k < 3; k++)
+		l.direction[k] = dir[k];
+	l.intensity = lux;
+	assert_int_equal(ajar_scene_add_light(s, &l), AJAR_OK);
+	ajar_light_default(&l);
+	for (int k = 0; k < 3; k++)
+		l.position[k] = p[k];
+	l.color[2] = 0.5f;
+	l.intensity = cd;
+	assert_int_equal(ajar_scene_add_light(s, &l), AJAR_OK);
+	ajar_light_default(&l);
+	l.type = AJAR_LIGHT_SPOT;
+	for (int k = 0; k < 3; k++)
+		l.position[k] = q[k];
+	l.direction[0] = 0.1f;
+	l.direction[1] = -1.0f;
+	l.direction[2] = 0.2f;
+	l.inner_cone = 0.3f;
+	l.outer_cone = 0.6f;
+	l.intensity = 2 * cd;
+	l.range = 4.0f;
+	assert_int_equal(ajar_scene_add_light(s, &l), AJAR_OK);
+	compare_scene(s, what, w, h, spp_pt, spp_bdpt);
+}
+
+/* path under a sky with a sun disc of radiance 300 at elevation `sun`
+ * (radians) toward -z. */
+static void compare_sky(const char *path, float sun, uint32_t w, uint32_t h, uint32_t spp_pt, uint32_t spp_bdpt)
+{
+	ajar_scene *s;
+	if (ajar_scene_load(path, &s) != AJAR_OK)
+		fail_msg("%s", ajar_last_error());
+	float *sky = test_sun_sky(256, 128, 0.1f, sinf(sun), -cosf(sun), 0.04f, 300.0f);
+	assert_int_equal(scene_set_env_image(s, 256, 128, sky, 1.0f), AJAR_OK);
+	compare_scene(s, path, w, h, spp_pt, spp_bdpt);
 }
 
 static void test_cornell(void **state) { compare(SCENE("cornell/cornell.gltf"), 32, 32, 32, 8); }
@@ -121,6 +164,25 @@ static void test_window_room_sun(void **state)
 }
 static void test_door_ajar(void **state) { compare(SCENE("door-ajar/door-ajar.gltf"), 24, 24, 512, 128); }
 
+/* The Cornell box lit by its emitter, the sun through its open side, a
+ * point light and a spot (no portals: the sun's light subpaths start on
+ * the scene's disk). */
+static void test_cornell_punctual(void **state)
+{
+	const float sun[3] = {0.2f, -0.5f, 0.8f}, p[3] = {0.15f, 0.45f, 0.3f}, q[3] = {0.4f, 0.5f, 0.25f};
+	compare_punctual(SCENE("cornell/cornell.gltf"), "cornell + punctual lights", sun, 683.0f, p, q, 0.1f * 683.0f,
+			 32, 32, 32, 8);
+}
+
+/* The window room lit by the sun through its window (light subpaths start
+ * on the portal), a point light and a spot, besides its sky. */
+static void test_window_room_punctual(void **state)
+{
+	const float sun[3] = {0.3f, -0.5f, 0.8f}, p[3] = {1.0f, 2.2f, 2.0f}, q[3] = {3.0f, 2.5f, 1.5f};
+	compare_punctual(SCENE("window-room/window-room.gltf"), "window-room + sun + punctual lights", sun,
+			 683.0f * 10.0f, p, q, 683.0f, 32, 32, 64, 16);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -130,6 +192,8 @@ int main(void)
 		cmocka_unit_test(test_living_room),
 		cmocka_unit_test(test_bathroom),
 		cmocka_unit_test(test_door_ajar),
+		cmocka_unit_test(test_cornell_punctual),
+		cmocka_unit_test(test_window_room_punctual),
 	};
 	return cmocka_run_group_tests_name("integrators", tests, NULL, NULL);
 }

@@ -2,6 +2,7 @@
 
   python backend.py RENDERER SCENE.gltf OUT.npy --size WxH --depth D
                     (--seconds T | --spp N) [--seed S] [--threads N] [--integrator NAME]
+                    [--sky-array SKY.npy]
 
 RENDERER is mitsuba, cycles or luxcore (backend_<name>.py). The scene is
 read by scene.py, must be exactly Lambertian (the driver passes the matched
@@ -38,12 +39,15 @@ def main():
 	p.add_argument("--seed", type=int, default=1)
 	p.add_argument("--threads", type=int, default=os.cpu_count())
 	p.add_argument("--integrator", default="")
+	p.add_argument("--sky-array", default="", help="the sky image's pixels as .npy (driver.sky_array)")
 	a = p.parse_args()
 	if (a.seconds > 0) == (a.spp > 0):
 		p.error("give exactly one of --seconds and --spp")
 	a.width, a.height = (int(x) for x in a.size.split("x"))
 	s = Scene(a.scene)
 	s.check_lambertian()
+	if s.sky is not None and a.sky_array:
+		s.sky["array"] = a.sky_array
 	mod = importlib.import_module("backend_" + a.renderer)
 	rgb, info = mod.render(s, a, t0)
 	import numpy as np

@@ -5,7 +5,20 @@ importer (which neither sets the camera nor keeps flat normals): one flat
 shaded mesh per material with a Diffuse BSDF (roughness 0: Lambertian,
 two-sided like Ajar's). Emission is one-sided like Ajar's: the Emission
 strength is multiplied by (1 - Backfacing), and the material's emission
-sampling is FRONT. The world is the uniform environment (black if none).
+sampling is FRONT. The world is the uniform environment (black if none), or
+the sky image: an Environment Texture with "Closest" interpolation (Ajar's
+lookup is nearest-texel), fed the world direction through a Mapping node
+turning it by -(90 + rotation) degrees about Blender's Z. Ajar's lookup
+u = 0.5 + atan2(x, -z) / 2 pi in glTF axes is Cycles' equirectangular
+u = 0.5 - atan2(y, x) / 2 pi turned by -90 degrees (Blender's importer maps
+glTF (x, y, z) to (x, -z, y)), and the sky's rotation about glTF +Y is one
+about Blender +Z, the lookup turning the other way (checked with a sky of
+numbered columns seen straight on). Its negative pixels are clamped to 0,
+as Ajar does. KHR_lights_punctual lights become Blender lamps with the
+importer's "Standard" units: sun strength = lux / 683 W/m^2, point and
+spot power = candela x 4 pi / 683 W, spot size = 2 x outer cone angle,
+blend = 1 - inner / outer, and no soft radius or sun disk
+(shadow_soft_size = 0, angle = 0).
 With --integrator noportal the scene has no portal; otherwise every Ajar
 portal quad becomes a Cycles portal: an area light with is_portal set, of
 the quad's size, emitting into the room.
@@ -81,6 +94,55 @@ def frame_matrix(mathutils, x, y, z, origin):
 	return m
 
 
+def sky_world(bpy, nt, bg, sky):
+	img = bpy.data.images.load(sky["path"])
+	img.colorspace_settings.is_data = True  # the file's numbers, no colour conversion
+	px = np.empty(img.size[0] * img.size[1] * img.channels, dtype=np.float32)
+	img.pixels.foreach_get(px)
+	if (px < 0).any():
+		img.pixels.foreach_set(np.maximum(px, 0.0))
+		img.update()
+	tc = nt.nodes.new("ShaderNodeTexCoord")
+	mp = nt.nodes.new("ShaderNodeMapping")
+	mp.vector_type = "POINT"
+	mp.inputs["Rotation"].default_value = (0.0, 0.0, math.radians(-90.0 - sky["rotation"]))
+	et = nt.nodes.new("ShaderNodeTexEnvironment")
+	et.image = img
+	et.interpolation = "Closest"
+	et.projection = "EQUIRECTANGULAR"
+	nt.links.new(tc.outputs["Generated"], mp.inputs["Vector"])
+	nt.links.new(mp.outputs["Vector"], et.inputs["Vector"])
+	nt.links.new(et.outputs["Color"], bg.inputs["Color"])
+	bg.inputs["Strength"].default_value = float(sky["strength"])
+
+
+def blender_vec(mathutils, v):
+	"""glTF axes to Blender's, as its importer maps them."""
+	return mathutils.Vector((float(v[0]), float(-v[2]), float(v[1])))
+
+
+def add_lamps(bpy, mathutils, sc, lights):
+	for k, li in enumerate(lights):
+		color = li["color"]
+		if li["type"] == "directional":
+			lamp = bpy.data.lights.new(f"light{k}", "SUN")
+			lamp.energy = li["intensity"] / 683.0
+			lamp.angle = 0.0
+		else:
+			lamp = bpy.data.lights.new(f"light{k}", "POINT" if li["type"] == "point" else "SPOT")
+			lamp.energy = li["intensity"] * 4.0 * math.pi / 683.0
+			lamp.shadow_soft_size = 0.0
+			if li["type"] == "spot":
+				lamp.spot_size = 2.0 * li["outer"]
+				lamp.spot_blend = 1.0 - li["inner"] / li["outer"] if li["outer"] > 0 else 0.0
+		lamp.color = tuple(float(c) for c in color)
+		lamp.use_shadow = True
+		ob = bpy.data.objects.new(f"light{k}", lamp)
+		rot = blender_vec(mathutils, li["direction"]).to_track_quat("-Z", "Y").to_matrix().to_4x4()
+		ob.matrix_world = mathutils.Matrix.Translation(blender_vec(mathutils, li["position"])) @ rot
+		sc.collection.objects.link(ob)
+
+
 def build(bpy, mathutils, scene, a):
 	bpy.ops.wm.read_factory_settings(use_empty=True)
 	sc = bpy.context.scene
@@ -95,9 +157,12 @@ def build(bpy, mathutils, scene, a):
 	env = scene.environment or [0.0, 0.0, 0.0]
 	bg.inputs["Color"].default_value = (*[float(x) for x in env], 1.0)
 	bg.inputs["Strength"].default_value = 1.0 if scene.environment else 0.0
+	if scene.sky is not None:
+		sky_world(bpy, world.node_tree, bg, scene.sky)
 	sc.world = world
+	add_lamps(bpy, mathutils, sc, scene.lights)
 	portals = 0
-	if scene.environment is not None and a.integrator != "noportal":
+	if scene.has_sky() and a.integrator != "noportal":
 		for r in scene.portal_rects():
 			li = bpy.data.lights.new(r["name"], "AREA")
 			li.shape = "RECTANGLE"

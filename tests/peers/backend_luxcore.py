@@ -35,6 +35,8 @@ def vec(x):
 
 
 def build(pyluxcore, scene, a):
+	if scene.sky is not None or scene.lights:
+		raise ValueError(f"{scene.path}: sky images and punctual lights are not built for LuxCore here")
 	sc = pyluxcore.Scene()
 	props = {}
 	for mi_index, (v, f) in scene.by_material().items():

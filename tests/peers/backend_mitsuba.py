@@ -9,6 +9,16 @@ camera is `perspective` with the vertical field of view, the film `hdrfilm`
 with the 1-pixel box filter. max_depth D counts segments from the camera,
 as Ajar's --max-depth does. Russian roulette is Mitsuba's default (unbiased).
 
+The sky image is an `envmap`: Mitsuba's lookup is Ajar's turned by half a
+turn about +Y (checked with a sky of numbered columns), so its to_world is
+a rotation of (rotation + 180) degrees about +Y. Its lookup is bilinear,
+Ajar's nearest-texel: the image goes in clamped to >= 0 (as Ajar reads
+it) and upsampled 4x by repetition, so the two differ only within a
+quarter texel of each texel edge. KHR_lights_punctual lights become
+`directional` (irradiance = colour x lux / 683 W/m^2, `direction` where
+the light travels), `point` and `spot` (intensity = colour x cd / 683
+W/sr; cutoff_angle the outer cone, beam_width the inner).
+
 Sampler: `independent` (Mitsuba's default), or with --integrator ld
 (renderer name mitsuba-ld) `ldsampler`, Mitsuba's low-discrepancy sampler
 (padded, scrambled (0,2)-sequences, as Ajar's), in passes of a power of two
@@ -51,7 +61,20 @@ def set_variant(mi):
 	raise RuntimeError("no usable Mitsuba variant")
 
 
-def build(mi, scene, a, tmp):
+def load_sky(mi, scene):
+	"""The sky image as Mitsuba gets it (clamped, upsampled), or None: from
+	the driver's .npy where given (Mitsuba's EXR reader hangs in a process
+	bound to one CPU), else read here, before drjit's thread count is set."""
+	if scene.sky is None:
+		return None
+	if scene.sky.get("array"):
+		px = np.maximum(np.load(scene.sky["array"]).astype(np.float32)[:, :, :3], 0.0)
+	else:
+		px = np.maximum(np.array(mi.Bitmap(scene.sky["path"]), dtype=np.float32)[:, :, :3], 0.0)
+	return np.repeat(np.repeat(px, 4, axis=0), 4, axis=1)
+
+
+def build(mi, scene, a, tmp, sky_px=None):
 	d = {"type": "scene", "integrator": {"type": "path", "max_depth": a.depth}}
 	c = scene.camera
 	origin = [float(x) for x in c["pos"]]
@@ -80,6 +103,23 @@ def build(mi, scene, a, tmp):
 		d[f"mesh{mi_index}"] = shape
 	if scene.environment is not None:
 		d["env"] = {"type": "constant", "radiance": {"type": "rgb", "value": scene.environment}}
+	if sky_px is not None:
+		d["env"] = {"type": "envmap", "bitmap": mi.Bitmap(sky_px), "scale": float(scene.sky["strength"]),
+			    "to_world": mi.ScalarTransform4f().rotate([0, 1, 0], scene.sky["rotation"] + 180.0)}
+	for k, li in enumerate(scene.lights):
+		rgb = [float(c) * li["intensity"] / 683.0 for c in li["color"]]
+		pos = [float(x) for x in li["position"]]
+		if li["type"] == "directional":
+			d[f"light{k}"] = {"type": "directional", "direction": [float(x) for x in li["direction"]],
+					  "irradiance": {"type": "rgb", "value": rgb}}
+		elif li["type"] == "point":
+			d[f"light{k}"] = {"type": "point", "position": pos, "intensity": {"type": "rgb", "value": rgb}}
+		else:
+			target = [p + float(x) for p, x in zip(pos, li["direction"])]
+			up = [0, 1, 0] if abs(li["direction"][1]) < 0.9 else [1, 0, 0]
+			d[f"light{k}"] = {"type": "spot", "intensity": {"type": "rgb", "value": rgb},
+					  "cutoff_angle": math.degrees(li["outer"]), "beam_width": math.degrees(li["inner"]),
+					  "to_world": mi.ScalarTransform4f().look_at(origin=pos, target=target, up=up)}
 	return mi.load_dict(d)
 
 
@@ -87,12 +127,13 @@ def render(scene, a, t0):
 	import mitsuba as mi
 	import drjit as dr
 	variant = set_variant(mi)
+	sky_px = load_sky(mi, scene)
 	try:
 		dr.set_thread_count(a.threads)
 	except Exception:
 		pass
 	with tempfile.TemporaryDirectory(prefix="peers-mi-") as tmp:
-		sc = build(mi, scene, a, tmp)
+		sc = build(mi, scene, a, tmp, sky_px)
 	# Passes small enough for the wavefront to stay in memory (about 1M lanes).
 	per_pass = max(1, min(256, (1 << 20) // (a.width * a.height)))
 	if a.integrator == "ld":

@@ -10,7 +10,8 @@ time (relMSE x t_actual / T: variance falls as 1/time for unbiased
 renderers). relMSE is tests/bench.c's formula (images.rel_mse).
 
 Environment: PEERS_SECONDS (20), PEERS_SCENES ("window-room living-room
-door-ajar"; cornell also works), PEERS_SIZE (image width, height from the
+door-ajar"; cornell also works, and "sky" names the sky-lit scenes
+window-room-sunset window-room-forest living-room-forest window-room-sun), PEERS_SIZE (image width, height from the
 camera's aspect ratio, or WxH; 128), PEERS_REF_SECONDS (each reference half;
 300), PEERS_DEPTH (32), PEERS_THREADS (all cores), PEERS_RENDERERS (default
 all: ajar-pt ajar-bdpt ajar-portal mitsuba mitsuba-ld cycles cycles-noportal
@@ -39,7 +40,19 @@ AJAR = os.path.join(ROOT, "build", "release", "ajar")
 ALL = ["ajar-pt", "ajar-bdpt", "ajar-portal", "mitsuba", "mitsuba-ld", "cycles", "cycles-noportal", "luxcore-path",
        "luxcore-bidir"]
 # Fastest to converge, measured on this machine (see the README of tests/peers).
-DEFAULT_REF = {"window-room": "mitsuba", "living-room": "mitsuba", "door-ajar": "mitsuba", "cornell": "mitsuba"}
+DEFAULT_REF = {"window-room": "mitsuba", "living-room": "mitsuba", "door-ajar": "mitsuba", "cornell": "mitsuba",
+	       "window-room-sunset": "mitsuba", "window-room-forest": "mitsuba", "living-room-forest": "mitsuba",
+	       "window-room-sun": "mitsuba"}
+# The scenes lit by sky images and KHR_lights_punctual lamps (scenes/skies/make_sky_scenes.py).
+SKY_SCENES = "window-room-sunset window-room-forest living-room-forest window-room-sun"
+
+
+def supports(renderer, scene):
+	"""Whether a renderer's backend builds this scene: LuxCore's here has
+	only the uniform sky and mesh emitters."""
+	if renderer.startswith("luxcore"):
+		return scene.sky is None and not scene.lights
+	return True
 
 
 def log(*a):
@@ -124,12 +137,37 @@ def run_ajar(integrator, path, size, depth, out, seconds=0.0, spp=0, seed=7):
 		     "setup_seconds": round(wall - float(meta.get("ajar:render_seconds", wall)), 3), "cores": cpu / wall}
 
 
+_sky_arrays = {}
+
+
+def sky_array(path):
+	"""For a scene with a sky image: the image as a .npy (float32, H x W x 3,
+	clamped to >= 0 as Ajar reads it), made here once. Mitsuba's EXR reader
+	never returns in a process bound to one CPU (PEERS_THREADS=1, pin_cpus),
+	so its backend takes the pixels from this file instead."""
+	if path not in _sky_arrays:
+		env = json.load(open(path))["scenes"][0].get("extras", {}).get("environment", {})
+		out = None
+		if "image" in env:
+			img = os.path.join(os.path.dirname(os.path.abspath(path)), env["image"])
+			h = hashlib.sha1(open(img, "rb").read()).hexdigest()[:12]
+			out = os.path.join(OUT, "skies", f"{os.path.splitext(os.path.basename(img))[0]}-{h}.npy")
+			if not os.path.exists(out):
+				os.makedirs(os.path.dirname(out), exist_ok=True)
+				rgb, _ = images.read_exr(img)
+				np.save(out, np.maximum(rgb, 0.0).astype(np.float32))
+		_sky_arrays[path] = out
+	return _sky_arrays[path]
+
+
 def run_peer(renderer, path, size, depth, out_base, seconds=0.0, spp=0, seed=7):
 	name, _, variant = renderer.partition("-")
 	w, h = size
 	npy = out_base + ".npy"
 	cmd = [os.path.join(OUT, "venv", "bin", "python"), os.path.join(HERE, "backend.py"), name, path, npy,
 	       "--size", f"{w}x{h}", "--depth", str(depth), "--seed", str(seed), "--threads", str(env_threads())]
+	if sky_array(path):
+		cmd += ["--sky-array", sky_array(path)]
 	if variant:
 		cmd += ["--integrator", variant]
 	cmd += ["--seconds", str(seconds)] if seconds else ["--spp", str(spp)]
@@ -172,10 +210,13 @@ def file_hash(path):
 	h = hashlib.sha1()
 	g = json.load(open(path))
 	h.update(json.dumps(g, sort_keys=True).encode())
-	for b in g.get("buffers", []):
-		if "uri" in b and not b["uri"].startswith("data:"):
-			with open(os.path.join(os.path.dirname(path), b["uri"]), "rb") as f:
-				h.update(f.read())
+	files = [b["uri"] for b in g.get("buffers", []) if "uri" in b and not b["uri"].startswith("data:")]
+	env = g["scenes"][g.get("scene", 0)].get("extras", {}).get("environment", {})
+	if "image" in env:
+		files.append(env["image"])
+	for uri in files:
+		with open(os.path.join(os.path.dirname(path), uri), "rb") as f:
+			h.update(f.read())
 	return h.hexdigest()[:12]
 
 
@@ -242,8 +283,11 @@ def bench_scene(name, seconds, size_spec, depth, ref_seconds, renderers, rows):
 			run_ajar(integ, path, size, depth, os.path.join(OUT, "warmup.exr"), spp=1)
 	tiles, labels, res = [ref], [f"reference ({rinfo['renderer']})"], {}
 	for r in renderers:
-		if r == "cycles-noportal" and not (s.portals and s.environment):
+		if r == "cycles-noportal" and not (s.portals and s.has_sky()):
 			continue  # the same as "cycles" where no portal light is placed
+		if not supports(r, s):
+			log(f"  {r:16s} skipped: its backend has no sky images or punctual lights")
+			continue
 		img, info = render(r, path, size, depth, os.path.join(OUT, f"{name}-{r}"), seconds=seconds)
 		if img is None:
 			rows.append({"scene": name, "renderer": r, "failed": True})
@@ -308,7 +352,8 @@ def table(rows, seconds, size_spec, depth, refs):
 
 def main():
 	seconds = float(os.environ.get("PEERS_SECONDS", "20"))
-	scenes = os.environ.get("PEERS_SCENES", "window-room living-room door-ajar").split()
+	scenes = [n for w in os.environ.get("PEERS_SCENES", "window-room living-room door-ajar").split()
+		  for n in (SKY_SCENES.split() if w == "sky" else [w])]
 	size_spec = os.environ.get("PEERS_SIZE", "128")
 	ref_seconds = float(os.environ.get("PEERS_REF_SECONDS", "300"))
 	depth = int(os.environ.get("PEERS_DEPTH", "32"))

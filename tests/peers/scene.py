@@ -14,7 +14,14 @@ loader (src/gltf.cpp) where that matters for matching:
     its triangles are not geometry;
   - emission = emissiveFactor x KHR_materials_emissive_strength;
   - scene extras {"environment": {"color": [r, g, b], "strength": s}} is a
-    uniform environment of radiance color x strength.
+    uniform environment of radiance color x strength; {"environment":
+    {"image": "sky.exr", "strength": s, "rotation": a}} a sky image (path
+    relative to the glTF), turned by a degrees about +Y, right-handed
+    (counter-clockwise seen from above; kernels/env.h);
+  - KHR_lights_punctual lights on nodes: position the node's origin,
+    direction its -Z, colour x intensity (lux for directional, candela for
+    point and spot), spot cones in radians; range ignored (Ajar's, and
+    the peers' lights, have none).
 Normals are not read: the peers get flat triangles, so shading normals cannot
 make them differ (scenes whose normals are not flat are rendered through a
 matched variant without normals, see lambert_variant).
@@ -70,7 +77,11 @@ class Scene:
 	  transmission, specularFactor 0), metallic, transmission, specular;
 	meshes: list of (material index, vertices (n, 3) float64, faces (m, 3) int);
 	portals: list of (name, vertices, faces); camera: dict pos, forward, up,
-	yfov, aspect (the glTF aspectRatio, 0 if none); environment: RGB or None.
+	yfov, aspect (the glTF aspectRatio, 0 if none); environment: RGB or None
+	(a uniform sky); sky: dict path (absolute), strength, rotation (degrees)
+	or None (a sky image); lights: list of dicts type (directional, point,
+	spot), color, intensity, position, direction (unit, where the light
+	shines), inner, outer (spot cone angles, radians).
 	"""
 
 	def __init__(self, path):
@@ -81,15 +92,22 @@ class Scene:
 		self.buffers = [self._buffer(b) for b in self.g.get("buffers", [])]
 		self.materials = [self._material(i, m) for i, m in enumerate(self.g.get("materials", []))]
 		self.default_material = None
-		self.meshes, self.portals, self.camera = [], [], None
+		self.meshes, self.portals, self.camera, self.lights = [], [], None, []
+		self.light_defs = self.g.get("extensions", {}).get("KHR_lights_punctual", {}).get("lights", [])
 		sc = self.g["scenes"][self.g.get("scene", 0)]
 		self._walk(sc.get("nodes", []))
 		self.environment = None
+		self.sky = None
 		env = sc.get("extras", {}).get("environment")
 		if env is not None:
-			if "color" not in env:
-				raise ValueError(f"{path}: only a uniform environment (color) is supported here")
-			self.environment = [float(c) * float(env.get("strength", 1.0)) for c in env["color"]]
+			strength = float(env.get("strength", 1.0))
+			if "image" in env:
+				self.sky = {"path": os.path.join(self.dir, env["image"]), "strength": strength,
+					    "rotation": float(env.get("rotation", 0.0))}
+			elif "color" in env:
+				self.environment = [float(c) * strength for c in env["color"]]
+			else:
+				raise ValueError(f"{path}: environment needs color or image")
 		if self.camera is None:
 			raise ValueError(f"{path}: no perspective camera")
 
@@ -159,6 +177,9 @@ class Scene:
 				self._mesh(ni, n, world)
 			if "camera" in n and self.camera is None:
 				self._camera(n, world)
+			light = n.get("extensions", {}).get("KHR_lights_punctual", {}).get("light")
+			if light is not None:
+				self._light(light, world)
 			for c in reversed(n.get("children", [])):
 				stack.append((c, world))
 
@@ -198,7 +219,21 @@ class Scene:
 			       "yfov": float(c["perspective"]["yfov"]),
 			       "aspect": float(c["perspective"].get("aspectRatio", 0.0))}
 
+	def _light(self, i, world):
+		d = self.light_defs[i]
+		z = world[:3, 2]
+		spot = d.get("spot", {})
+		self.lights.append({
+			"type": d["type"], "color": np.array(d.get("color", [1, 1, 1]), dtype=np.float64),
+			"intensity": float(d.get("intensity", 1.0)), "position": world[:3, 3].copy(),
+			"direction": -z / np.linalg.norm(z), "inner": float(spot.get("innerConeAngle", 0.0)),
+			"outer": float(spot.get("outerConeAngle", math.pi / 4))})
+
 	# ---- what the peers use ----
+
+	def has_sky(self):
+		"""A uniform environment or a sky image: light enters through openings."""
+		return self.environment is not None or self.sky is not None
 
 	def check_lambertian(self):
 		"""Raise unless every used material is exactly Lambertian."""
@@ -325,13 +360,36 @@ def write_lambert_variant(scene, out_path):
 	scene_extras = {}
 	if scene.environment is not None:
 		scene_extras["environment"] = {"color": scene.environment}
+	if scene.sky is not None:
+		rel = os.path.relpath(scene.sky["path"], os.path.dirname(os.path.abspath(out_path)))
+		scene_extras["environment"] = {"image": rel, "strength": scene.sky["strength"],
+					       "rotation": scene.sky["rotation"]}
+	used = ["KHR_materials_specular", "KHR_materials_emissive_strength"]
+	light_defs = []
+	for li in scene.lights:
+		d = {"type": li["type"], "color": [float(x) for x in li["color"]], "intensity": li["intensity"]}
+		if li["type"] == "spot":
+			d["spot"] = {"innerConeAngle": li["inner"], "outerConeAngle": li["outer"]}
+		light_defs.append(d)
+		# A frame whose -Z is the light's direction.
+		z = -li["direction"]
+		a = np.array([0.0, 1.0, 0.0]) if abs(z[1]) < 0.9 else np.array([1.0, 0.0, 0.0])
+		x = np.cross(a, z)
+		x /= np.linalg.norm(x)
+		y = np.cross(z, x)
+		m = np.eye(4)
+		m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = x, y, z, li["position"]
+		nodes.append({"name": f"light{len(light_defs) - 1}", "matrix": [float(v) for v in m.T.reshape(-1)],
+			      "extensions": {"KHR_lights_punctual": {"light": len(light_defs) - 1}}})
 	base = os.path.splitext(os.path.basename(out_path))[0]
 	g = {"asset": {"version": "2.0", "generator": "Ajar tests/peers/scene.py (Lambertian variant)"},
-	     "extensionsUsed": ["KHR_materials_specular", "KHR_materials_emissive_strength"],
+	     "extensionsUsed": used + (["KHR_lights_punctual"] if light_defs else []),
 	     "scene": 0, "scenes": [{"nodes": list(range(len(nodes))), "extras": scene_extras}],
 	     "nodes": nodes, "meshes": meshes, "materials": mats, "cameras": [cam],
 	     "accessors": accessors, "bufferViews": views,
 	     "buffers": [{"uri": base + ".bin", "byteLength": len(blob)}]}
+	if light_defs:
+		g["extensions"] = {"KHR_lights_punctual": {"lights": light_defs}}
 	with open(os.path.join(os.path.dirname(out_path), base + ".bin"), "wb") as f:
 		f.write(blob)
 	with open(out_path, "w") as f:
@@ -353,6 +411,6 @@ if __name__ == "__main__":
 	import sys
 	s = Scene(sys.argv[1])
 	print(len(s.meshes), "meshes", sum(len(f) for _, _, f in s.meshes), "triangles;", len(s.portals), "portals")
-	print("camera", s.camera, "environment", s.environment)
+	print("camera", s.camera, "environment", s.environment, "sky", s.sky, "lights", s.lights)
 	for r in s.portal_rects():
 		print("portal", r)
