@@ -115,6 +115,19 @@ $(BUILD)/kernel_source.c: $(KERNELS) $(BUILD)/embed_kernels
 $(BUILD)/kernel_source.o: $(BUILD)/kernel_source.c
 	$(Q)$(CC) -std=c11 $(WARN) -O0 -c -o $@ $<
 
+# The BSDF's albedo tables (energy compensation) are integrated from the
+# kernels' own microfacet code by a build tool, one build for every MODE
+# (always -O2, no sanitizers: the same bits), and kept in the tree so the
+# kernels can include them; deterministic, so regenerating changes nothing.
+TABLE_SRC := src/tools/bsdf_tables.c kernels/microfacet.h kernels/sampling.h kernels/fastmath.h kernels/vec.h kernels/compat.h
+build/tools/bsdf_tables: $(TABLE_SRC)
+	@mkdir -p $(@D)
+	$(Q)$(CC) -std=c11 -D_GNU_SOURCE -ffp-contract=off $(WARN) -O2 -o $@ $< -lm
+
+kernels/bsdf_tables.h: build/tools/bsdf_tables
+	@echo "  GEN     $@"
+	$(Q)$< > $@.tmp && mv $@.tmp $@
+
 $(BUILD)/tests/%.o: tests/%.c
 	@mkdir -p $(@D)
 	@echo "  CC      $<"

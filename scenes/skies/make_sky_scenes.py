@@ -1,14 +1,15 @@
 #!/usr/bin/env python3
 """Writes the sky-lit variants of the window room and the living room.
 
-Each variant is the shipped room (its .bin and textures referenced by relative
-path, not copied) under one of the CC0 skies of this folder, the sky turned
+Each variant is the shipped room under one of the CC0 skies of this folder,
+in a folder of its own with copies of the room's .bin and textures and of the
+sky (Ajar reads no file outside a scene's folder unless told to), the sky turned
 about +Y so that the sun's rays pass through a window onto a chosen surface,
 or, for window-room-sun, a KHR_lights_punctual directional light as the sun
 under a constant sky. Python 3 standard library only; the output is
 byte-for-byte the same on every run.
 
-    python3 make_sky_scenes.py          # writes ../<variant>/<variant>.gltf
+    python3 make_sky_scenes.py          # writes ../<variant>/ (glTF and copies)
 
 The sun of each sky is its brightest pixel (SOURCE.md; tests/test_exr.c checks
 it). Ajar's convention (README, kernels/env.h): pixel (x, y) of a W x H
@@ -22,6 +23,7 @@ phi to phi - a. So the sun lands at azimuth phi_world when a = phi_img - phi_wor
 import json
 import math
 import os
+import shutil
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCENES = os.path.dirname(HERE)
@@ -89,30 +91,36 @@ VARIANTS = {
 	# front of the camera.
 	"living-room-forest": {"room": "living-room", "sky": "forest", "phi": -105.0},
 	# A directional lamp as the sun, higher than either sky's (32 degrees),
-	# onto the floor in view, left of the box (azimuth 15 degrees: light
+	# onto the floor in view, on the -X side of the box (azimuth 15 degrees: light
 	# travelling +Z and toward -X); the forest sun's irradiance, and the
 	# forest's average sky without its sun as a constant sky.
 	"window-room-sun": {"room": "window-room", "lamp": (32.0, 15.0)},
 }
 
 
-def relative(room, uri):
-	return "../" + room + "/" + uri
+def copy(src, dst):
+	"""Copies src to dst unless dst already holds the same bytes."""
+	os.makedirs(os.path.dirname(dst), exist_ok=True)
+	if os.path.exists(dst):
+		with open(src, "rb") as a, open(dst, "rb") as b:
+			if a.read() == b.read():
+				return
+	shutil.copyfile(src, dst)
 
 
 def make(name, spec):
 	room = spec["room"]
+	out = os.path.join(SCENES, name)
 	with open(os.path.join(SCENES, room, room + ".gltf")) as f:
 		g = json.load(f)
-	for b in g.get("buffers", []):
-		b["uri"] = relative(room, b["uri"])
-	for im in g.get("images", []):
-		if "uri" in im:
-			im["uri"] = relative(room, im["uri"])
+	for item in g.get("buffers", []) + g.get("images", []):
+		if "uri" in item and not item["uri"].startswith("data:"):
+			copy(os.path.join(SCENES, room, item["uri"]), os.path.join(out, item["uri"]))
 	g["asset"]["generator"] = "scenes/skies/make_sky_scenes.py (from scenes/%s)" % room
 	extras = g["scenes"][0].setdefault("extras", {})
 	if "sky" in spec:
-		extras["environment"] = {"image": "../skies/%s.exr" % spec["sky"], "strength": 1.0,
+		copy(os.path.join(HERE, spec["sky"] + ".exr"), os.path.join(out, spec["sky"] + ".exr"))
+		extras["environment"] = {"image": "%s.exr" % spec["sky"], "strength": 1.0,
 					 "rotation": rotation_for(spec["sky"], spec["phi"])}
 	else:
 		elev, phi = spec["lamp"]
@@ -128,7 +136,6 @@ def make(name, spec):
 				   "extensions": {"KHR_lights_punctual": {"light": 0}}})
 		g["scenes"][0]["nodes"].append(len(g["nodes"]) - 1)
 		extras["environment"] = {"color": list(FOREST_SKY_RADIANCE)}
-	out = os.path.join(SCENES, name)
 	os.makedirs(out, exist_ok=True)
 	with open(os.path.join(out, name + ".gltf"), "w") as f:
 		json.dump(g, f, indent=1, sort_keys=False)

@@ -45,7 +45,8 @@ def main():
 		p.error("give exactly one of --seconds and --spp")
 	a.width, a.height = (int(x) for x in a.size.split("x"))
 	s = Scene(a.scene)
-	s.check_lambertian()
+	if a.integrator != "principled":  # cycles-principled: glTF's materials (energy.py)
+		s.check_lambertian()
 	if s.sky is not None and a.sky_array:
 		s.sky["array"] = a.sky_array
 	mod = importlib.import_module("backend_" + a.renderer)

@@ -8,12 +8,13 @@ strength is multiplied by (1 - Backfacing), and the material's emission
 sampling is FRONT. The world is the uniform environment (black if none), or
 the sky image: an Environment Texture with "Closest" interpolation (Ajar's
 lookup is nearest-texel), fed the world direction through a Mapping node
-turning it by -(90 + rotation) degrees about Blender's Z. Ajar's lookup
-u = 0.5 + atan2(x, -z) / 2 pi in glTF axes is Cycles' equirectangular
-u = 0.5 - atan2(y, x) / 2 pi turned by -90 degrees (Blender's importer maps
-glTF (x, y, z) to (x, -z, y)), and the sky's rotation about glTF +Y is one
-about Blender +Z, the lookup turning the other way (checked with a sky of
-numbered columns seen straight on). Its negative pixels are clamped to 0,
+with Euler rotation (90, 0, -(90 + rotation)) degrees. The scene is built
+in glTF's axes (+Y up), so the X turn first takes the direction to
+Blender's (x, -z, y), where Cycles' equirectangular lookup
+u = 0.5 - atan2(y, x) / 2 pi is Ajar's u = 0.5 + atan2(x, -z) / 2 pi turned
+by -90 degrees about Z, and the sky's rotation about glTF +Y is one about
+Blender +Z, the lookup turning the other way (checked with a sky of
+numbered columns seen straight on, and by the converged means). Its negative pixels are clamped to 0,
 as Ajar does. KHR_lights_punctual lights become Blender lamps with the
 importer's "Standard" units: sun strength = lux / 683 W/m^2, point and
 spot power = candela x 4 pi / 683 W, spot size = 2 x outer cone angle,
@@ -21,7 +22,11 @@ blend = 1 - inner / outer, and no soft radius or sun disk
 (shadow_soft_size = 0, angle = 0).
 With --integrator noportal the scene has no portal; otherwise every Ajar
 portal quad becomes a Cycles portal: an area light with is_portal set, of
-the quad's size, emitting into the room.
+the quad's size, emitting into the room. With --integrator principled
+(tests/peers/energy.py) a material that is not Lambertian gets a Principled
+BSDF with its base colour, metallic, roughness, IOR and Specular IOR Level
+0.5 x specularFactor (0.5 leaves the IOR's Fresnel as it is), as Blender's
+glTF importer builds it; portals stay.
 
 Matching (see tests/peers/README.md): max_bounces = D - 2 for Ajar's and
 Mitsuba's max depth D (Cycles counts bounces after the first hit, and the
@@ -54,17 +59,29 @@ def make_mesh(bpy, name, v, f):
 	return me
 
 
-def make_material(bpy, name, base, emission):
+def make_material(bpy, name, base, emission, pbr=None):
 	mat = bpy.data.materials.new(name)
 	mat.use_nodes = True
 	nt = mat.node_tree
 	for n in list(nt.nodes):
 		nt.nodes.remove(n)
 	out = nt.nodes.new("ShaderNodeOutputMaterial")
-	dif = nt.nodes.new("ShaderNodeBsdfDiffuse")
-	dif.inputs["Color"].default_value = (*[float(x) for x in base], 1.0)
-	dif.inputs["Roughness"].default_value = 0.0
-	shader = dif.outputs["BSDF"]
+	if pbr is None:
+		dif = nt.nodes.new("ShaderNodeBsdfDiffuse")
+		dif.inputs["Color"].default_value = (*[float(x) for x in base], 1.0)
+		dif.inputs["Roughness"].default_value = 0.0
+		shader = dif.outputs["BSDF"]
+	else:
+		pr = nt.nodes.new("ShaderNodeBsdfPrincipled")
+		pr.inputs["Base Color"].default_value = (*[float(x) for x in base], 1.0)
+		pr.inputs["Metallic"].default_value = float(pbr["metallic"])
+		pr.inputs["Roughness"].default_value = float(pbr["roughness"])
+		pr.inputs["IOR"].default_value = float(pbr["ior"])
+		pr.inputs["Specular IOR Level"].default_value = 0.5 * float(pbr["specular"])
+		pr.inputs["Emission Strength"].default_value = 0.0
+		if "Diffuse Roughness" in pr.inputs:  # 0: Lambertian, like Ajar's base
+			pr.inputs["Diffuse Roughness"].default_value = 0.0
+		shader = pr.outputs["BSDF"]
 	s = float(max(emission))
 	if s > 0:
 		em = nt.nodes.new("ShaderNodeEmission")
@@ -105,7 +122,8 @@ def sky_world(bpy, nt, bg, sky):
 	tc = nt.nodes.new("ShaderNodeTexCoord")
 	mp = nt.nodes.new("ShaderNodeMapping")
 	mp.vector_type = "POINT"
-	mp.inputs["Rotation"].default_value = (0.0, 0.0, math.radians(-90.0 - sky["rotation"]))
+	# Euler XYZ: the X turn applies first.
+	mp.inputs["Rotation"].default_value = (math.radians(90.0), 0.0, math.radians(-90.0 - sky["rotation"]))
 	et = nt.nodes.new("ShaderNodeTexEnvironment")
 	et.image = img
 	et.interpolation = "Closest"
@@ -116,9 +134,9 @@ def sky_world(bpy, nt, bg, sky):
 	bg.inputs["Strength"].default_value = float(sky["strength"])
 
 
-def blender_vec(mathutils, v):
-	"""glTF axes to Blender's, as its importer maps them."""
-	return mathutils.Vector((float(v[0]), float(-v[2]), float(v[1])))
+def vec(mathutils, v):
+	"""The scene stays in glTF's axes here (+Y up), so vectors go in as they are."""
+	return mathutils.Vector((float(v[0]), float(v[1]), float(v[2])))
 
 
 def add_lamps(bpy, mathutils, sc, lights):
@@ -138,8 +156,8 @@ def add_lamps(bpy, mathutils, sc, lights):
 		lamp.color = tuple(float(c) for c in color)
 		lamp.use_shadow = True
 		ob = bpy.data.objects.new(f"light{k}", lamp)
-		rot = blender_vec(mathutils, li["direction"]).to_track_quat("-Z", "Y").to_matrix().to_4x4()
-		ob.matrix_world = mathutils.Matrix.Translation(blender_vec(mathutils, li["position"])) @ rot
+		rot = vec(mathutils, li["direction"]).to_track_quat("-Z", "Y").to_matrix().to_4x4()
+		ob.matrix_world = mathutils.Matrix.Translation(vec(mathutils, li["position"])) @ rot
 		sc.collection.objects.link(ob)
 
 
@@ -149,7 +167,8 @@ def build(bpy, mathutils, scene, a):
 	for mi_index, (v, f) in scene.by_material().items():
 		m = scene.materials[mi_index]
 		me = make_mesh(bpy, f"mesh{mi_index}", v, f)
-		me.materials.append(make_material(bpy, m["name"], m["base"], m["emission"]))
+		pbr = m if a.integrator == "principled" and not m["lambertian"] else None
+		me.materials.append(make_material(bpy, m["name"], m["base"], m["emission"], pbr))
 		sc.collection.objects.link(bpy.data.objects.new(f"mesh{mi_index}", me))
 	world = bpy.data.worlds.new("world")
 	world.use_nodes = True
