@@ -23,8 +23,13 @@
 #define AJAR_KERNEL_ENV_PORTAL_H
 #include "env.h"
 #include "portal_geometry.h"
+#include "portal_sky.h"
 
+/* The portals' share of next-event samples of the sky; -D overrides it
+ * (AJAR_CL_OPTIONS) for experiments: sampling and densities read the same. */
+#ifndef PORTAL_NEE_MIX
 #define PORTAL_NEE_MIX 0.8f
+#endif
 #define PORTAL_SA_MIN 1e-3f
 #define PORTAL_COS_MIN 0.1f
 #define PORTAL_W_KEPT 16
@@ -153,10 +158,146 @@ CALLED float env_portal_pdf_w(const SceneView *sc, V3 x, V3 n, V3 wi, float tota
 	return p;
 }
 
+/* ---- Sky images through planar portals (portal_sky.h) ----------------
+ * Where the environment is an image, the host groups the portal triangles
+ * into planar portals with tables of the sky behind them
+ * (Params.num_portal_planes > 0), and the portal part of the density is
+ *   sum_{P: wi in x's rectangle of P} (w_P / W) f_P(u, v) / (I_P dw/dudv)
+ * with w_P = I_P max(PORTAL_COS_MIN, n . c_P): the sky's integral over the
+ * rectangle x sees (not the portal's solid angle) times the receiver's
+ * cosine toward the rectangle's centre c_P, floored as above. */
+
+/* Plane P's selection weight from x with normal n; r and *total (I_P) are
+ * filled in when it is positive. */
+INLINE float sky_plane_weight(const SceneView *sc, GLOBAL const PortalPlane *P, V3 x, V3 n, SkyRect *r, float *total)
+{
+	if (!sky_rect(P, x, r))
+		return 0.0f;
+	*total = sky_rect_integral(sc->portal_sky + P->table, r);
+	if (!(*total > 0.0f))
+		return 0.0f;
+	V3 d = v3_sub(sky_plane_centre(P), x);
+	float cr = fmax(PORTAL_COS_MIN, v3_dot(d, n) / sqrt(v3_len2(d)));
+	return *total * cr;
+}
+
+/* The planes' weights from one x and n, computed once per next-event
+ * sample or density: the first SKY_KEPT planes' rectangles, integrals and
+ * weights are kept, the rest computed again where needed. */
+#define SKY_KEPT 4
+typedef struct {
+	SkyRect r[SKY_KEPT];
+	float mass[SKY_KEPT], w[SKY_KEPT];
+	float W;
+} SkyWeights;
+
+INLINE void sky_weights(const SceneView *sc, V3 x, V3 n, SkyWeights *sw)
+{
+	SkyRect r;
+	float mass;
+	sw->W = 0.0f;
+	for (int k = 0; k < sc->params->num_portal_planes; k++) {
+		float w = sky_plane_weight(sc, &sc->portal_planes[k], x, n, &r, &mass);
+		if (k < SKY_KEPT) {
+			sw->r[k] = r;
+			sw->mass[k] = mass;
+			sw->w[k] = w;
+		}
+		sw->W += w;
+	}
+}
+
+/* Plane k's weight, rectangle and integral. */
+INLINE float sky_weight_of(const SceneView *sc, const SkyWeights *sw, int k, V3 x, V3 n, SkyRect *r, float *mass)
+{
+	if (k >= SKY_KEPT)
+		return sky_plane_weight(sc, &sc->portal_planes[k], x, n, r, mass);
+	*r = sw->r[k];
+	*mass = sw->mass[k];
+	return sw->w[k];
+}
+
+/* The portal part of the density of unit wi from x (sw->W > 0). */
+INLINE float sky_portal_pdf_w(const SceneView *sc, const SkyWeights *sw, V3 x, V3 n, V3 wi)
+{
+	float p = 0.0f;
+	for (int k = 0; k < sc->params->num_portal_planes; k++) {
+		GLOBAL const PortalPlane *P = &sc->portal_planes[k];
+		SkyRect r;
+		float mass, U, V, jac;
+		if (!(v3_dot(wi, P->n) > 0.0f))
+			continue;
+		float w = sky_weight_of(sc, sw, k, x, n, &r, &mass);
+		if (!(w > 0.0f))
+			continue;
+		sky_coords(P, wi, &U, &V, &jac);
+		float puv = sky_pdf_uv(sc->portal_sky + P->table, &r, mass, U, V);
+		if (puv > 0.0f && jac > 0.0f)
+			p += w / sw->W * puv / jac;
+	}
+	return p;
+}
+
+INLINE float sky_mix_pdf_w(const SceneView *sc, const SkyWeights *sw, V3 x, V3 n, V3 wi)
+{
+	float pe = env_pdf_w(sc, wi);
+	if (!(sw->W > 0.0f))
+		return pe;
+	return PORTAL_NEE_MIX * sky_portal_pdf_w(sc, sw, x, n, wi) + (1.0f - PORTAL_NEE_MIX) * pe;
+}
+
+INLINE float sky_nee_pdf_w(const SceneView *sc, V3 x, V3 n, V3 wi)
+{
+	SkyWeights sw;
+	sky_weights(sc, x, n, &sw);
+	return sky_mix_pdf_w(sc, &sw, x, n, wi);
+}
+
+/* env_nee_sample where the planes have sky tables: the density is
+ * recomputed from the direction (sky_mix_pdf_w), exactly what MIS reads. */
+INLINE V3 sky_nee_sample(const SceneView *sc, V3 x, V3 n, float u_mix, float u1, float u2, V3 *wi, float *pdf_w)
+{
+	*pdf_w = 0.0f;
+	SkyWeights sw;
+	sky_weights(sc, x, n, &sw);
+	if (u_mix >= PORTAL_NEE_MIX || !(sw.W > 0.0f)) {
+		float pe;
+		V3 Le = env_sample(sc, u1, u2, wi, &pe);
+		if (!(pe > 0.0f))
+			return v3(0.0f, 0.0f, 0.0f);
+		*pdf_w = sky_mix_pdf_w(sc, &sw, x, n, *wi);
+		return Le;
+	}
+	float target = u_mix / PORTAL_NEE_MIX * sw.W, cum = 0.0f;
+	int pick = -1;
+	SkyRect r, rk;
+	float mass = 0.0f, mass_k;
+	for (int k = 0; k < sc->params->num_portal_planes && cum <= target; k++) {
+		float wk = sky_weight_of(sc, &sw, k, x, n, &rk, &mass_k);
+		if (wk > 0.0f) { /* the last positive one if rounding leaves target >= the sum */
+			pick = k;
+			r = rk;
+			mass = mass_k;
+			cum += wk;
+		}
+	}
+	if (pick < 0)
+		return v3(0.0f, 0.0f, 0.0f);
+	GLOBAL const PortalPlane *P = &sc->portal_planes[pick];
+	float U, V, jac;
+	if (!sky_sample_uv(sc->portal_sky + P->table, &r, mass, u1, u2, &U, &V))
+		return v3(0.0f, 0.0f, 0.0f);
+	*wi = sky_dir(P, U, V, &jac);
+	*pdf_w = sky_mix_pdf_w(sc, &sw, x, n, *wi);
+	return *pdf_w > 0.0f ? env_radiance(sc, *wi) : v3(0.0f, 0.0f, 0.0f);
+}
+
 /* Solid-angle density with which env_nee_sample from x with normal n
  * returns wi. */
 INLINE float env_nee_pdf_w(const SceneView *sc, V3 x, V3 n, V3 wi)
 {
+	if (sc->params->num_portal_planes > 0)
+		return sky_nee_pdf_w(sc, x, n, wi);
 	float total = env_portal_total(sc, x, n), pe = env_pdf_w(sc, wi);
 	if (!(total > 0.0f))
 		return pe;
@@ -169,6 +310,8 @@ INLINE float env_nee_pdf_w(const SceneView *sc, V3 x, V3 n, V3 wi)
  * sample. */
 INLINE V3 env_nee_sample(const SceneView *sc, V3 x, V3 n, float u_mix, float u1, float u2, V3 *wi, float *pdf_w)
 {
+	if (sc->params->num_portal_planes > 0)
+		return sky_nee_sample(sc, x, n, u_mix, u1, u2, wi, pdf_w);
 	V3 black = v3(0.0f, 0.0f, 0.0f);
 	float total = 0.0f, pe;
 	*pdf_w = 0.0f;

@@ -8,7 +8,7 @@
 #define AJAR_LAYOUT_TYPES(X) \
 	X(BvhNode, 256) X(Tri, 48) X(TriShade, 64) X(Material, 64) X(Texture, 16) \
 	X(Emitter, 16) X(PortalTri, 64) X(Camera, 64) X(Params, 224) \
-	X(PunctualLight, 64)
+	X(PortalPlane, 80) X(PunctualLight, 64)
 
 #define AJAR_LAYOUT_FIELDS(X)                                                          \
 	X(BvhNode, lo_x) X(BvhNode, lo_z) X(BvhNode, hi_x) X(BvhNode, hi_z) X(BvhNode, child)\
@@ -40,5 +40,8 @@
 	X(PunctualLight, pos) X(PunctualLight, type) X(PunctualLight, dir)            \
 	X(PunctualLight, pdf_select) X(PunctualLight, intensity) X(PunctualLight, range)\
 	X(PunctualLight, cos_outer) X(PunctualLight, cone_scale)                       \
-	X(PunctualLight, disk_radius)
+	X(PunctualLight, disk_radius)                                                  \
+	X(Params, num_portal_planes)                                                   \
+	X(PortalPlane, o) X(PortalPlane, a0) X(PortalPlane, t) X(PortalPlane, n)      \
+	X(PortalPlane, b1) X(PortalPlane, table)
 #endif

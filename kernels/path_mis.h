@@ -94,7 +94,9 @@ INLINE float path_pr(const SceneView *sc, const PathRef *P, const MisVertex *mv,
  *     the environment, whose importance-sampled directions are folded
  *     onto the portal's sky side (a direction and its mirror image in the
  *     portal's plane both lead there). */
+#ifndef PORTAL_COSINE /* -D overrides it for experiments, as PORTAL_NEE_MIX */
 #define PORTAL_COSINE 0.5f
+#endif
 
 INLINE V3 portal_mirror(V3 d, V3 n) { return v3_sub(d, v3_scale(n, 2.0f * v3_dot(d, n))); }
 

@@ -85,6 +85,25 @@ typedef struct {
 	int env_side;     /* +1 / -1: the side of n the environment lies behind; 0 none */
 } PortalTri; /* 64 */
 
+/* Planar portal: coplanar, connected portal triangles with the sky behind
+ * them, for next-event estimation of an environment image through them
+ * (kernels/portal_sky.h, src/portal_sky.c). Frame (t, b, n): n unit toward
+ * the sky, t along the longest edge; the triangles lie within the rectangle
+ * [a0, a1] x [b0, b1] of (t, b) coordinates about o. `table` is the first
+ * float of its summed-area table in portal_sky. */
+typedef struct {
+	V3 o;
+	float a0;
+	V3 t;
+	float a1;
+	V3 b;
+	float b0;
+	V3 n;
+	float b1;
+	int table;
+	int pad0, pad1, pad2;
+} PortalPlane; /* 80 */
+
 /* KHR_lights_punctual light (src/lights.c converts glTF's photometric
  * units at 683 lm/W). A delta light: no ray hits it, next-event estimation
  * and light subpaths reach it deterministically. Chosen by power in the
@@ -172,7 +191,8 @@ typedef struct {
 	float env_rotation;     /* radians about +Y, right-handed (env.h) */
 	int num_lights;         /* 208, PunctualLight */
 	float light_power;      /* their total power estimate (src/lights.c) */
-	int pad2, pad3;
+	int num_portal_planes;  /* 216, planar portals with sky tables (env_portal.h), 0 = none */
+	int pad2;
 } Params; /* 224 */
 
 /* Layout of the float array `env`: for an ENV_IMAGE of W x H,
@@ -200,6 +220,8 @@ typedef struct {
 	X(PortalTri, portals)     \
 	X(float, portal_cdf)      \
 	X(PunctualLight, punctual) \
+	X(PortalPlane, portal_planes) \
+	X(float, portal_sky)      \
 	X(Params, params)
 
 /* What device code sees of the scene: one pointer per array. */

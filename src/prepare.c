@@ -12,6 +12,7 @@
 
 #include "error.h"
 #include "portal_flux.h"
+#include "portal_sky.h"
 
 static double seconds(void)
 {
@@ -177,14 +178,6 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	}
 	if (!p->light_paths && p->portal_s_max > 1)
 		p->portal_s_max = 1; /* larger s needs light subpaths */
-	/* How often a pixel sample traces an intermediate subpath (mis.h,
-	 * MisPortalSet), chosen by measurement at equal time (kernels/README.md,
-	 * "portal"): with next-event estimation through the portals, the sky
-	 * needs them seldom; light from emitters behind an opening more often.
-	 * AJAR_PORTAL_RATE in (0, 1] overrides it. Layers without MIS weights
-	 * (tests) take every intermediate subpath. */
-	float rate = p->light_paths ? PORTAL_RATE_EMITTERS : PORTAL_RATE_SKY;
-	p->portal_rate = p->strategy_unweighted ? 1.0f : env_rate("AJAR_PORTAL_RATE", rate);
 	p->emitter_power = d->lights.emitter_power;
 	p->env_power = d->lights.env_power;
 	/* What lies behind each side of the portals, with the kernels' own
@@ -197,6 +190,30 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 		prepare_free(d);
 		return st;
 	}
+	/* Sky images are sampled through the planar portals by their radiance
+	 * (kernels/portal_sky.h); AJAR_PORTAL_SKY=0 keeps the triangles' solid
+	 * angle instead, for comparisons. */
+	const char *sky = getenv("AJAR_PORTAL_SKY");
+	if (!(sky && strcmp(sky, "0") == 0) &&
+	    (st = portal_sky_build(&view, d->portals, (uint32_t)d->n_portals, &d->portal_planes, &d->n_portal_planes,
+				   &d->portal_sky, &d->n_portal_sky)) != AJAR_OK) {
+		prepare_free(d);
+		return st;
+	}
+	p->num_portal_planes = (int)d->n_portal_planes;
+	/* How often a pixel sample traces an intermediate subpath (mis.h,
+	 * MisPortalSet), chosen by measurement at equal time (kernels/README.md,
+	 * "portal"): with next-event estimation through the portals, the sky
+	 * needs them seldom; light from emitters behind an opening more often.
+	 * AJAR_PORTAL_RATE in (0, 1] overrides it. Layers without MIS weights
+	 * (tests) take every intermediate subpath. */
+	float rate = p->light_paths ? PORTAL_RATE_EMITTERS : PORTAL_RATE_SKY;
+	/* Under a sky image (with a sun), sampled through planar portals, the
+	 * <- halves guided by the sky's importance find the sun and the ->
+	 * halves the patch it lights: worth a higher rate than a constant sky. */
+	if (!p->light_paths && p->num_portal_planes > 0)
+		rate = PORTAL_RATE_SKY_IMAGE;
+	p->portal_rate = p->strategy_unweighted ? 1.0f : env_rate("AJAR_PORTAL_RATE", rate);
 	if (p->num_emitters == 0 && p->num_lights == 0 && p->env_type == ENV_NONE)
 		log_msg(AJAR_LOG_WARNING, "%s: no emissive triangles, no lights and no environment: the image is black",
 			s->source);
@@ -210,6 +227,8 @@ void prepare_free(SceneData *d)
 	free(d->shade);
 	free(d->params);
 	free(d->portals);
+	free(d->portal_planes);
+	free(d->portal_sky);
 	bvh_free(&d->bvh);
 	lights_free(&d->lights);
 	memset(d, 0, sizeof *d);

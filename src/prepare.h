@@ -32,6 +32,8 @@ typedef struct {
  * AJAR_PORTAL_RATE overrides them. */
 #define PORTAL_RATE_SKY 0.1f
 #define PORTAL_RATE_EMITTERS 1.0f
+/* Scenes lit only by a sky image, sampled through planar portals. */
+#define PORTAL_RATE_SKY_IMAGE 0.3f
 
 ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *out);
 void prepare_free(SceneData *d);

@@ -79,7 +79,8 @@ void host_render(HostScene *h, uint32_t spp, uint32_t seed, double *rgb, double 
 	free(fv);
 }
 
-void host_batch_estimate(HostScene *h, uint32_t spp, int layer, int batches, uint32_t seed0, Estimate *est)
+void host_batch_estimates(HostScene *h, uint32_t spp, int layer, int count, int batches, uint32_t seed0,
+			  Estimate *est)
 {
 	Params *prm = h->data.params;
 	uint32_t npix = (uint32_t)(prm->camera.width * prm->camera.height);
@@ -87,24 +88,35 @@ void host_batch_estimate(HostScene *h, uint32_t spp, int layer, int batches, uin
 		      (prm->integrator == INTEGRATOR_PORTAL ? portal_layer_count(prm->strategy_len) : 0);
 	double *rgb = malloc(sizeof(double) * 3 * npix);
 	double *lay = nlayers ? malloc(sizeof(double) * 3 * npix * nlayers) : NULL;
-	double s1[3] = {0}, s2[3] = {0};
+	double *s1 = calloc((size_t)3 * count, sizeof(double)), *s2 = calloc((size_t)3 * count, sizeof(double));
 	for (int b = 0; b < batches; b++) {
 		host_render(h, spp, seed0 + (uint32_t)b, rgb, lay);
-		const double *img = layer >= 0 ? lay + (size_t)3 * npix * layer : rgb;
-		for (int c = 0; c < 3; c++) {
-			double m = 0;
-			for (uint32_t i = 0; i < npix; i++)
-				m += img[3 * i + c];
-			m /= npix;
-			s1[c] += m;
-			s2[c] += m * m;
+		for (int k = 0; k < count; k++) {
+			const double *img = layer >= 0 ? lay + (size_t)3 * npix * (layer + k) : rgb;
+			for (int c = 0; c < 3; c++) {
+				double m = 0;
+				for (uint32_t i = 0; i < npix; i++)
+					m += img[3 * i + c];
+				m /= npix;
+				s1[3 * k + c] += m;
+				s2[3 * k + c] += m * m;
+			}
 		}
 	}
-	for (int c = 0; c < 3; c++) {
-		est->mean[c] = s1[c] / batches;
-		double var = (s2[c] - s1[c] * s1[c] / batches) / (batches - 1);
-		est->se[c] = sqrt(fmax(var, 0) / batches);
-	}
+	for (int k = 0; k < count; k++)
+		for (int c = 0; c < 3; c++) {
+			double m1 = s1[3 * k + c], m2 = s2[3 * k + c];
+			est[k].mean[c] = m1 / batches;
+			double var = (m2 - m1 * m1 / batches) / (batches - 1);
+			est[k].se[c] = sqrt(fmax(var, 0) / batches);
+		}
 	free(rgb);
 	free(lay);
+	free(s1);
+	free(s2);
+}
+
+void host_batch_estimate(HostScene *h, uint32_t spp, int layer, int batches, uint32_t seed0, Estimate *est)
+{
+	host_batch_estimates(h, spp, layer, 1, batches, seed0, est);
 }

@@ -32,4 +32,8 @@ typedef struct {
 	double mean[3], se[3];
 } Estimate;
 void host_batch_estimate(HostScene *h, uint32_t spp, int layer, int batches, uint32_t seed0, Estimate *est);
+/* The same for `count` consecutive layers from `layer` at once (one
+ * render per batch): est[0 .. count). */
+void host_batch_estimates(HostScene *h, uint32_t spp, int layer, int count, int batches, uint32_t seed0,
+			  Estimate *est);
 #endif

@@ -17,6 +17,7 @@
 #include <stdlib.h>
 
 #include "ajar.h"
+#include "scene.h"
 #include "testutil.h"
 
 #define BATCHES 16
@@ -137,10 +138,30 @@ static void compare_punctual(const char *path, const char *what, const float dir
 	compare_scene(s, what, w, h, spp_pt, spp_bdpt);
 }
 
+/* path under a sky with a sun disc of radiance 300 at elevation `sun`
+ * (radians) toward -z. */
+static void compare_sky(const char *path, float sun, uint32_t w, uint32_t h, uint32_t spp_pt, uint32_t spp_bdpt)
+{
+	ajar_scene *s;
+	if (ajar_scene_load(path, &s) != AJAR_OK)
+		fail_msg("%s", ajar_last_error());
+	float *sky = test_sun_sky(256, 128, 0.1f, sinf(sun), -cosf(sun), 0.04f, 300.0f);
+	assert_int_equal(scene_set_env_image(s, 256, 128, sky, 1.0f), AJAR_OK);
+	compare_scene(s, path, w, h, spp_pt, spp_bdpt);
+}
+
 static void test_cornell(void **state) { compare(SCENE("cornell/cornell.gltf"), 32, 32, 32, 8); }
 static void test_window_room(void **state) { compare(SCENE("window-room/window-room.gltf"), 32, 32, 64, 16); }
 static void test_living_room(void **state) { compare(SCENE("living-room/living-room.gltf"), 32, 18, 64, 16); }
 static void test_bathroom(void **state) { compare(SCENE("bathroom/bathroom.gltf"), 24, 24, 32, 8); }
+/* Under a sky with a sun through the window, high (the patch on the
+ * floor) and low (on the far wall): next-event estimation through the
+ * portal by the sky's radiance (kernels/portal_sky.h). */
+static void test_window_room_sun(void **state)
+{
+	compare_sky(SCENE("window-room/window-room.gltf"), 0.84f, 32, 32, 64, 16);
+	compare_sky(SCENE("window-room/window-room.gltf"), 0.14f, 32, 32, 64, 16);
+}
 static void test_door_ajar(void **state) { compare(SCENE("door-ajar/door-ajar.gltf"), 24, 24, 512, 128); }
 
 /* The Cornell box lit by its emitter, the sun through its open side, a
@@ -167,6 +188,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_cornell),
 		cmocka_unit_test(test_window_room),
+		cmocka_unit_test(test_window_room_sun),
 		cmocka_unit_test(test_living_room),
 		cmocka_unit_test(test_bathroom),
 		cmocka_unit_test(test_door_ajar),

@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "lights.h"
+#include "portal_sky.h"
 #include "scene.h"
 #include "../kernels/lights.h"
 
@@ -42,6 +43,8 @@ typedef struct {
 	LightTables lt;
 	Params prm;
 	SceneView sc;
+	PortalPlane *planes; /* lit_planes */
+	float *sky;
 } Lit;
 
 static uint32_t add_material(Scene *s, V3 emission)
@@ -95,10 +98,29 @@ static void lit_build(Lit *l)
 	l->sc.portals = s->portals;
 	l->sc.portal_cdf = l->lt.portal_cdf;
 	l->sc.params = &l->prm;
+	l->planes = NULL;
+	l->sky = NULL;
+}
+
+/* Planar portals with sky tables (src/portal_sky.c) from the portal
+ * triangles' sky sides as they are now; returns how many. */
+static int lit_planes(Lit *l)
+{
+	size_t np, ns;
+	free(l->planes);
+	free(l->sky);
+	assert_int_equal(portal_sky_build(&l->sc, l->s->portals, l->s->nportal_tris, &l->planes, &np, &l->sky, &ns),
+			 AJAR_OK);
+	l->sc.portal_planes = l->planes;
+	l->sc.portal_sky = l->sky;
+	l->prm.num_portal_planes = (int)np;
+	return (int)np;
 }
 
 static void lit_free(Lit *l)
 {
+	free(l->planes);
+	free(l->sky);
 	lights_free(&l->lt);
 	free(l->tris);
 	scene_free(l->s);
@@ -654,6 +676,21 @@ static void test_light_sample_env_image(void **state)
 	lit_free(&l);
 }
 
+/* Portals around x = (0.1, 0.2, 0.05): a window in front, a triangle
+ * behind it, a tiny far one, one with x on its sky side and one with no
+ * sky behind it (the last two get their sides from the callers). */
+static void add_window_portals(Lit *l)
+{
+	float pos[] = {-0.8f, -0.4f, 1, 0.8f, -0.4f, 1, 0.8f, 0.8f, 1, -0.8f, 0.8f, 1, /* window, z = 1 */
+		       0.0f, 0.0f, 2, 1.5f, 0.0f, 2, 1.5f, 1.5f, 2,                /* behind it, z = 2 */
+		       3.0f, 0.2f, 2, 3.05f, 0.2f, 2, 3.0f, 0.25f, 2,              /* tiny and far */
+		       -1.5f, -1, -1, -1.5f, 1, -1, -1.5f, 0, 1,                   /* x on its sky side */
+		       0, -2, -1, 1, -2, 1, -1, -2, 1};                            /* no sky behind it */
+	uint32_t idx[] = {0, 1, 2, 0, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
+	assert_int_equal(scene_add_portal(l->s, "windows", pos, 16, idx, 6), AJAR_OK);
+	lit_build(l);
+}
+
 /* Environment sampling through portals (kernels/env_portal.h) from x =
  * (0.1, 0.2, 0.05) among the emitters above and an environment image:
  * a window in front of x, a second one behind it that overlaps it as seen
@@ -667,14 +704,7 @@ static void test_light_sample_env_portals(void **state)
 	Lit l;
 	build_light_scene(&l);
 	assert_int_equal(scene_set_env_image(l.s, 40, 20, synthetic_sky(40, 20), 0.02f), AJAR_OK);
-	float pos[] = {-0.8f, -0.4f, 1, 0.8f, -0.4f, 1, 0.8f, 0.8f, 1, -0.8f, 0.8f, 1, /* window, z = 1 */
-		       0.0f, 0.0f, 2, 1.5f, 0.0f, 2, 1.5f, 1.5f, 2,                /* behind it, z = 2 */
-		       3.0f, 0.2f, 2, 3.05f, 0.2f, 2, 3.0f, 0.25f, 2,              /* tiny and far */
-		       -1.5f, -1, -1, -1.5f, 1, -1, -1.5f, 0, 1,                   /* x on its sky side */
-		       0, -2, -1, 1, -2, 1, -1, -2, 1};                            /* no sky behind it */
-	uint32_t idx[] = {0, 1, 2, 0, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
-	assert_int_equal(scene_add_portal(l.s, "windows", pos, 16, idx, 6), AJAR_OK);
-	lit_build(&l);
+	add_window_portals(&l);
 	V3 x = v3(0.1f, 0.2f, 0.05f);
 	int side[6] = {0, 0, 0, 0, 0, 0};
 	for (int j = 0; j < 5; j++) { /* the sky beyond each from x, but for the fourth */
@@ -734,6 +764,28 @@ static void test_light_sample_env_portal_near(void **state)
 	lit_free(&l);
 }
 
+/* The window [-1, 1] x [-0.6, 0.9] at z = 1 as a 4 x 3 grid of quads. */
+enum { GRID_NX = 4, GRID_NY = 3, GRID_NV = (GRID_NX + 1) * (GRID_NY + 1), GRID_NT = 2 * GRID_NX * GRID_NY };
+static void grid_window(float *pos, uint32_t *idx)
+{
+	for (int j = 0; j <= GRID_NY; j++)
+		for (int i = 0; i <= GRID_NX; i++) {
+			float *v = &pos[3 * (j * (GRID_NX + 1) + i)];
+			v[0] = -1.0f + 2.0f * (float)i / GRID_NX;
+			v[1] = -0.6f + 1.5f * (float)j / GRID_NY;
+			v[2] = 1.0f;
+		}
+	int t = 0;
+	for (int j = 0; j < GRID_NY; j++)
+		for (int i = 0; i < GRID_NX; i++) {
+			uint32_t a = (uint32_t)(j * (GRID_NX + 1) + i), b = a + 1, c = a + GRID_NX + 2, d = a + GRID_NX + 1;
+			uint32_t q[6] = {a, b, c, a, c, d};
+			for (int k = 0; k < 6; k++)
+				idx[3 * t + k] = q[k];
+			t += 2;
+		}
+}
+
 /* A window cut into 24 triangles (a 4 x 3 grid of quads), more than
  * env_nee_sample keeps weights for between its sum and its pick
  * (PORTAL_W_KEPT): the rest are weighed again, and the pick must still
@@ -744,25 +796,10 @@ static void test_light_sample_env_portal_grid(void **state)
 	Lit l;
 	build_light_scene(&l);
 	assert_int_equal(scene_set_env_image(l.s, 40, 20, synthetic_sky(40, 20), 0.02f), AJAR_OK);
-	enum { NX = 4, NY = 3, NV = (NX + 1) * (NY + 1), NT = 2 * NX * NY };
+	enum { NV = GRID_NV, NT = GRID_NT };
 	float pos[3 * NV];
 	uint32_t idx[3 * NT];
-	for (int j = 0; j <= NY; j++)
-		for (int i = 0; i <= NX; i++) {
-			float *v = &pos[3 * (j * (NX + 1) + i)];
-			v[0] = -1.0f + 2.0f * (float)i / NX;
-			v[1] = -0.6f + 1.5f * (float)j / NY;
-			v[2] = 1.0f;
-		}
-	int t = 0;
-	for (int j = 0; j < NY; j++)
-		for (int i = 0; i < NX; i++) {
-			uint32_t a = (uint32_t)(j * (NX + 1) + i), b = a + 1, c = a + NX + 2, d = a + NX + 1;
-			uint32_t q[6] = {a, b, c, a, c, d};
-			for (int k = 0; k < 6; k++)
-				idx[3 * t + k] = q[k];
-			t += 2;
-		}
+	grid_window(pos, idx);
 	assert_true(NT > PORTAL_W_KEPT);
 	assert_int_equal(scene_add_portal(l.s, "grid", pos, NV, idx, NT), AJAR_OK);
 	lit_build(&l);
@@ -770,6 +807,152 @@ static void test_light_sample_env_portal_grid(void **state)
 	for (int j = 0; j < NT; j++)
 		l.s->portals[j].env_side = v3_dot(v3_sub(x, l.s->portals[j].p0), l.s->portals[j].n) > 0 ? -1 : 1;
 	check_light_sample(&l, x, v3_norm(v3(0.2f, -0.3f, 0.9f)), "+ portal grid");
+	lit_free(&l);
+}
+
+/* ---- Sky images through planar portals (kernels/portal_sky.h) ---------- */
+
+/* Plane k's (U, V) sampler from x against its density, exactly: the
+ * density is constant on each table cell within x's rectangle, so a bin
+ * of whole cells expects the sum of density times area. Also the
+ * directions: (U, V) -> w -> (U, V) round trips, and w lies in the plane's
+ * sky half. */
+static void check_sky_uv(Lit *l, int k, V3 x, const char *name)
+{
+	enum { B = 4, NB = (PORTAL_SKY_RES / B) * (PORTAL_SKY_RES / B), N = 200000 };
+	static double obs[NB], expct[NB];
+	const PortalPlane *P = &l->planes[k];
+	const float *S = l->sky + P->table;
+	SkyRect r;
+	assert_true(sky_rect(P, x, &r));
+	float total = sky_rect_integral(S, &r);
+	assert_true(total > 0.0f);
+	memset(obs, 0, sizeof obs);
+	memset(expct, 0, sizeof expct);
+	double sum = 0.0;
+	for (int j = (int)r.V0; j < PORTAL_SKY_RES && j < r.V1; j++)
+		for (int i = (int)r.U0; i < PORTAL_SKY_RES && i < r.U1; i++) {
+			float ulo = fmaxf((float)i, r.U0), uhi = fminf((float)(i + 1), r.U1);
+			float vlo = fmaxf((float)j, r.V0), vhi = fminf((float)(j + 1), r.V1);
+			double area = (double)(uhi - ulo) * (vhi - vlo);
+			if (!(area > 0.0))
+				continue;
+			double pc = sky_pdf_uv(S, &r, total, 0.5f * (ulo + uhi), 0.5f * (vlo + vhi));
+			assert_true(pc > 0.0); /* the floor: no cell within the rectangle is left out */
+			expct[(j / B) * (PORTAL_SKY_RES / B) + i / B] += pc * area * N;
+			sum += pc * area;
+		}
+	assert_float_equal(sum, 1.0, 1e-3);
+	for (int n = 0; n < N; n++) {
+		float U, V, jac, U2, V2, jac2;
+		assert_true(sky_sample_uv(S, &r, total, rnd(), rnd(), &U, &V));
+		assert_true(U >= r.U0 && U <= r.U1 && V >= r.V0 && V <= r.V1);
+		int i = (int)U, j = (int)V;
+		i = i >= PORTAL_SKY_RES ? PORTAL_SKY_RES - 1 : i;
+		j = j >= PORTAL_SKY_RES ? PORTAL_SKY_RES - 1 : j;
+		obs[(j / B) * (PORTAL_SKY_RES / B) + i / B] += 1.0;
+		if (n % 16 == 0) {
+			V3 w = sky_dir(P, U, V, &jac);
+			assert_float_equal(v3_len(w), 1.0f, 1e-5f);
+			assert_true(v3_dot(w, P->n) > 0.0f);
+			sky_coords(P, w, &U2, &V2, &jac2);
+			assert_float_equal(U2, U, 2e-3f);
+			assert_float_equal(V2, V, 2e-3f);
+			assert_float_equal(jac2, jac, 1e-3f * jac);
+		}
+	}
+	double p = chi2_test(obs, expct, NB, 5.0);
+	printf("  sky through plane %d %-12s p = %.3f (rectangle %.1f..%.1f x %.1f..%.1f cells)\n", k, name, p, r.U0,
+	       r.U1, r.V0, r.V1);
+	assert_true(p > ALPHA);
+}
+
+/* The portals of test_light_sample_env_portals (a window quad in front of
+ * x, an overlapping triangle behind it, a tiny far one in the same plane
+ * but apart, one x sees from its sky side, one without sky) and a sky
+ * with a sun: they group into four planes, each plane's sampler follows
+ * its density, and the whole next-event sample (sky through the planes by
+ * radiance, the environment's own sampling as defence, the emitters)
+ * follows light_pdf_w, with the sun inside the window's view and outside
+ * every portal's. */
+static void test_light_sample_sky_portals(void **state)
+{
+	rng_state = 31;
+	Lit l;
+	build_light_scene(&l);
+	V3 sun = v3_norm(v3(0.15f, 0.5f, 1.0f)); /* seen from x through the window */
+	assert_int_equal(scene_set_env_image(l.s, 128, 64, test_sun_sky(128, 64, sun.x, sun.y, sun.z, 0.06f, 300.0f), 0.05f), AJAR_OK);
+	add_window_portals(&l);
+	V3 x = v3(0.1f, 0.2f, 0.05f);
+	for (int j = 0; j < 5; j++) {
+		PortalTri *pt = &l.s->portals[j];
+		float dn = v3_dot(v3_sub(x, pt->p0), pt->n);
+		pt->env_side = j == 4 ? (dn > 0 ? 1 : -1) : (dn > 0 ? -1 : 1);
+	}
+	l.s->portals[5].env_side = 0;
+	assert_int_equal(lit_planes(&l), 4);
+	SkyRect r;
+	int seen = 0;
+	for (int k = 0; k < 4; k++)
+		if (sky_rect(&l.planes[k], x, &r)) {
+			seen++;
+			check_sky_uv(&l, k, x, "");
+		}
+	assert_int_equal(seen, 3); /* not the one x sees from its sky side */
+	check_light_sample(&l, x, v3_norm(v3(0.3f, -0.2f, 0.9f)), "+ sky, planes");
+	check_light_sample(&l, x, v3(1, 0, 0), "+ sky sideways");
+	check_light_sample(&l, x, v3(0, 0, 0), "+ sky, no n");
+	/* From a point that sees the sun through no portal (above the window,
+	 * beside the triangle behind it; within that triangle's bounding
+	 * rectangle, which its frame along the hypotenuse makes larger). */
+	V3 x2 = v3(-0.6f, 0.5f, 0.2f), nx = v3_norm(v3(0.3f, -0.2f, 0.9f));
+	SkyWeights sw;
+	sky_weights(&l.sc, x, nx, &sw);
+	assert_true(sky_portal_pdf_w(&l.sc, &sw, x, nx, sun) > 0.0f);
+	assert_int_equal(portal_crossings(&l.sc, x2, sun, 1), 0);
+	for (int k = 0; k < 4; k++)
+		if (sky_rect(&l.planes[k], x2, &r))
+			check_sky_uv(&l, k, x2, "");
+	check_light_sample(&l, x2, v3(0, 0, 1), "+ sun outside");
+	lit_free(&l);
+}
+
+/* A window in a grid of 24 triangles (one plane), seen from close by and
+ * off its centre, and single-triangle portals (directions in their
+ * bounding rectangles but outside them are valid samples of the plane). */
+static void test_light_sample_sky_grid(void **state)
+{
+	rng_state = 37;
+	Lit l;
+	build_light_scene(&l);
+	V3 sun = v3_norm(v3(-0.2f, 0.3f, 1.0f));
+	assert_int_equal(scene_set_env_image(l.s, 128, 64, test_sun_sky(128, 64, sun.x, sun.y, sun.z, 0.05f, 500.0f), 0.05f), AJAR_OK);
+	enum { NV = GRID_NV, NT = GRID_NT };
+	float pos[3 * NV + 36];
+	uint32_t idx[3 * NT + 12];
+	grid_window(pos, idx);
+	/* A triangle in the plane x = 1.2, tilted against the grid, and three
+	 * apart in the plane z = 1.6 behind it: more planes than the sampler
+	 * keeps weights for (SKY_KEPT), so the rest are weighed again. */
+	const float tri[4][9] = {{1.2f, -0.5f, -0.5f, 1.2f, 0.9f, 0.2f, 1.2f, 0.0f, 0.8f},
+				 {-0.6f, 0.2f, 1.6f, -0.3f, 0.2f, 1.6f, -0.4f, 0.5f, 1.6f},
+				 {0.1f, -0.3f, 1.6f, 0.4f, -0.3f, 1.6f, 0.3f, 0.0f, 1.6f},
+				 {0.5f, 0.4f, 1.6f, 0.8f, 0.4f, 1.6f, 0.7f, 0.7f, 1.6f}};
+	for (int k = 0; k < 4; k++) {
+		memcpy(&pos[3 * (NV + 3 * k)], tri[k], sizeof tri[k]);
+		for (int c = 0; c < 3; c++)
+			idx[3 * (NT + k) + c] = (uint32_t)(NV + 3 * k + c);
+	}
+	assert_int_equal(scene_add_portal(l.s, "grid", pos, NV + 12, idx, NT + 4), AJAR_OK);
+	lit_build(&l);
+	V3 x = v3(0.3f, 0.1f, 0.75f);
+	for (int j = 0; j < NT + 4; j++)
+		l.s->portals[j].env_side = v3_dot(v3_sub(x, l.s->portals[j].p0), l.s->portals[j].n) > 0 ? -1 : 1;
+	assert_int_equal(lit_planes(&l), 5);
+	assert_true(5 > SKY_KEPT);
+	check_sky_uv(&l, 0, x, "near");
+	check_sky_uv(&l, 1, x, "triangle");
+	check_light_sample(&l, x, v3_norm(v3(0.2f, -0.3f, 0.9f)), "+ sky grid");
 	lit_free(&l);
 }
 
@@ -789,6 +972,8 @@ int main(void)
 		cmocka_unit_test(test_light_sample_env_portals),
 		cmocka_unit_test(test_light_sample_env_portal_near),
 		cmocka_unit_test(test_light_sample_env_portal_grid),
+		cmocka_unit_test(test_light_sample_sky_portals),
+		cmocka_unit_test(test_light_sample_sky_grid),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -109,3 +109,24 @@ void test_remove_tree(const char *dir)
 	closedir(d);
 	rmdir(dir);
 }
+
+float *test_sun_sky(uint32_t w, uint32_t h, float sun_x, float sun_y, float sun_z, float radius, float sun_l)
+{
+	float *rgb = malloc(sizeof(float) * 3 * w * h);
+	if (!rgb)
+		return NULL;
+	for (uint32_t y = 0; y < h; y++)
+		for (uint32_t x = 0; x < w; x++) {
+			/* env_dir of the texel centre */
+			double phi = 2.0 * M_PI * ((x + 0.5) / w - 0.5), theta = M_PI * (y + 0.5) / h;
+			double dx = sin(theta) * sin(phi), dy = cos(theta), dz = -sin(theta) * cos(phi);
+			float base = dy > 0.0 ? (float)(0.3 + 0.7 * dy) : (float)(0.1 + 0.05 * dy);
+			float *p = rgb + 3 * (y * w + x);
+			p[0] = 0.8f * base;
+			p[1] = 0.9f * base + 0.1f * (float)(dx * dx);
+			p[2] = 1.2f * base;
+			if (dx * sun_x + dy * sun_y + dz * sun_z > cos(radius))
+				p[0] = p[1] = p[2] = sun_l;
+		}
+	return rgb;
+}

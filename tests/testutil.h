@@ -19,6 +19,13 @@ double chi2_test(const double *observed, const double *expected, int ncells, dou
 /* Upper tail of the chi-square distribution with `dof` degrees of freedom. */
 double chi2_sf(double x, double dof);
 
+/* A w x h equirectangular sky (linear RGB, malloc'd; kernels/env.h's
+ * convention): a smooth gradient, brighter and bluer toward the zenith,
+ * dim below the horizon, and a small, very bright sun disc of radiance
+ * sun_l and angular radius `radius` about the unit direction (sun_x,
+ * sun_y, sun_z). */
+float *test_sun_sky(uint32_t w, uint32_t h, float sun_x, float sun_y, float sun_z, float radius, float sun_l);
+
 /* A fresh temporary directory (removed by the caller) or NULL. */
 char *test_tmpdir(void);
 /* "dir/name", malloc'ed. */
