@@ -14,7 +14,7 @@ INLINE V3 bdpt_emitted(const SceneView *sc, const PathVertex *l, V3 w)
 {
 	if (l->type == VERTEX_ENV)
 		return env_radiance(sc, l->p);
-	return emitter_radiance(sc, l->tri, w);
+	return emitter_radiance(sc, l->tri, l->p, w);
 }
 
 /* Density of the light vertex as a light subpath's origin (pf_0). */
@@ -23,7 +23,7 @@ INLINE float bdpt_origin_pdf(const SceneView *sc, const PathVertex *l)
 	float ps = sc->params->env_pdf_select;
 	if (l->type == VERTEX_ENV)
 		return ps * env_pdf_w(sc, l->p);
-	return (1.0f - ps) * emitter_pdf_a(sc, l->tri);
+	return (1.0f - ps) * emitter_pdf_a(sc, l->tri, l->p);
 }
 
 /* Density of the light vertex as a next-event sample from vertex x, seen
@@ -33,7 +33,7 @@ INLINE float bdpt_nee_pdf(const SceneView *sc, const PathVertex *l, const PathVe
 	float ps = sc->params->env_pdf_select;
 	if (l->type == VERTEX_ENV)
 		return ps * env_nee_pdf_w(sc, x->p, vertex_nee_normal(x, from), l->p);
-	return (1.0f - ps) * emitter_pdf_a(sc, l->tri);
+	return (1.0f - ps) * emitter_pdf_a(sc, l->tri, l->p);
 }
 
 /* x_0's two densities in a path's MIS records: as the light subpath's

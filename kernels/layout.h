@@ -6,7 +6,7 @@
 #include "types.h"
 
 #define AJAR_LAYOUT_TYPES(X) \
-	X(BvhNode, 256) X(Tri, 48) X(TriShade, 64) X(Material, 64) X(Texture, 16) \
+	X(BvhNode, 256) X(Tri, 48) X(TriShade, 64) X(Material, 64) X(Texture, 48) \
 	X(Emitter, 16) X(PortalTri, 64) X(Camera, 64) X(Params, 208)
 
 #define AJAR_LAYOUT_FIELDS(X)                                                          \
@@ -17,9 +17,10 @@
 	X(Material, base_color) X(Material, base_tex) X(Material, emission)            \
 	X(Material, metallic) X(Material, roughness) X(Material, transmission)         \
 	X(Material, ior) X(Material, specular) X(Material, flags)                      \
-	X(Material, alpha_cutoff)                                                       \
-	X(Texture, offset) X(Texture, width) X(Texture, height)                        \
-	X(Emitter, tri) X(Emitter, area) X(Emitter, pdf_select)                        \
+	X(Material, alpha_cutoff) X(Material, mr_tex) X(Material, emissive_tex)         \
+	X(Texture, offset) X(Texture, width) X(Texture, height) X(Texture, flags)      \
+	X(Texture, xf)                                                                  \
+	X(Emitter, tri) X(Emitter, area) X(Emitter, pdf_select) X(Emitter, cell)       \
 	X(PortalTri, p0) X(PortalTri, p2) X(PortalTri, n) X(PortalTri, area)          \
 	X(PortalTri, pdf_select) X(PortalTri, side_plus) X(PortalTri, env_side)       \
 	X(Camera, pos) X(Camera, tan_half_fov_y) X(Camera, right) X(Camera, aspect)    \

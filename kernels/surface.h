@@ -1,5 +1,6 @@
 /* surface.h — what integrators know about a ray hit: position, geometric
- * and shading normals, material and its textured base colour.
+ * and shading normals, material, its textures (base colour, metallic-
+ * roughness, emission) and the BSDF they make.
  *
  * The geometric normal is the CCW front face's (glTF's front), not flipped
  * toward the ray: emitters emit from the front, and the BSDF decides sides
@@ -7,6 +8,7 @@
  * interpolated normals never point through the surface. */
 #ifndef AJAR_SURFACE_H
 #define AJAR_SURFACE_H
+#include "bsdf.h"
 #include "bvh.h"
 #include "types.h"
 
@@ -24,34 +26,80 @@ INLINE float srgb_to_linear(float c)
 	return c <= 0.04045f ? c * (1.0f / 12.92f) : pow((c + 0.055f) * (1.0f / 1.055f), 2.4f);
 }
 
-INLINE V3 texel_rgb(uint t)
+/* One texel's four channels in [0, 1], colour decoded from sRGB if asked. */
+typedef struct {
+	V3 rgb;
+	float a;
+} Rgba;
+
+INLINE Rgba texel_rgba(uint t, int srgb)
 {
-	return v3(srgb_to_linear((float)(t & 255u) * (1.0f / 255.0f)),
-		  srgb_to_linear((float)((t >> 8) & 255u) * (1.0f / 255.0f)),
-		  srgb_to_linear((float)((t >> 16) & 255u) * (1.0f / 255.0f)));
+	Rgba r;
+	float c[3];
+	for (int i = 0; i < 3; i++) {
+		float x = (float)((t >> (8 * i)) & 255u) * (1.0f / 255.0f);
+		c[i] = srgb ? srgb_to_linear(x) : x;
+	}
+	r.rgb = v3(c[0], c[1], c[2]);
+	r.a = (float)(t >> 24) * (1.0f / 255.0f);
+	return r;
 }
 
-/* Bilinear lookup with repeat wrapping; (0, 0) is the image's first texel
- * corner, as glTF defines UVs. */
-INLINE V3 texture_rgb(const SceneView *sc, int tex, float u, float v)
+/* Texel index i of a row or column of n texels under a glTF wrap mode. */
+INLINE int texture_wrap(int i, int n, int mode)
+{
+	if (mode == TEX_WRAP_CLAMP)
+		return i < 0 ? 0 : (i >= n ? n - 1 : i);
+	if (mode == TEX_WRAP_MIRROR) {
+		int m = (i % (2 * n) + 2 * n) % (2 * n);
+		return m < n ? m : 2 * n - 1 - m;
+	}
+	return (i % n + n) % n;
+}
+
+/* A coordinate brought into a range where texel indices stay small ints,
+ * without changing what the wrap mode makes of it: one period (two for
+ * mirrored repeat) for the repeating modes, just past [0, 1] for clamp. */
+INLINE float texture_reduce(float u, int mode)
+{
+	if (mode == TEX_WRAP_CLAMP)
+		return fmin(fmax(u, -1.0f), 2.0f);
+	float period = mode == TEX_WRAP_MIRROR ? 2.0f : 1.0f;
+	return u - period * floor(u / period);
+}
+
+INLINE Rgba rgba_lerp(Rgba a, Rgba b, float t)
+{
+	Rgba r;
+	r.rgb = v3_add(v3_scale(a.rgb, 1.0f - t), v3_scale(b.rgb, t));
+	r.a = a.a + (b.a - a.a) * t;
+	return r;
+}
+
+/* Texture `tex` at (u, v), the coordinates of its set before its
+ * transform: wrap modes and filter as its sampler says; (0, 0) is the
+ * image's first texel's corner, as glTF defines UVs. Bilinear filtering
+ * blends decoded (linear) values. */
+INLINE Rgba texture_rgba(const SceneView *sc, int tex, float u0, float v0, int srgb)
 {
 	GLOBAL const Texture *t = &sc->textures[tex];
-	float x = (u - floor(u)) * (float)t->width - 0.5f;
-	float y = (v - floor(v)) * (float)t->height - 0.5f;
+	int ws = TEX_WRAP_S(t->flags), wt = TEX_WRAP_T(t->flags);
+	float u = texture_reduce(t->xf[0] * u0 + t->xf[1] * v0 + t->xf[2], ws);
+	float v = texture_reduce(t->xf[3] * u0 + t->xf[4] * v0 + t->xf[5], wt);
+	GLOBAL const uint *px = sc->texels + t->offset;
+	if (t->flags & TEX_NEAREST) {
+		int x = texture_wrap((int)floor(u * (float)t->width), t->width, ws);
+		int y = texture_wrap((int)floor(v * (float)t->height), t->height, wt);
+		return texel_rgba(px[y * t->width + x], srgb);
+	}
+	float x = u * (float)t->width - 0.5f, y = v * (float)t->height - 0.5f;
 	float fx = floor(x), fy = floor(y);
 	float ax = x - fx, ay = y - fy;
-	int x0 = (int)fx, y0 = (int)fy;
-	int x1 = x0 + 1, y1 = y0 + 1;
-	x0 = (x0 % t->width + t->width) % t->width;
-	x1 = x1 % t->width;
-	y0 = (y0 % t->height + t->height) % t->height;
-	y1 = y1 % t->height;
-	GLOBAL const uint *px = sc->texels + t->offset;
-	V3 c00 = texel_rgb(px[y0 * t->width + x0]), c10 = texel_rgb(px[y0 * t->width + x1]);
-	V3 c01 = texel_rgb(px[y1 * t->width + x0]), c11 = texel_rgb(px[y1 * t->width + x1]);
-	V3 top = v3_add(v3_scale(c00, 1.0f - ax), v3_scale(c10, ax));
-	V3 bot = v3_add(v3_scale(c01, 1.0f - ax), v3_scale(c11, ax));
-	return v3_add(v3_scale(top, 1.0f - ay), v3_scale(bot, ay));
+	int x0 = texture_wrap((int)fx, t->width, ws), x1 = texture_wrap((int)fx + 1, t->width, ws);
+	int y0 = texture_wrap((int)fy, t->height, wt), y1 = texture_wrap((int)fy + 1, t->height, wt);
+	Rgba c00 = texel_rgba(px[y0 * t->width + x0], srgb), c10 = texel_rgba(px[y0 * t->width + x1], srgb);
+	Rgba c01 = texel_rgba(px[y1 * t->width + x0], srgb), c11 = texel_rgba(px[y1 * t->width + x1], srgb);
+	return rgba_lerp(rgba_lerp(c00, c10, ax), rgba_lerp(c01, c11, ax), ay);
 }
 
 INLINE void surface_from_hit(const SceneView *sc, const Hit *h, Surface *s)
@@ -93,11 +141,58 @@ INLINE int segment_clear(const SceneView *sc, V3 a, V3 na, V3 b, V3 nb)
 	return !bvh_occluded(sc, o, v3_scale(od, 1.0f / len), len * (1.0f - 1e-4f));
 }
 
+/* Texture `tex` where surface s lies, in the coordinate set it reads. */
+INLINE Rgba surface_texture(const SceneView *sc, const Surface *s, int tex, int srgb)
+{
+	return texture_rgba(sc, tex, s->tu, s->tv, srgb);
+}
+
 INLINE V3 surface_base_color(const SceneView *sc, const Surface *s)
 {
 	GLOBAL const Material *m = &sc->materials[s->material];
 	if (m->base_tex < 0)
 		return m->base_color;
-	return v3_mul(m->base_color, texture_rgb(sc, m->base_tex, s->tu, s->tv));
+	return v3_mul(m->base_color, surface_texture(sc, s, m->base_tex, 1).rgb);
+}
+
+/* The BSDF at s with base colour `base` (surface_base_color): metallic and
+ * roughness are the factors times the metallic-roughness texture's blue
+ * and green channels (glTF 3.9.2), read without sRGB decoding. */
+INLINE void surface_bsdf(const SceneView *sc, const Surface *s, V3 base, Bsdf *bs)
+{
+	GLOBAL const Material *m = &sc->materials[s->material];
+	float metallic = m->metallic, roughness = m->roughness;
+	if (m->mr_tex) {
+		Rgba t = surface_texture(sc, s, m->mr_tex - 1, 0);
+		metallic *= t.rgb.z;
+		roughness *= t.rgb.y;
+	}
+	bsdf_setup_mr(bs, m, base, metallic, roughness, s->ns, s->ng);
+}
+
+/* Barycentric coordinates (b1, b2) of p, a point in triangle t's plane,
+ * clamped into the triangle (p = (1 - b1 - b2) p0 + b1 p1 + b2 p2). */
+INLINE void tri_barycentric(GLOBAL const Tri *t, V3 p, float *b1, float *b2)
+{
+	V3 e1 = v3_sub(t->p1, t->p0), e2 = v3_sub(t->p2, t->p0), d = v3_sub(p, t->p0);
+	float d11 = v3_dot(e1, e1), d12 = v3_dot(e1, e2), d22 = v3_dot(e2, e2);
+	float d1 = v3_dot(d, e1), d2 = v3_dot(d, e2);
+	float den = d11 * d22 - d12 * d12;
+	float u = den > 0.0f ? (d22 * d1 - d12 * d2) / den : 0.0f;
+	float v = den > 0.0f ? (d11 * d2 - d12 * d1) / den : 0.0f;
+	u = fmin(fmax(u, 0.0f), 1.0f);
+	v = fmin(fmax(v, 0.0f), 1.0f - u);
+	*b1 = u;
+	*b2 = v;
+}
+
+/* Texture `tex` at barycentric (b1, b2) of triangle `tri`. */
+INLINE Rgba tri_texture(const SceneView *sc, int tri, float b1, float b2, int tex, int srgb)
+{
+	GLOBAL const TriShade *sh = &sc->shade[tri];
+	float w = 1.0f - b1 - b2;
+	float u = w * sh->u0 + b1 * sh->u1 + b2 * sh->u2;
+	float v = w * sh->v0 + b1 * sh->v1 + b2 * sh->v2;
+	return texture_rgba(sc, tex, u, v, srgb);
 }
 #endif

@@ -53,24 +53,44 @@ typedef struct {
 	float specular;     /* KHR_materials_specular factor; 0 = pure diffuse */
 	int flags;          /* MATERIAL_* */
 	float alpha_cutoff;
-	float pad0, pad1;
+	int mr_tex;         /* Texture index + 1 (0: none): B metallic, G roughness, times the factors */
+	int emissive_tex;   /* Texture index + 1 (0: none): multiplies emission */
 } Material; /* 64 */
 
-/* RGBA8 texture (sRGB colour, linear alpha) in the shared texel array. */
+/* A texture as a material uses it: an RGBA8 image in the shared texel
+ * array (decoded from sRGB only where it holds colour, surface.h), the
+ * glTF sampler's wrap modes and filter, the texture coordinate set and
+ * KHR_texture_transform as an affine map of (u, v). */
+#define TEX_WRAP_REPEAT 0
+#define TEX_WRAP_CLAMP 1
+#define TEX_WRAP_MIRROR 2
+#define TEX_WRAP_S(flags) ((flags) & 3)
+#define TEX_WRAP_T(flags) (((flags) >> 2) & 3)
+#define TEX_NEAREST 16 /* else bilinear */
+#define TEX_UV1 32     /* reads TEXCOORD_1 (TriExtra) instead of TEXCOORD_0 */
 typedef struct {
 	int offset; /* first texel in `texels` */
 	int width;
 	int height;
-	int pad0;
-} Texture; /* 16 */
+	int flags;  /* TEX_* */
+	float xf[6]; /* u' = xf[0] u + xf[1] v + xf[2], v' = xf[3] u + xf[4] v + xf[5] */
+	int pad0, pad1;
+} Texture; /* 48 */
 
-/* Emissive triangle; chosen with probability proportional to its power. */
+/* Emissive triangle, or one cell of a triangle with an emissive texture;
+ * chosen with probability proportional to its (textured) power. The cells
+ * of one triangle are consecutive, Tri.emitter the first. */
 typedef struct {
 	int tri;
 	float area;
 	float pdf_select; /* probability of choosing this emitter */
-	int pad0;
+	int cell;         /* EMITTER_LEVEL(cell): the triangle is split into 4^level cells,
+			   * this entry is cell EMITTER_INDEX(cell) of them (lights.h) */
 } Emitter; /* 16 */
+
+#define EMITTER_CELL(level, index) ((level) << 24 | (index))
+#define EMITTER_LEVEL(cell) ((cell) >> 24)
+#define EMITTER_INDEX(cell) ((cell) & 0xffffff)
 
 /* Portal triangle: invisible to every ray. The host measures the direct
  * light arriving through it from each side (src/portal_flux.c): that picks

@@ -35,7 +35,7 @@ namespace tg = tinygltf;
  * other cannot be shown correctly and is refused. */
 const char *const supported_extensions[] = {
 	"KHR_materials_emissive_strength", "KHR_materials_ior", "KHR_materials_specular",
-	"KHR_materials_transmission", "KHR_mesh_quantization",
+	"KHR_materials_transmission", "KHR_mesh_quantization", "KHR_texture_transform",
 };
 
 struct Loader {
@@ -516,6 +516,102 @@ ajar_status image_texture(Loader &L, int i, int *id)
 	return AJAR_OK;
 }
 
+/* A number, or a JSON array of n numbers, of a KHR_texture_transform. */
+bool transform_numbers(const tg::Value &ext, const char *key, int n, double *out)
+{
+	const tg::Value *v = value_member(ext, key);
+	if (!v)
+		return true;
+	if (n == 1) {
+		if (!v->IsNumber() || !std::isfinite(v->GetNumberAsDouble()))
+			return false;
+		out[0] = v->GetNumberAsDouble();
+		return true;
+	}
+	if (!v->IsArray() || v->ArrayLen() != (size_t)n)
+		return false;
+	for (int i = 0; i < n; i++) {
+		if (!v->Get(i).IsNumber() || !std::isfinite(v->Get(i).GetNumberAsDouble()))
+			return false;
+		out[i] = v->Get(i).GetNumberAsDouble();
+	}
+	return true;
+}
+
+int wrap_mode(int gl)
+{
+	return gl == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE     ? TEX_WRAP_CLAMP
+	       : gl == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT ? TEX_WRAP_MIRROR
+							     : TEX_WRAP_REPEAT;
+}
+
+/* materials[mi]'s texture `slot` (textures[index], coordinate set
+ * texcoord, the textureInfo's extensions) as a scene texture: the image's
+ * texels, the sampler's wrap modes and magnification filter (there are no
+ * mipmaps: pixel sampling filters), the coordinate set and
+ * KHR_texture_transform (T R S, its texCoord replacing the set). *id is -1
+ * where there is no texture. */
+ajar_status texture_use(Loader &L, int mi, const char *slot, int index, int texcoord, const tg::ExtensionMap &exts,
+			int *id)
+{
+	*id = -1;
+	if (index < 0)
+		return AJAR_OK;
+	const tg::Model &m = L.model;
+	if ((size_t)index >= m.textures.size())
+		return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d].%s: textures[%d] does not exist (%zu textures)", mi, slot,
+			    index, m.textures.size());
+	const tg::Texture &tex = m.textures[(size_t)index];
+	if (tex.source < 0 || (size_t)tex.source >= m.images.size())
+		return fail(L, AJAR_ERROR_BAD_INPUT, "textures[%d]: images[%d] does not exist (%zu images)", index,
+			    tex.source, m.images.size());
+	int flags = 0;
+	if (tex.sampler >= 0) {
+		if ((size_t)tex.sampler >= m.samplers.size())
+			return fail(L, AJAR_ERROR_BAD_INPUT, "textures[%d]: samplers[%d] does not exist (%zu samplers)", index,
+				    tex.sampler, m.samplers.size());
+		const tg::Sampler &sm = m.samplers[(size_t)tex.sampler];
+		flags |= wrap_mode(sm.wrapS) | wrap_mode(sm.wrapT) << 2;
+		if (sm.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST)
+			flags |= TEX_NEAREST;
+	}
+	float xf[6] = {1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f};
+	auto it = exts.find("KHR_texture_transform");
+	if (it != exts.end()) {
+		double off[2] = {0.0, 0.0}, rot = 0.0, sc[2] = {1.0, 1.0}, tc = texcoord;
+		if (!transform_numbers(it->second, "offset", 2, off) || !transform_numbers(it->second, "rotation", 1, &rot) ||
+		    !transform_numbers(it->second, "scale", 2, sc) || !transform_numbers(it->second, "texCoord", 1, &tc) ||
+		    !(tc >= 0.0 && tc == std::floor(tc)))
+			return fail(L, AJAR_ERROR_BAD_INPUT,
+				    "materials[%d].%s.extensions.KHR_texture_transform: offset and scale must be 2 numbers, "
+				    "rotation a number, texCoord an integer >= 0",
+				    mi, slot);
+		/* The extension's GLSL: uv' = T(offset) R(rotation) S(scale) uv,
+		 * R = [cos -sin; sin cos] in (u, v). */
+		double c = std::cos(rot), sn = std::sin(rot);
+		xf[0] = (float)(c * sc[0]);
+		xf[1] = (float)(-sn * sc[1]);
+		xf[2] = (float)off[0];
+		xf[3] = (float)(sn * sc[0]);
+		xf[4] = (float)(c * sc[1]);
+		xf[5] = (float)off[1];
+		texcoord = (int)std::fmin(tc, 1e6);
+	}
+	if (texcoord != 0) {
+		log_msg(AJAR_LOG_WARNING, "%s: materials[%d].%s uses TEXCOORD_%d; only TEXCOORD_0 is supported, texture ignored",
+			L.file, mi, slot, texcoord);
+		return AJAR_OK;
+	}
+	int img = -1;
+	ajar_status st = image_texture(L, tex.source, &img);
+	uint32_t tid;
+	if (!st)
+		st = scene_add_texture_use(L.s, (uint32_t)img, flags, xf, &tid);
+	if (!st)
+		*id = (int)tid;
+	return st;
+}
+
 ajar_status in_unit(const Loader &L, int mi, const char *name, double v)
 {
 	if (!(v >= 0.0 && v <= 1.0))
@@ -577,28 +673,17 @@ ajar_status load_material(Loader &L, int mi, uint32_t *id)
 			L.file, mi);
 	}
 
-	const tg::TextureInfo &bt = pbr.baseColorTexture;
-	if (bt.index >= 0) {
-		if ((size_t)bt.index >= L.model.textures.size())
-			return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d]: textures[%d] does not exist (%zu textures)", mi,
-				    bt.index, L.model.textures.size());
-		int src = L.model.textures[(size_t)bt.index].source;
-		if (src < 0 || (size_t)src >= L.model.images.size())
-			return fail(L, AJAR_ERROR_BAD_INPUT, "textures[%d]: images[%d] does not exist (%zu images)", bt.index,
-				    src, L.model.images.size());
-		if (bt.texCoord != 0) {
-			log_msg(AJAR_LOG_WARNING, "%s: materials[%d]: baseColorTexture uses TEXCOORD_%d; only TEXCOORD_0 is supported, texture ignored",
-				L.file, mi, bt.texCoord);
-		} else {
-			int tid = -1;
-			if ((st = image_texture(L, src, &tid)))
-				return st;
-			m.base_tex = tid;
-		}
-	}
-	if (!L.warned_textures && (pbr.metallicRoughnessTexture.index >= 0 || gm.emissiveTexture.index >= 0 ||
-				   gm.normalTexture.index >= 0)) {
-		log_msg(AJAR_LOG_WARNING, "%s: materials[%d]: metallic-roughness, emissive and normal textures are ignored",
+	int base = -1, mr = -1, em = -1;
+	const tg::TextureInfo &bt = pbr.baseColorTexture, &mt = pbr.metallicRoughnessTexture, &et = gm.emissiveTexture;
+	if ((st = texture_use(L, mi, "baseColorTexture", bt.index, bt.texCoord, bt.extensions, &base)) ||
+	    (st = texture_use(L, mi, "metallicRoughnessTexture", mt.index, mt.texCoord, mt.extensions, &mr)) ||
+	    (st = texture_use(L, mi, "emissiveTexture", et.index, et.texCoord, et.extensions, &em)))
+		return st;
+	m.base_tex = base;
+	m.mr_tex = mr + 1;
+	m.emissive_tex = em + 1;
+	if (!L.warned_textures && gm.normalTexture.index >= 0) {
+		log_msg(AJAR_LOG_WARNING, "%s: materials[%d]: normalTexture is not supported: the surface is shaded flat (and other materials' normal maps too)",
 			L.file, mi);
 		L.warned_textures = true;
 	}

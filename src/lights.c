@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "error.h"
+#include "../kernels/lights.h"
 
 static float tri_area(V3 p0, V3 p1, V3 p2)
 {
@@ -36,37 +37,181 @@ double cdf_build(float *cdf, const double *w, uint32_t n, int uniform_if_empty)
 	return total;
 }
 
-static ajar_status build_emitters(Tri *tris, uint32_t ntris, const Material *mats, LightTables *out)
+/* Emissive textures: a triangle is split into 4^level cells of equal area
+ * (kernels/lights.h) so that a cell covers about TEXELS_PER_CELL texels,
+ * and each cell is chosen by its own power; dark parts of a texture are
+ * then never sampled. Levels are capped per triangle and lowered for all
+ * where the scene would pass CELL_BUDGET cells. */
+#define TEXELS_PER_CELL 2.0
+#define MAX_LEVEL 7
+#define CELL_BUDGET (1u << 21)
+#define SCAN_LIMIT (1u << 22) /* texels a "can it emit" test reads at most */
+
+/* Triangle i's texture coordinates under tex's transform, in texels. */
+static void tri_texel_coords(const SceneView *v, uint32_t i, int tex, double x[3], double y[3])
 {
-	uint32_t n = 0;
+	const TriShade *sh = &v->shade[i];
+	const Texture *t = &v->textures[tex];
+	float u[3] = {sh->u0, sh->u1, sh->u2}, w[3] = {sh->v0, sh->v1, sh->v2};
+	for (int k = 0; k < 3; k++) {
+		x[k] = ((double)t->xf[0] * u[k] + (double)t->xf[1] * w[k] + t->xf[2]) * t->width;
+		y[k] = ((double)t->xf[3] * u[k] + (double)t->xf[4] * w[k] + t->xf[5]) * t->height;
+	}
+}
+
+/* Texel indices lo..hi (of n) as a small range [*a, *b] that the wrap
+ * mode maps onto the same texels: clamped, or shifted by whole periods
+ * (two images wide, for mirrored repeat), or all of one period. */
+static void scan_range(double lo, double hi, int n, int mode, long *a, long *b)
+{
+	if (mode == TEX_WRAP_CLAMP) {
+		*a = (long)fmin(fmax(lo, 0.0), n - 1.0);
+		*b = (long)fmin(fmax(hi, 0.0), n - 1.0);
+	} else if (hi - lo >= 2.0 * n) {
+		*a = 0;
+		*b = 2L * n - 1;
+	} else {
+		double shift = 2.0 * n * floor(lo / (2.0 * n));
+		*a = (long)(lo - shift);
+		*b = (long)(hi - shift);
+	}
+}
+
+/* Whether triangle i can emit anywhere: some texel that a lookup inside
+ * its coordinates' bounding box reads (bilinear: the texels around
+ * x - 0.5, which include nearest's) is not black. Too large a box to read
+ * counts as emitting. */
+static int tri_can_emit(const SceneView *v, uint32_t i, int tex)
+{
+	const Texture *t = &v->textures[tex];
+	double x[3], y[3];
+	tri_texel_coords(v, i, tex, x, y);
+	const double eps = 1e-3; /* float rounding in the kernel's lookup */
+	double x0 = floor(fmin(x[0], fmin(x[1], x[2])) - 0.5 - eps), x1 = floor(fmax(x[0], fmax(x[1], x[2])) - 0.5 + eps) + 1;
+	double y0 = floor(fmin(y[0], fmin(y[1], y[2])) - 0.5 - eps), y1 = floor(fmax(y[0], fmax(y[1], y[2])) - 0.5 + eps) + 1;
+	if ((x1 - x0 + 1) * (y1 - y0 + 1) > SCAN_LIMIT)
+		return 1;
+	long ax, bx, ay, by;
+	scan_range(x0, x1, t->width, TEX_WRAP_S(t->flags), &ax, &bx);
+	scan_range(y0, y1, t->height, TEX_WRAP_T(t->flags), &ay, &by);
+	for (long yy = ay; yy <= by; yy++) {
+		int ty = texture_wrap((int)yy, t->height, TEX_WRAP_T(t->flags));
+		for (long xx = ax; xx <= bx; xx++) {
+			int tx = texture_wrap((int)xx, t->width, TEX_WRAP_S(t->flags));
+			if (v->texels[t->offset + (size_t)ty * t->width + tx] & 0xffffffu)
+				return 1;
+		}
+	}
+	return 0;
+}
+
+static int cell_level(const SceneView *v, uint32_t i, int tex, int cap)
+{
+	double x[3], y[3];
+	tri_texel_coords(v, i, tex, x, y);
+	double texels = 0.5 * fabs((x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]));
+	int level = 0;
+	while (level < cap && (double)(1u << (2 * level)) * TEXELS_PER_CELL < texels)
+		level++;
+	return level;
+}
+
+/* Mean emitted luminance over cell c of triangle i, from four points
+ * (the centroid and three toward the corners) of its bilinear texture. */
+static double cell_luminance(const SceneView *v, uint32_t i, int level, int c)
+{
+	static const float w[4][3] = {{1.0f / 3, 1.0f / 3, 1.0f / 3},
+				      {2.0f / 3, 1.0f / 6, 1.0f / 6},
+				      {1.0f / 6, 2.0f / 3, 1.0f / 6},
+				      {1.0f / 6, 1.0f / 6, 2.0f / 3}};
+	const Tri *t = &v->tris[i];
+	float b1[3] = {0.0f, 1.0f, 0.0f}, b2[3] = {0.0f, 0.0f, 1.0f};
+	if (level)
+		emitter_cell_corners(level, c, b1, b2);
+	double sum = 0.0;
+	for (int k = 0; k < 4; k++) {
+		float u = w[k][0] * b1[0] + w[k][1] * b1[1] + w[k][2] * b1[2];
+		float vv = w[k][0] * b2[0] + w[k][1] * b2[1] + w[k][2] * b2[2];
+		V3 p = v3_add(t->p0, v3_add(v3_scale(v3_sub(t->p1, t->p0), u), v3_scale(v3_sub(t->p2, t->p0), vv)));
+		sum += v3_lum(emitter_emission(v, (int)i, p));
+	}
+	return sum / 4.0;
+}
+
+static ajar_status build_emitters(const Scene *s, Tri *tris, const TriShade *shade, uint32_t ntris,
+				  const Material *mats, LightTables *out)
+{
+	SceneView v;
+	memset(&v, 0, sizeof v);
+	v.tris = tris;
+	v.shade = shade;
+	v.materials = mats;
+	v.textures = s->textures;
+	v.texels = s->texels;
+	signed char *level = calloc(ntris ? ntris : 1, 1);
+	if (!level)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "lights: out of memory for %u triangles", ntris);
+	/* Which triangles emit, and each one's finest level. */
 	for (uint32_t i = 0; i < ntris; i++) {
 		Tri *t = &tris[i];
+		const Material *m = &mats[t->material];
 		t->emitter = -1;
-		if (v3_lum(mats[t->material].emission) > 0.0f && tri_area(t->p0, t->p1, t->p2) > 0.0f)
-			t->emitter = (int)n++;
+		level[i] = -1;
+		if (!(v3_lum(m->emission) > 0.0f) || !(tri_area(t->p0, t->p1, t->p2) > 0.0f))
+			continue;
+		if (m->emissive_tex && !tri_can_emit(&v, i, m->emissive_tex - 1))
+			continue;
+		level[i] = (signed char)(m->emissive_tex ? cell_level(&v, i, m->emissive_tex - 1, MAX_LEVEL) : 0);
 	}
-	out->nemitters = n;
+	uint64_t n;
+	for (int cap = MAX_LEVEL;; cap--) {
+		n = 0;
+		for (uint32_t i = 0; i < ntris; i++)
+			if (level[i] >= 0) {
+				if (level[i] > cap)
+					level[i] = (signed char)cap;
+				n += 1u << (2 * level[i]);
+			}
+		if (n <= CELL_BUDGET || cap == 0)
+			break;
+	}
+	if (n > UINT32_MAX / 2) {
+		free(level);
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %llu emitters are too many", s->source, (unsigned long long)n);
+	}
+	out->nemitters = (uint32_t)n;
 	out->emitters = calloc(n ? n : 1, sizeof(Emitter));
 	out->emitter_cdf = calloc((size_t)n + 1, sizeof(float));
 	double *power = calloc(n ? n : 1, sizeof(double));
 	if (!out->emitters || !out->emitter_cdf || !power) {
 		free(power);
-		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "lights: out of memory for %u emitters", n);
+		free(level);
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "lights: out of memory for %llu emitters", (unsigned long long)n);
 	}
+	uint32_t k = 0;
 	for (uint32_t i = 0; i < ntris; i++) {
-		const Tri *t = &tris[i];
-		if (t->emitter < 0)
+		Tri *t = &tris[i];
+		if (level[i] < 0)
 			continue;
-		Emitter *e = &out->emitters[t->emitter];
-		e->tri = (int)i;
-		e->area = tri_area(t->p0, t->p1, t->p2);
-		/* One-sided Lambertian emitter: exitance pi L over the area. */
-		power[t->emitter] = (double)e->area * AJAR_PI * v3_lum(mats[t->material].emission);
+		const Material *m = &mats[t->material];
+		int cells = 1 << (2 * level[i]);
+		float area = tri_area(t->p0, t->p1, t->p2);
+		t->emitter = (int)k;
+		for (int c = 0; c < cells; c++, k++) {
+			Emitter *e = &out->emitters[k];
+			e->tri = (int)i;
+			e->area = area / (float)cells;
+			e->cell = EMITTER_CELL(level[i], c);
+			/* One-sided Lambertian emitter: exitance pi L over the area. */
+			double lum = m->emissive_tex ? cell_luminance(&v, i, level[i], c) : v3_lum(m->emission);
+			power[k] = (double)e->area * AJAR_PI * lum;
+		}
 	}
-	out->emitter_power = (float)cdf_build(out->emitter_cdf, power, n, 0);
-	for (uint32_t k = 0; k < n; k++)
-		out->emitters[k].pdf_select = out->emitter_cdf[k + 1] - out->emitter_cdf[k];
+	out->emitter_power = (float)cdf_build(out->emitter_cdf, power, (uint32_t)n, 0);
+	for (uint32_t j = 0; j < n; j++)
+		out->emitters[j].pdf_select = out->emitter_cdf[j + 1] - out->emitter_cdf[j];
 	free(power);
+	free(level);
 	return AJAR_OK;
 }
 
@@ -134,13 +279,13 @@ static ajar_status build_portals(PortalTri *portals, uint32_t n, LightTables *ou
 	return AJAR_OK;
 }
 
-ajar_status lights_build(const Scene *s, Tri *tris, uint32_t ntris, const Material *mats,
+ajar_status lights_build(const Scene *s, Tri *tris, const TriShade *shade, uint32_t ntris, const Material *mats,
 			 PortalTri *portals, uint32_t nportal_tris, V3 scene_center, float scene_radius,
 			 LightTables *out)
 {
 	ajar_status st;
 	memset(out, 0, sizeof(*out));
-	if ((st = build_emitters(tris, ntris, mats, out)) != AJAR_OK ||
+	if ((st = build_emitters(s, tris, shade, ntris, mats, out)) != AJAR_OK ||
 	    (st = build_portals(portals, nportal_tris, out)) != AJAR_OK) {
 		lights_free(out);
 		return st;

@@ -98,7 +98,7 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	scene_bounds(s, &d->bmin, &d->bmax);
 	V3 center = v3_scale(v3_add(d->bmin, d->bmax), 0.5f);
 	float radius = 0.5f * v3_len(v3_sub(d->bmax, d->bmin)) * 1.001f + 1e-4f;
-	if ((st = lights_build(s, d->tris, n, s->materials, d->portals, s->nportal_tris, center, radius,
+	if ((st = lights_build(s, d->tris, d->shade, n, s->materials, d->portals, s->nportal_tris, center, radius,
 			       &d->lights)) != AJAR_OK) {
 		prepare_free(d);
 		return st;

@@ -83,6 +83,10 @@ ajar_status scene_add_material(Scene *s, const Material *m, uint32_t *id)
 	if (m->base_tex >= (int)s->ntextures || m->base_tex < -1)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: material %u: texture %d does not exist (%u textures)",
 			       s->source, s->nmaterials, m->base_tex, s->ntextures);
+	if (m->mr_tex < 0 || m->mr_tex > (int)s->ntextures || m->emissive_tex < 0 ||
+	    m->emissive_tex > (int)s->ntextures)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: material %u: texture %d or %d does not exist (%u textures)",
+			       s->source, s->nmaterials, m->mr_tex - 1, m->emissive_tex - 1, s->ntextures);
 	ajar_status st = grow32((void **)&s->materials, &s->cap_materials, (size_t)s->nmaterials + 1,
 				sizeof *s->materials);
 	if (st)
@@ -119,7 +123,34 @@ ajar_status scene_add_texture(Scene *s, uint32_t width, uint32_t height, const u
 	t->offset = (int)s->ntexels;
 	t->width = (int)width;
 	t->height = (int)height;
+	t->xf[0] = t->xf[4] = 1.0f;
 	s->ntexels += n;
+	s->nimages++;
+	if (id)
+		*id = s->ntextures;
+	s->ntextures++;
+	return AJAR_OK;
+}
+
+ajar_status scene_add_texture_use(Scene *s, uint32_t image, int flags, const float xf[6], uint32_t *id)
+{
+	if (image >= s->ntextures)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: texture %u does not exist (%u textures)", s->source,
+			       image, s->ntextures);
+	for (int i = 0; i < 6; i++)
+		if (!isfinite(xf[i]))
+			return err_set(AJAR_ERROR_BAD_INPUT, "%s: texture %u: transform is not finite", s->source,
+				       s->ntextures);
+	if (s->ntextures >= SCENE_MAX_ITEMS)
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: too many textures", s->source);
+	ajar_status st = grow32((void **)&s->textures, &s->cap_textures, (size_t)s->ntextures + 1,
+				sizeof *s->textures);
+	if (st)
+		return st;
+	Texture *t = &s->textures[s->ntextures];
+	*t = s->textures[image];
+	t->flags = flags;
+	memcpy(t->xf, xf, sizeof t->xf);
 	if (id)
 		*id = s->ntextures;
 	s->ntextures++;

@@ -47,6 +47,8 @@ typedef struct ajar_scene {
 	float env_strength;
 	uint32_t env_width, env_height;
 	float *env_rgb;          /* env_width * env_height * 3, row 0 = top (+Y) */
+
+	uint32_t nimages;        /* textures made by scene_add_texture (the others are uses of them) */
 } Scene;
 
 ajar_status scene_new(const char *source, Scene **out);
@@ -57,6 +59,9 @@ ajar_status scene_add_material(Scene *s, const Material *m, uint32_t *id);
 /* RGBA8 texels, row 0 first as stored in the image file. */
 ajar_status scene_add_texture(Scene *s, uint32_t width, uint32_t height, const uint8_t *rgba,
 			      uint32_t *id);
+/* Another use of texture `image`'s texels with its own sampler and
+ * coordinates: flags TEX_*, xf the affine map of (u, v) (kernels/types.h). */
+ajar_status scene_add_texture_use(Scene *s, uint32_t image, int flags, const float xf[6], uint32_t *id);
 /* Adds triangles already in world space. `normals` and `uvs` may be NULL.
  * `what` names the origin for messages (e.g. "meshes[2].primitives[0]"). */
 ajar_status scene_add_triangles(Scene *s, const char *what, const float *pos, const float *normals,

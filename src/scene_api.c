@@ -261,7 +261,7 @@ ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info)
 	info->emissive_triangles = scene_count_emissive(s);
 	info->portal_triangles = s->nportal_tris;
 	info->portals = s->nportals;
-	info->textures = s->ntextures;
+	info->textures = s->nimages;
 	info->environment = s->env_type == ENV_IMAGE ? 2 : s->env_type == ENV_COLOR ? 1 : 0;
 	V3 lo, hi;
 	scene_bounds(s, &lo, &hi);
