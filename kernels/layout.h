@@ -6,14 +6,15 @@
 #include "types.h"
 
 #define AJAR_LAYOUT_TYPES(X) \
-	X(BvhNode, 256) X(Tri, 48) X(TriShade, 64) X(Material, 64) X(Texture, 48) \
+	X(BvhNode, 256) X(Tri, 48) X(TriShade, 64) X(TriExtra, 80) X(Material, 64) X(Texture, 48) \
 	X(Emitter, 16) X(PortalTri, 64) X(Camera, 64) X(Params, 208)
 
 #define AJAR_LAYOUT_FIELDS(X)                                                          \
 	X(BvhNode, lo_x) X(BvhNode, lo_z) X(BvhNode, hi_x) X(BvhNode, hi_z) X(BvhNode, child)\
 	X(Tri, p0) X(Tri, p1) X(Tri, p2) X(Tri, material) X(Tri, emitter)              \
 	X(TriShade, n0) X(TriShade, n2) X(TriShade, u0) X(TriShade, v2)                \
-	X(TriShade, has_normals)                                                        \
+	X(TriShade, has_normals) X(TriExtra, u0) X(TriExtra, c0) X(TriExtra, c2)      \
+	X(Tri, flags)                                                                   \
 	X(Material, base_color) X(Material, base_tex) X(Material, emission)            \
 	X(Material, metallic) X(Material, roughness) X(Material, transmission)         \
 	X(Material, ior) X(Material, specular) X(Material, flags)                      \

@@ -16,7 +16,10 @@ typedef struct {
 	V3 p;
 	V3 ng;        /* unit geometric normal, front face */
 	V3 ns;        /* unit shading normal, same side as ng */
-	float tu, tv; /* texture coordinates */
+	float tu, tv;   /* texture coordinates, TEXCOORD_0 */
+	float tu1, tv1; /* TEXCOORD_1 (0 where the mesh has none) */
+	V3 color;       /* COLOR_0 (1 where the mesh has none) */
+	float alpha;    /* COLOR_0's alpha */
 	int tri;
 	int material;
 } Surface;
@@ -120,6 +123,19 @@ INLINE void surface_from_hit(const SceneView *sc, const Hit *h, Surface *s)
 	}
 	s->tu = w * sh->u0 + h->u * sh->u1 + h->v * sh->u2;
 	s->tv = w * sh->v0 + h->u * sh->v1 + h->v * sh->v2;
+	s->tu1 = s->tv1 = 0.0f;
+	s->color = v3(1.0f, 1.0f, 1.0f);
+	s->alpha = 1.0f;
+	if (t->flags & TRI_EXTRA) {
+		GLOBAL const TriExtra *e = &sc->extra[h->tri];
+		s->tu1 = w * e->u0 + h->u * e->u1 + h->v * e->u2;
+		s->tv1 = w * e->v0 + h->u * e->v1 + h->v * e->v2;
+		float c[4];
+		for (int k = 0; k < 4; k++)
+			c[k] = w * e->c0[k] + h->u * e->c1[k] + h->v * e->c2[k];
+		s->color = v3(c[0], c[1], c[2]);
+		s->alpha = c[3];
+	}
 	s->tri = h->tri;
 	s->material = t->material;
 }
@@ -144,15 +160,19 @@ INLINE int segment_clear(const SceneView *sc, V3 a, V3 na, V3 b, V3 nb)
 /* Texture `tex` where surface s lies, in the coordinate set it reads. */
 INLINE Rgba surface_texture(const SceneView *sc, const Surface *s, int tex, int srgb)
 {
+	if (sc->textures[tex].flags & TEX_UV1)
+		return texture_rgba(sc, tex, s->tu1, s->tv1, srgb);
 	return texture_rgba(sc, tex, s->tu, s->tv, srgb);
 }
 
+/* Factor x texture (sRGB) x COLOR_0 (glTF 3.9.2). */
 INLINE V3 surface_base_color(const SceneView *sc, const Surface *s)
 {
 	GLOBAL const Material *m = &sc->materials[s->material];
+	V3 c = v3_mul(m->base_color, s->color);
 	if (m->base_tex < 0)
-		return m->base_color;
-	return v3_mul(m->base_color, surface_texture(sc, s, m->base_tex, 1).rgb);
+		return c;
+	return v3_mul(c, surface_texture(sc, s, m->base_tex, 1).rgb);
 }
 
 /* The BSDF at s with base colour `base` (surface_base_color): metallic and
@@ -193,6 +213,14 @@ INLINE Rgba tri_texture(const SceneView *sc, int tri, float b1, float b2, int te
 	float w = 1.0f - b1 - b2;
 	float u = w * sh->u0 + b1 * sh->u1 + b2 * sh->u2;
 	float v = w * sh->v0 + b1 * sh->v1 + b2 * sh->v2;
+	if (sc->textures[tex].flags & TEX_UV1) {
+		u = v = 0.0f;
+		if (sc->tris[tri].flags & TRI_EXTRA) {
+			GLOBAL const TriExtra *e = &sc->extra[tri];
+			u = w * e->u0 + b1 * e->u1 + b2 * e->u2;
+			v = w * e->v0 + b1 * e->v1 + b2 * e->v2;
+		}
+	}
 	return texture_rgba(sc, tex, u, v, srgb);
 }
 #endif

@@ -24,11 +24,12 @@ typedef struct {
 } BvhNode; /* 256 */
 
 /* Triangle as traversal sees it. `emitter` indexes Emitter (or -1). */
+#define TRI_EXTRA 1 /* has TriExtra data (TEXCOORD_1, COLOR_0) */
 typedef struct {
 	V3 p0, p1, p2;
 	int material;
 	int emitter;
-	int pad0;
+	int flags;  /* TRI_* */
 } Tri; /* 48 */
 
 /* Shading attributes of the triangle with the same index. */
@@ -37,6 +38,14 @@ typedef struct {
 	float u0, v0, u1, v1, u2, v2;
 	int has_normals; /* 0: use the geometric normal */
 } TriShade; /* 64 */
+
+/* The attributes few meshes have, for triangles with TRI_EXTRA: the
+ * array has one entry per triangle where any has them, else one. */
+typedef struct {
+	float u0, v0, u1, v1, u2, v2; /* TEXCOORD_1 */
+	float c0[4], c1[4], c2[4];    /* COLOR_0, linear RGBA */
+	int pad0, pad1;
+} TriExtra; /* 80 */
 
 #define MATERIAL_DOUBLE_SIDED 1
 #define MATERIAL_ALPHA_MASK 2   /* alpha below alpha_cutoff is a hole (future) */
@@ -196,6 +205,7 @@ typedef struct {
 	X(float, env)             \
 	X(PortalTri, portals)     \
 	X(float, portal_cdf)      \
+	X(TriExtra, extra)        \
 	X(Params, params)
 
 /* What device code sees of the scene: one pointer per array. */

@@ -586,22 +586,26 @@ ajar_status texture_use(Loader &L, int mi, const char *slot, int index, int texc
 				    "materials[%d].%s.extensions.KHR_texture_transform: offset and scale must be 2 numbers, "
 				    "rotation a number, texCoord an integer >= 0",
 				    mi, slot);
-		/* The extension's GLSL: uv' = T(offset) R(rotation) S(scale) uv,
-		 * R = [cos -sin; sin cos] in (u, v). */
+		/* uv' = T(offset) R(rotation) S(scale) uv with R = [cos sin;
+		 * -sin cos] in (u, v): counter-clockwise as the image is seen
+		 * (v grows downwards), which TextureTransformTest's markers
+		 * confirm (the other sign hits its red "opposite" marker). */
 		double c = std::cos(rot), sn = std::sin(rot);
 		xf[0] = (float)(c * sc[0]);
-		xf[1] = (float)(-sn * sc[1]);
+		xf[1] = (float)(sn * sc[1]);
 		xf[2] = (float)off[0];
-		xf[3] = (float)(sn * sc[0]);
+		xf[3] = (float)(-sn * sc[0]);
 		xf[4] = (float)(c * sc[1]);
 		xf[5] = (float)off[1];
 		texcoord = (int)std::fmin(tc, 1e6);
 	}
-	if (texcoord != 0) {
-		log_msg(AJAR_LOG_WARNING, "%s: materials[%d].%s uses TEXCOORD_%d; only TEXCOORD_0 is supported, texture ignored",
+	if (texcoord > 1) {
+		log_msg(AJAR_LOG_WARNING, "%s: materials[%d].%s uses TEXCOORD_%d; only TEXCOORD_0 and _1 are supported, texture ignored",
 			L.file, mi, slot, texcoord);
 		return AJAR_OK;
 	}
+	if (texcoord == 1)
+		flags |= TEX_UV1;
 	int img = -1;
 	ajar_status st = image_texture(L, tex.source, &img);
 	uint32_t tid;
@@ -837,15 +841,41 @@ ajar_status load_primitive(Loader &L, int mi, int pi, const double world[16], co
 				nrm[3 * v + (size_t)r] = (float)(nm[r][0] * n[0] + nm[r][1] * n[1] + nm[r][2] * n[2]);
 		}
 	}
-	auto uit = pr.attributes.find("TEXCOORD_0");
-	if (uit != pr.attributes.end()) {
+	std::vector<float> uv1, col;
+	const char *sets[2] = {"TEXCOORD_0", "TEXCOORD_1"};
+	for (int k = 0; k < 2; k++) {
+		auto uit = pr.attributes.find(sets[k]);
+		if (uit == pr.attributes.end())
+			continue;
 		Packed pu;
-		if ((st = accessor_read(L, what, "TEXCOORD_0", uit->second, 2, pu)))
+		if ((st = accessor_read(L, what, sets[k], uit->second, 2, pu)))
 			return st;
 		if (pu.count != nv)
-			return fail(L, AJAR_ERROR_BAD_INPUT, "%s: TEXCOORD_0 has %zu elements, POSITION %zu", what.c_str(),
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s: %s has %zu elements, POSITION %zu", what.c_str(), sets[k],
 				    pu.count, nv);
-		uv = to_floats(pu);
+		(k ? uv1 : uv) = to_floats(pu);
+	}
+	/* COLOR_0: RGB or RGBA, float or normalized unsigned integers, linear. */
+	auto cit = pr.attributes.find("COLOR_0");
+	if (cit != pr.attributes.end()) {
+		int acc = cit->second;
+		int nc = acc >= 0 && (size_t)acc < L.model.accessors.size()
+				 ? type_components(L.model.accessors[(size_t)acc].type)
+				 : 4;
+		Packed pc;
+		if ((st = accessor_read(L, what, "COLOR_0", acc, nc == 3 ? 3 : 4, pc)))
+			return st;
+		if (pc.count != nv)
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s: COLOR_0 has %zu elements, POSITION %zu", what.c_str(),
+				    pc.count, nv);
+		if (pc.ctype != TINYGLTF_COMPONENT_TYPE_FLOAT && !pc.normalized)
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s: accessors[%d] (COLOR_0): integer components must be normalized",
+				    what.c_str(), acc);
+		std::vector<float> c = to_floats(pc);
+		col.assign(4 * nv, 1.0f);
+		for (size_t v = 0; v < nv; v++)
+			for (int j = 0; j < pc.ncomp; j++)
+				col[4 * v + (size_t)j] = std::fmin(std::fmax(c[(size_t)pc.ncomp * v + (size_t)j], 0.0f), 1.0f);
 	}
 	uint32_t mat = 0;
 	if (pr.material < 0) {
@@ -858,8 +888,9 @@ ajar_status load_primitive(Loader &L, int mi, int pi, const double world[16], co
 	}
 	if (st)
 		return st;
-	return scene_add_triangles(L.s, what.c_str(), pos.data(), nrm.empty() ? nullptr : nrm.data(),
-				   uv.empty() ? nullptr : uv.data(), (uint32_t)nv, tri.data(), ntris, mat);
+	return scene_add_triangles_ex(L.s, what.c_str(), pos.data(), nrm.empty() ? nullptr : nrm.data(),
+				      uv.empty() ? nullptr : uv.data(), uv1.empty() ? nullptr : uv1.data(),
+				      col.empty() ? nullptr : col.data(), (uint32_t)nv, tri.data(), ntris, mat);
 }
 
 ajar_status load_mesh_node(Loader &L, int ni, const double world[16])

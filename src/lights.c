@@ -53,6 +53,11 @@ static void tri_texel_coords(const SceneView *v, uint32_t i, int tex, double x[3
 	const TriShade *sh = &v->shade[i];
 	const Texture *t = &v->textures[tex];
 	float u[3] = {sh->u0, sh->u1, sh->u2}, w[3] = {sh->v0, sh->v1, sh->v2};
+	if (t->flags & TEX_UV1) {
+		const TriExtra *e = v->tris[i].flags & TRI_EXTRA ? &v->extra[i] : NULL;
+		u[0] = e ? e->u0 : 0.0f, u[1] = e ? e->u1 : 0.0f, u[2] = e ? e->u2 : 0.0f;
+		w[0] = e ? e->v0 : 0.0f, w[1] = e ? e->v1 : 0.0f, w[2] = e ? e->v2 : 0.0f;
+	}
 	for (int k = 0; k < 3; k++) {
 		x[k] = ((double)t->xf[0] * u[k] + (double)t->xf[1] * w[k] + t->xf[2]) * t->width;
 		y[k] = ((double)t->xf[3] * u[k] + (double)t->xf[4] * w[k] + t->xf[5]) * t->height;
@@ -81,7 +86,7 @@ static void scan_range(double lo, double hi, int n, int mode, long *a, long *b)
  * its coordinates' bounding box reads (bilinear: the texels around
  * x - 0.5, which include nearest's) is not black. Too large a box to read
  * counts as emitting. */
-static int tri_can_emit(const SceneView *v, uint32_t i, int tex)
+int lights_can_emit(const SceneView *v, uint32_t i, int tex)
 {
 	const Texture *t = &v->textures[tex];
 	double x[3], y[3];
@@ -138,13 +143,14 @@ static double cell_luminance(const SceneView *v, uint32_t i, int level, int c)
 	return sum / 4.0;
 }
 
-static ajar_status build_emitters(const Scene *s, Tri *tris, const TriShade *shade, uint32_t ntris,
-				  const Material *mats, LightTables *out)
+static ajar_status build_emitters(const Scene *s, Tri *tris, const TriShade *shade, const TriExtra *extra,
+				  uint32_t ntris, const Material *mats, LightTables *out)
 {
 	SceneView v;
 	memset(&v, 0, sizeof v);
 	v.tris = tris;
 	v.shade = shade;
+	v.extra = extra;
 	v.materials = mats;
 	v.textures = s->textures;
 	v.texels = s->texels;
@@ -159,7 +165,7 @@ static ajar_status build_emitters(const Scene *s, Tri *tris, const TriShade *sha
 		level[i] = -1;
 		if (!(v3_lum(m->emission) > 0.0f) || !(tri_area(t->p0, t->p1, t->p2) > 0.0f))
 			continue;
-		if (m->emissive_tex && !tri_can_emit(&v, i, m->emissive_tex - 1))
+		if (m->emissive_tex && !lights_can_emit(&v, i, m->emissive_tex - 1))
 			continue;
 		level[i] = (signed char)(m->emissive_tex ? cell_level(&v, i, m->emissive_tex - 1, MAX_LEVEL) : 0);
 	}
@@ -279,13 +285,13 @@ static ajar_status build_portals(PortalTri *portals, uint32_t n, LightTables *ou
 	return AJAR_OK;
 }
 
-ajar_status lights_build(const Scene *s, Tri *tris, const TriShade *shade, uint32_t ntris, const Material *mats,
+ajar_status lights_build(const Scene *s, Tri *tris, const TriShade *shade, const TriExtra *extra, uint32_t ntris, const Material *mats,
 			 PortalTri *portals, uint32_t nportal_tris, V3 scene_center, float scene_radius,
 			 LightTables *out)
 {
 	ajar_status st;
 	memset(out, 0, sizeof(*out));
-	if ((st = build_emitters(s, tris, shade, ntris, mats, out)) != AJAR_OK ||
+	if ((st = build_emitters(s, tris, shade, extra, ntris, mats, out)) != AJAR_OK ||
 	    (st = build_portals(portals, nportal_tris, out)) != AJAR_OK) {
 		lights_free(out);
 		return st;

@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "error.h"
+#include "lights.h"
 
 /* Device code indexes with int, so no array may pass INT32_MAX entries. */
 #define SCENE_MAX_ITEMS ((size_t)INT32_MAX)
@@ -73,6 +74,7 @@ void scene_free(Scene *s)
 	free(s->texels);
 	free(s->portals);
 	free(s->env_rgb);
+	free(s->extra);
 	free(s);
 }
 
@@ -199,8 +201,45 @@ ajar_status scene_add_triangles(Scene *s, const char *what, const float *pos, co
 				const float *uvs, uint32_t nverts, const uint32_t *idx, uint32_t ntris,
 				uint32_t material)
 {
+	return scene_add_triangles_ex(s, what, pos, normals, uvs, NULL, NULL, nverts, idx, ntris, material);
+}
+
+static void extra_default(TriExtra *e)
+{
+	memset(e, 0, sizeof *e);
+	for (int c = 0; c < 4; c++)
+		e->c0[c] = e->c1[c] = e->c2[c] = 1.0f;
+}
+
+/* TriExtra entries for triangles [s->ntris, s->ntris + ntris), made when
+ * the first triangle with extra attributes arrives (earlier ones get the
+ * defaults: coordinates 0, colour 1). */
+static ajar_status extra_reserve(Scene *s, const char *what, uint32_t ntris)
+{
+	size_t have = s->extra ? s->ntris : 0, need = (size_t)s->ntris + ntris;
+	ajar_status st = grow((void **)&s->extra, &s->cap_extra, need, sizeof *s->extra);
+	if (st)
+		return err_set(st, "%s: %s: out of memory for vertex attributes", s->source, what);
+	for (size_t i = have; i < need; i++)
+		extra_default(&s->extra[i]);
+	return AJAR_OK;
+}
+
+ajar_status scene_add_triangles_ex(Scene *s, const char *what, const float *pos, const float *normals,
+				   const float *uvs, const float *uvs1, const float *colors, uint32_t nverts,
+				   const uint32_t *idx, uint32_t ntris, uint32_t material)
+{
 	ajar_status st = check_geometry(s, what, pos, nverts, idx, ntris, s->ntris);
 	if (st)
+		return st;
+	if (uvs1 && !all_finite(uvs1, 2 * (size_t)nverts))
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: TEXCOORD_1 is not finite", s->source, what);
+	if (colors)
+		for (size_t i = 0; i < 4 * (size_t)nverts; i++)
+			if (!(colors[i] >= 0.0f && colors[i] <= 1.0f))
+				return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: vertex %zu: colour is not in [0, 1]",
+					       s->source, what, i / 4);
+	if ((uvs1 || colors || s->extra) && (st = extra_reserve(s, what, ntris)))
 		return st;
 	if (material >= s->nmaterials)
 		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: material %u does not exist (%u materials)", s->source,
@@ -264,6 +303,24 @@ ajar_status scene_add_triangles(Scene *s, const char *what, const float *pos, co
 				sh->n1 = n[1];
 				sh->n2 = n[2];
 			}
+		}
+		if (uvs1 || colors) {
+			TriExtra *e = &s->extra[s->ntris + t];
+			tri->flags |= TRI_EXTRA;
+			if (uvs1) {
+				e->u0 = uvs1[2 * (size_t)k[0]];
+				e->v0 = uvs1[2 * (size_t)k[0] + 1];
+				e->u1 = uvs1[2 * (size_t)k[1]];
+				e->v1 = uvs1[2 * (size_t)k[1] + 1];
+				e->u2 = uvs1[2 * (size_t)k[2]];
+				e->v2 = uvs1[2 * (size_t)k[2] + 1];
+			}
+			if (colors)
+				for (int c = 0; c < 4; c++) {
+					e->c0[c] = colors[4 * (size_t)k[0] + c];
+					e->c1[c] = colors[4 * (size_t)k[1] + c];
+					e->c2[c] = colors[4 * (size_t)k[2] + c];
+				}
 		}
 		if (uvs) {
 			sh->u0 = uvs[2 * (size_t)k[0]];
@@ -401,9 +458,17 @@ void scene_bounds(const Scene *s, V3 *bmin, V3 *bmax)
 uint32_t scene_count_emissive(const Scene *s)
 {
 	uint32_t n = 0;
+	SceneView v;
+	memset(&v, 0, sizeof v);
+	v.tris = s->tris;
+	v.shade = s->shade;
+	v.extra = s->extra;
+	v.textures = s->textures;
+	v.texels = s->texels;
 	for (uint32_t i = 0; i < s->ntris; i++) {
 		int m = s->tris[i].material;
-		if (m >= 0 && (uint32_t)m < s->nmaterials && !v3_is_zero(s->materials[m].emission))
+		if (m >= 0 && (uint32_t)m < s->nmaterials && !v3_is_zero(s->materials[m].emission) &&
+		    (!s->materials[m].emissive_tex || lights_can_emit(&v, i, s->materials[m].emissive_tex - 1)))
 			n++;
 	}
 	return n;

@@ -49,6 +49,8 @@ typedef struct ajar_scene {
 	float *env_rgb;          /* env_width * env_height * 3, row 0 = top (+Y) */
 
 	uint32_t nimages;        /* textures made by scene_add_texture (the others are uses of them) */
+	TriExtra *extra;         /* NULL, or one per triangle once any has TEXCOORD_1 or COLOR_0 */
+	size_t cap_extra;
 } Scene;
 
 ajar_status scene_new(const char *source, Scene **out);
@@ -67,6 +69,12 @@ ajar_status scene_add_texture_use(Scene *s, uint32_t image, int flags, const flo
 ajar_status scene_add_triangles(Scene *s, const char *what, const float *pos, const float *normals,
 				const float *uvs, uint32_t nverts, const uint32_t *idx, uint32_t ntris,
 				uint32_t material);
+/* scene_add_triangles with a second texture coordinate set (2 floats a
+ * vertex) and vertex colours (linear RGBA, 4 floats a vertex), each may
+ * be NULL. */
+ajar_status scene_add_triangles_ex(Scene *s, const char *what, const float *pos, const float *normals,
+				   const float *uvs, const float *uvs1, const float *colors, uint32_t nverts,
+				   const uint32_t *idx, uint32_t ntris, uint32_t material);
 ajar_status scene_add_portal(Scene *s, const char *what, const float *pos, uint32_t nverts,
 			     const uint32_t *idx, uint32_t ntris);
 ajar_status scene_set_camera(Scene *s, V3 pos, V3 forward, V3 up, float yfov, float aspect);

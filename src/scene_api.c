@@ -251,6 +251,27 @@ ajar_status ajar_scene_set_environment_image(ajar_scene *s, const char *exr_path
 	return scene_set_env_image(s, w, h, rgba, strength);
 }
 
+static int texture_of(const Material *m, int which)
+{
+	return which == 0 ? m->base_tex : which == 1 ? m->mr_tex - 1 : m->emissive_tex - 1;
+}
+
+/* Distinct images behind the textures of one kind: which = 0 base colour,
+ * 1 metallic-roughness, 2 emissive. */
+static uint32_t count_images(const ajar_scene *s, int which)
+{
+	uint32_t n = 0;
+	for (uint32_t i = 0; i < s->nmaterials; i++) {
+		int t = texture_of(&s->materials[i], which), seen = t < 0;
+		for (uint32_t j = 0; j < i && !seen; j++) {
+			int u = texture_of(&s->materials[j], which);
+			seen = u >= 0 && s->textures[u].offset == s->textures[t].offset;
+		}
+		n += !seen;
+	}
+	return n;
+}
+
 ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info)
 {
 	if (!s || !info)
@@ -262,6 +283,10 @@ ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info)
 	info->portal_triangles = s->nportal_tris;
 	info->portals = s->nportals;
 	info->textures = s->nimages;
+	info->base_color_textures = count_images(s, 0);
+	info->metallic_roughness_textures = count_images(s, 1);
+	info->emissive_textures = count_images(s, 2);
+	info->texture_bytes = (uint64_t)s->ntexels * sizeof *s->texels;
 	info->environment = s->env_type == ENV_IMAGE ? 2 : s->env_type == ENV_COLOR ? 1 : 0;
 	V3 lo, hi;
 	scene_bounds(s, &lo, &hi);

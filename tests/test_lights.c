@@ -72,7 +72,7 @@ static void lit_build(Lit *l)
 	assert_non_null(l->tris);
 	if (s->ntris)
 		memcpy(l->tris, s->tris, sizeof(Tri) * s->ntris);
-	assert_int_equal(lights_build(s, l->tris, s->shade, s->ntris, s->materials, s->portals, s->nportal_tris,
+	assert_int_equal(lights_build(s, l->tris, s->shade, s->extra, s->ntris, s->materials, s->portals, s->nportal_tris,
 				      v3(0, 0, 0), 10.0f, &l->lt),
 			 AJAR_OK);
 	memset(&l->prm, 0, sizeof(l->prm));
@@ -471,6 +471,8 @@ static void test_emissive_texture(void **state)
 	s.material = (int)m;
 	s.ng = s.ns = v3(0, 0, 1);
 	s.tu = s.tv = 0.3f;
+	s.color = v3(1, 1, 1);
+	s.alpha = 1.0f;
 	Bsdf bs;
 	surface_bsdf(&l.sc, &s, surface_base_color(&l.sc, &s), &bs);
 	assert_float_equal(bs.metallic, 64.0f / 255.0f, 1e-6f);

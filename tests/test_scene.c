@@ -17,6 +17,7 @@
 
 #include "ajar.h"
 #include "scene.h"
+#include "../kernels/surface.h"
 
 #define EPS 1e-5f
 
@@ -712,6 +713,103 @@ static void test_environment_image(void **state)
 
 /* ---- Broken files ------------------------------------------------------ */
 
+/* ---- Texture coordinates, samplers, transforms, vertex colours ----------
+ * One triangle (0,0,0) (1,0,0) (0,1,0) with TEXCOORD_0 = xy, TEXCOORD_1 =
+ * (0.5 + x/2, 0.5 + y/2) and COLOR_0 red, green, blue (alpha 0.5) as
+ * normalized bytes, and a 4 x 4 PNG whose texel (x, y) is
+ * (60x + 10, 60y + 10, 0). Three materials: TEXCOORD_1 with a clamp (s) /
+ * mirrored-repeat (t) nearest sampler; KHR_texture_transform offset
+ * (0.25, 0), scale 0.5; rotation pi/2 and texCoord 1 (repeat, nearest). */
+#define UV_BUFFER "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAAAAAAAAAAAAIA/AAAAAAAAAAAAAIA/AAAAPwAAAD8AAIA/AAAAPwAAAD8AAIA//wAA/wD/AP8AAP+A"
+#define UV_PNG "iVBORw0KGgoAAAANSUhEUgAAAAQAAAAECAYAAACp8Z5+AAAAK0lEQVR4nBXIMQEAMBACMWaEIQxhWGvvhyyRrRcUgxwCxXJRAsV6MQLF8AFZeRxxtxm5jwAAAABJRU5ErkJggg=="
+static const char uv_gltf[] =
+	"{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_texture_transform\"],"
+	"\"extensionsRequired\":[\"KHR_texture_transform\"],\"scenes\":[{\"nodes\":[0,1,2]}],"
+	"\"nodes\":[{\"mesh\":0},{\"mesh\":1},{\"mesh\":2}],"
+	"\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1,\"TEXCOORD_1\":2,\"COLOR_0\":3},\"material\":0}]},"
+	"{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"material\":1}]},"
+	"{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"material\":2}]}],"
+	"\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,\"texCoord\":1}}},"
+	"{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":1,\"extensions\":{\"KHR_texture_transform\":"
+	"{\"offset\":[0.25,0],\"scale\":[0.5,0.5]}}}}},"
+	"{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":1,\"extensions\":{\"KHR_texture_transform\":"
+	"{\"rotation\":1.5707963267948966,\"texCoord\":1}}}}}],"
+	"\"textures\":[{\"source\":0,\"sampler\":0},{\"source\":0,\"sampler\":1}],"
+	"\"samplers\":[{\"magFilter\":9728,\"wrapS\":33071,\"wrapT\":33648},{\"magFilter\":9728}],"
+	"\"images\":[{\"uri\":\"data:image/png;base64," UV_PNG "\"}],"
+	"\"buffers\":[{\"byteLength\":96,\"uri\":\"data:application/octet-stream;base64," UV_BUFFER "\"}],"
+	"\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24},"
+	"{\"buffer\":0,\"byteOffset\":60,\"byteLength\":24},{\"buffer\":0,\"byteOffset\":84,\"byteLength\":12}],"
+	"\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+	"{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"},"
+	"{\"bufferView\":2,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"},"
+	"{\"bufferView\":3,\"componentType\":5121,\"normalized\":true,\"count\":3,\"type\":\"VEC4\"}]}";
+
+/* Texel (x, y)'s red and green, as texture_rgba reads them undecoded. */
+static void assert_texel(Rgba c, int x, int y)
+{
+	if (fabsf(c.rgb.x - (60 * x + 10) / 255.0f) > EPS || fabsf(c.rgb.y - (60 * y + 10) / 255.0f) > EPS)
+		fail_msg("read (%g, %g), want texel (%d, %d)", c.rgb.x * 255, c.rgb.y * 255, x, y);
+}
+
+static void test_texture_coordinates(void **state)
+{
+	(void)state;
+	write_text("uv.gltf", uv_gltf);
+	Scene *s = load_ok("uv.gltf");
+	assert_int_equal(s->nimages, 1);
+	SceneView sc;
+	memset(&sc, 0, sizeof sc);
+	sc.tris = s->tris;
+	sc.shade = s->shade;
+	sc.extra = s->extra;
+	sc.materials = s->materials;
+	sc.textures = s->textures;
+	sc.texels = s->texels;
+	int t0 = s->materials[0].base_tex, t1 = s->materials[1].base_tex, t2 = s->materials[2].base_tex;
+	/* Wrap modes at and past the edges: clamp in s, mirrored repeat in t. */
+	assert_texel(texture_rgba(&sc, t0, 1.3f, 0.1f, 0), 3, 0);
+	assert_texel(texture_rgba(&sc, t0, -0.2f, 0.1f, 0), 0, 0);
+	assert_texel(texture_rgba(&sc, t0, 0.99f, 0.99f, 0), 3, 3);
+	assert_texel(texture_rgba(&sc, t0, 0.1f, 1.2f, 0), 0, 3);   /* 2 - 1.2 = 0.8 */
+	assert_texel(texture_rgba(&sc, t0, 0.1f, -0.1f, 0), 0, 0);  /* 0.1 */
+	assert_texel(texture_rgba(&sc, t0, 0.1f, 2.3f, 0), 0, 1);   /* 0.3 */
+	assert_texel(texture_rgba(&sc, t0, 0.1f, -1.3f, 0), 0, 2);  /* 2 - 1.3 = 0.7 */
+	/* Repeat (texture 1's sampler) and the transform: offset + scale x uv. */
+	assert_texel(texture_rgba(&sc, t1, 0.1f, 0.1f, 0), 1, 0);   /* (0.3, 0.05) */
+	assert_texel(texture_rgba(&sc, t1, 1.9f, 0.9f, 0), 0, 1);   /* (1.2, 0.45) -> 0.2 */
+	/* Rotation pi/2: (u, v) -> (v, -u), as TextureTransformTest shows. */
+	assert_true(s->textures[t2].flags & TEX_UV1);
+	assert_texel(texture_rgba(&sc, t2, 0.1f, 0.6f, 0), 2, 3);   /* (0.6, -0.1) -> (0.6, 0.9) */
+	/* Bilinear (a use with the default sampler): halfway between texel
+	 * centres 0 and 1, blended after decoding. */
+	const float id[6] = {1, 0, 0, 0, 1, 0};
+	uint32_t lin;
+	assert_int_equal(scene_add_texture_use(s, 0, 0, id, &lin), AJAR_OK);
+	sc.textures = s->textures;
+	Rgba c = texture_rgba(&sc, (int)lin, 0.25f, 0.125f, 0);
+	assert_float_equal(c.rgb.x, 40.0f / 255.0f, EPS);
+	assert_float_equal(c.rgb.y, 10.0f / 255.0f, EPS);
+	c = texture_rgba(&sc, (int)lin, 0.25f, 0.125f, 1);
+	assert_float_equal(c.rgb.x, 0.5f * (srgb_to_linear(10.0f / 255) + srgb_to_linear(70.0f / 255)), EPS);
+	/* TEXCOORD_1 and COLOR_0 end to end: at barycentrics (0.2, 0.2) of
+	 * triangle 0, TEXCOORD_1 is (0.6, 0.6) (texel (2, 2)) and the colour
+	 * (0.6, 0.2, 0.2), alpha 0.6 + 0.2 + 0.2 x 128/255. */
+	assert_true(s->tris[0].flags & TRI_EXTRA);
+	assert_false(s->tris[1].flags & TRI_EXTRA);
+	Hit h = {1.0f, 0.2f, 0.2f, 0};
+	Surface sf;
+	surface_from_hit(&sc, &h, &sf);
+	assert_float_equal(sf.alpha, 0.8f + 0.2f * 128.0f / 255.0f, EPS);
+	V3 base = surface_base_color(&sc, &sf);
+	float t22 = srgb_to_linear(130.0f / 255.0f);
+	assert_v3(base, 0.6f * t22, 0.2f * t22, 0.0f);
+	h.tri = 1; /* no COLOR_0: white */
+	surface_from_hit(&sc, &h, &sf);
+	assert_v3(sf.color, 1, 1, 1);
+	ajar_scene_destroy(&s);
+}
+
 static void test_broken_files(void **state)
 {
 	/* Truncated JSON. */
@@ -816,6 +914,7 @@ int main(void)
 		cmocka_unit_test(test_glb),
 		cmocka_unit_test(test_portals_and_environment),
 		cmocka_unit_test(test_environment_image),
+		cmocka_unit_test(test_texture_coordinates),
 		cmocka_unit_test(test_broken_files),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
