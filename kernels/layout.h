@@ -6,7 +6,7 @@
 #include "types.h"
 
 #define AJAR_LAYOUT_TYPES(X) \
-	X(BvhNode, 256) X(Tri, 48) X(TriShade, 64) X(TriExtra, 80) X(Material, 64) X(Texture, 48) \
+	X(BvhNode, 256) X(Tri, 48) X(TriShade, 64) X(TriExtra, 80) X(Material, 80) X(Texture, 48) \
 	X(Emitter, 16) X(PortalTri, 64) X(Camera, 64) X(Params, 208)
 
 #define AJAR_LAYOUT_FIELDS(X)                                                          \
@@ -19,6 +19,7 @@
 	X(Material, metallic) X(Material, roughness) X(Material, transmission)         \
 	X(Material, ior) X(Material, specular) X(Material, flags)                      \
 	X(Material, alpha_cutoff) X(Material, mr_tex) X(Material, emissive_tex)         \
+	X(Material, base_alpha)                                                         \
 	X(Texture, offset) X(Texture, width) X(Texture, height) X(Texture, flags)      \
 	X(Texture, xf)                                                                  \
 	X(Emitter, tri) X(Emitter, area) X(Emitter, pdf_select) X(Emitter, cell)       \

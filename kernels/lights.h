@@ -12,15 +12,23 @@
 #include "surface.h"
 
 /* Emitted radiance of emitter triangle `tri` at its point p, front face:
- * the material's emission times its emissive texture (sRGB colour). */
+ * the material's emission times its emissive texture (sRGB colour) and,
+ * on alpha-tested triangles, its coverage (texture.h). */
 INLINE V3 emitter_emission(const SceneView *sc, int tri, V3 p)
 {
-	GLOBAL const Material *m = &sc->materials[sc->tris[tri].material];
-	if (!m->emissive_tex)
+	GLOBAL const Tri *t = &sc->tris[tri];
+	GLOBAL const Material *m = &sc->materials[t->material];
+	if (!m->emissive_tex && !(t->flags & TRI_ALPHA))
 		return m->emission;
 	float b1, b2;
-	tri_barycentric(&sc->tris[tri], p, &b1, &b2);
-	return v3_mul(m->emission, tri_texture(sc, tri, b1, b2, m->emissive_tex - 1, 1).rgb);
+	tri_barycentric(t, p, &b1, &b2);
+	V3 e = m->emission;
+	if (m->emissive_tex)
+		e = v3_mul(e, tri_texture(sc, tri, b1, b2, m->emissive_tex - 1, 1).rgb);
+	/* Where rays pass through it (alpha), it emits that much less. */
+	if (t->flags & TRI_ALPHA)
+		e = v3_scale(e, tri_coverage(sc, tri, b1, b2));
+	return e;
 }
 
 /* Radiance leaving triangle `tri` at its point p in direction w (any

@@ -25,6 +25,7 @@ typedef struct {
 
 /* Triangle as traversal sees it. `emitter` indexes Emitter (or -1). */
 #define TRI_EXTRA 1 /* has TriExtra data (TEXCOORD_1, COLOR_0) */
+#define TRI_ALPHA 2 /* its material may be transparent here: rays test its alpha (bvh.h) */
 typedef struct {
 	V3 p0, p1, p2;
 	int material;
@@ -48,7 +49,8 @@ typedef struct {
 } TriExtra; /* 80 */
 
 #define MATERIAL_DOUBLE_SIDED 1
-#define MATERIAL_ALPHA_MASK 2   /* alpha below alpha_cutoff is a hole (future) */
+#define MATERIAL_ALPHA_MASK 2   /* alpha below alpha_cutoff is a hole */
+#define MATERIAL_ALPHA_BLEND 4  /* stochastic transparency: rays meet the surface with probability alpha */
 
 /* glTF metallic-roughness, with KHR_materials_specular/transmission/ior. */
 typedef struct {
@@ -64,7 +66,9 @@ typedef struct {
 	float alpha_cutoff;
 	int mr_tex;         /* Texture index + 1 (0: none): B metallic, G roughness, times the factors */
 	int emissive_tex;   /* Texture index + 1 (0: none): multiplies emission */
-} Material; /* 64 */
+	float base_alpha;   /* baseColorFactor's alpha (MASK, BLEND) */
+	int pad0, pad1, pad2;
+} Material; /* 80 */
 
 /* A texture as a material uses it: an RGBA8 image in the shared texel
  * array (decoded from sRGB only where it holds colour, surface.h), the

@@ -633,7 +633,7 @@ ajar_status load_material(Loader &L, int mi, uint32_t *id)
 	if (pbr.baseColorFactor.size() != 4)
 		return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d]: baseColorFactor has %zu numbers, expected 4", mi,
 			    pbr.baseColorFactor.size());
-	for (int c = 0; c < 3 && !st; c++)
+	for (int c = 0; c < 4 && !st; c++)
 		st = in_unit(L, mi, "baseColorFactor", pbr.baseColorFactor[(size_t)c]);
 	if (!st)
 		st = in_unit(L, mi, "metallicFactor", pbr.metallicFactor);
@@ -671,11 +671,14 @@ ajar_status load_material(Loader &L, int mi, uint32_t *id)
 	m.specular = (float)specular;
 	m.flags = gm.doubleSided ? MATERIAL_DOUBLE_SIDED : 0;
 	m.alpha_cutoff = (float)gm.alphaCutoff;
-	if (gm.alphaMode == "MASK") {
+	m.base_alpha = (float)pbr.baseColorFactor[3];
+	if (gm.alphaMode == "MASK")
 		m.flags |= MATERIAL_ALPHA_MASK;
-		log_msg(AJAR_LOG_WARNING, "%s: materials[%d]: alphaMode MASK is not applied yet: the surface is opaque",
-			L.file, mi);
-	}
+	else if (gm.alphaMode == "BLEND")
+		m.flags |= MATERIAL_ALPHA_BLEND;
+	else if (gm.alphaMode != "OPAQUE" && !gm.alphaMode.empty())
+		return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d]: alphaMode \"%s\" is not OPAQUE, MASK or BLEND", mi,
+			    gm.alphaMode.c_str());
 
 	int base = -1, mr = -1, em = -1;
 	const tg::TextureInfo &bt = pbr.baseColorTexture, &mt = pbr.metallicRoughnessTexture, &et = gm.emissiveTexture;

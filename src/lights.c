@@ -38,11 +38,11 @@ double cdf_build(float *cdf, const double *w, uint32_t n, int uniform_if_empty)
 }
 
 /* Emissive textures: a triangle is split into 4^level cells of equal area
- * (kernels/lights.h) so that a cell covers about TEXELS_PER_CELL texels,
- * and each cell is chosen by its own power; dark parts of a texture are
- * then never sampled. Levels are capped per triangle and lowered for all
+ * (kernels/lights.h) so that a cell covers at most TEXELS_PER_CELL texels,
+ * and each cell is chosen by its own power; dark parts of a texture (and
+ * holes that alpha cuts) are then never sampled. Levels are capped per triangle and lowered for all
  * where the scene would pass CELL_BUDGET cells. */
-#define TEXELS_PER_CELL 2.0
+#define TEXELS_PER_CELL 0.5
 #define MAX_LEVEL 7
 #define CELL_BUDGET (1u << 21)
 #define SCAN_LIMIT (1u << 22) /* texels a "can it emit" test reads at most */
@@ -167,7 +167,10 @@ static ajar_status build_emitters(const Scene *s, Tri *tris, const TriShade *sha
 			continue;
 		if (m->emissive_tex && !lights_can_emit(&v, i, m->emissive_tex - 1))
 			continue;
-		level[i] = (signed char)(m->emissive_tex ? cell_level(&v, i, m->emissive_tex - 1, MAX_LEVEL) : 0);
+		/* Cells as fine as the texture that varies the emission: the
+		 * emissive one, else, where alpha cuts holes, the base colour's. */
+		int tex = m->emissive_tex ? m->emissive_tex - 1 : (t->flags & TRI_ALPHA) ? m->base_tex : -1;
+		level[i] = (signed char)(tex >= 0 ? cell_level(&v, i, tex, MAX_LEVEL) : 0);
 	}
 	uint64_t n;
 	for (int cap = MAX_LEVEL;; cap--) {
@@ -209,7 +212,8 @@ static ajar_status build_emitters(const Scene *s, Tri *tris, const TriShade *sha
 			e->area = area / (float)cells;
 			e->cell = EMITTER_CELL(level[i], c);
 			/* One-sided Lambertian emitter: exitance pi L over the area. */
-			double lum = m->emissive_tex ? cell_luminance(&v, i, level[i], c) : v3_lum(m->emission);
+			double lum = m->emissive_tex || (t->flags & TRI_ALPHA) ? cell_luminance(&v, i, level[i], c)
+									       : v3_lum(m->emission);
 			power[k] = (double)e->area * AJAR_PI * lum;
 		}
 	}

@@ -244,6 +244,11 @@ ajar_status scene_add_triangles_ex(Scene *s, const char *what, const float *pos,
 	if (material >= s->nmaterials)
 		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: material %u does not exist (%u materials)", s->source,
 			       what, material, s->nmaterials);
+	/* Rays test the alpha only of triangles that can be transparent. */
+	const Material *mat = &s->materials[material];
+	int alpha = (mat->flags & (MATERIAL_ALPHA_MASK | MATERIAL_ALPHA_BLEND)) &&
+		    (mat->base_tex >= 0 || colors ||
+		     !(mat->base_alpha >= (mat->flags & MATERIAL_ALPHA_MASK ? mat->alpha_cutoff : 1.0f)));
 	if (normals)
 		for (uint32_t v = 0; v < nverts; v++)
 			if (!all_finite(normals + 3 * (size_t)v, 3))
@@ -285,6 +290,8 @@ ajar_status scene_add_triangles_ex(Scene *s, const char *what, const float *pos,
 		tri->p2 = load3(pos, k[2]);
 		tri->material = (int)material;
 		tri->emitter = -1;
+		if (alpha)
+			tri->flags |= TRI_ALPHA;
 		if (normals) {
 			V3 n[3];
 			sh->has_normals = 1;

@@ -454,6 +454,35 @@ static void test_emissive_texture(void **state)
 	assert_true(v3_is_zero(emitter_radiance(&l.sc, t, dark, v3(0, 0, 1))));
 	assert_float_equal(emitter_pdf_a(&l.sc, t, dark), 0.0f, 0.0f);
 
+	/* An alpha-masked emitter (checker of 4 x 4 texels, clear where
+	 * x + y is even): half the power, sampled only where it is. */
+	lit_free(&l);
+	assert_int_equal(scene_new("<test>", &l.s), AJAR_OK);
+	uint8_t chk[4 * 4 * 4];
+	for (int i = 0; i < 16; i++) {
+		chk[4 * i] = chk[4 * i + 1] = chk[4 * i + 2] = 255;
+		chk[4 * i + 3] = ((i % 4) + (i / 4)) % 2 ? 255 : 0;
+	}
+	assert_int_equal(scene_add_texture(l.s, 4, 4, chk, &img), AJAR_OK);
+	assert_int_equal(scene_add_texture_use(l.s, img, TEX_NEAREST, xf, &tex), AJAR_OK);
+	m = add_material(l.s, v3(2, 2, 2));
+	l.s->materials[m].base_tex = (int)tex;
+	l.s->materials[m].base_alpha = 1.0f;
+	l.s->materials[m].alpha_cutoff = 0.5f;
+	l.s->materials[m].flags = MATERIAL_ALPHA_MASK;
+	assert_int_equal(scene_add_triangles(l.s, "quad", pos, NULL, uv, 4, idx, 2, m), AJAR_OK);
+	lit_build(&l);
+	assert_float_equal(l.lt.emitter_power, AJAR_PI, 1e-5 * AJAR_PI);
+	for (int k = 0; k < 2000; k++) {
+		V3 p, n;
+		float pdf_a;
+		int tri = emitter_sample(&l.sc, rnd(), rnd(), rnd(), &p, &n, &pdf_a);
+		int ix = (int)fminf(p.x * 4, 3), iy = (int)fminf(p.y * 4, 3);
+		assert_true((ix + iy) % 2 == 1);
+		assert_float_equal(pdf_a, 2.0f, 1e-4f);
+		assert_float_equal(emitter_radiance(&l.sc, tri, p, v3(0, 0, 1)).x, 2.0f, 0.0f);
+	}
+
 	/* The metallic-roughness texture (linear, B metallic, G roughness)
 	 * times the factors, sRGB decoding only for colour. */
 	uint8_t mr[4] = {0, 128, 64, 255};
