@@ -6,7 +6,7 @@
 #include "types.h"
 
 #define AJAR_LAYOUT_TYPES(X) \
-	X(BvhNode, 256) X(Tri, 48) X(TriShade, 64) X(TriExtra, 80) X(Material, 80) X(Texture, 48) \
+	X(BvhNode, 256) X(Tri, 48) X(TriShade, 64) X(TriExtra, 128) X(Material, 80) X(Texture, 48) \
 	X(Emitter, 16) X(PortalTri, 64) X(Camera, 64) X(Params, 208)
 
 #define AJAR_LAYOUT_FIELDS(X)                                                          \
@@ -14,6 +14,7 @@
 	X(Tri, p0) X(Tri, p1) X(Tri, p2) X(Tri, material) X(Tri, emitter)              \
 	X(TriShade, n0) X(TriShade, n2) X(TriShade, u0) X(TriShade, v2)                \
 	X(TriShade, has_normals) X(TriExtra, u0) X(TriExtra, c0) X(TriExtra, c2)      \
+	X(TriExtra, t0) X(TriExtra, t2) X(Material, normal_tex) X(Material, normal_scale)\
 	X(Tri, flags)                                                                   \
 	X(Material, base_color) X(Material, base_tex) X(Material, emission)            \
 	X(Material, metallic) X(Material, roughness) X(Material, transmission)         \

@@ -26,6 +26,7 @@ typedef struct {
 /* Triangle as traversal sees it. `emitter` indexes Emitter (or -1). */
 #define TRI_EXTRA 1 /* has TriExtra data (TEXCOORD_1, COLOR_0) */
 #define TRI_ALPHA 2 /* its material may be transparent here: rays test its alpha (bvh.h) */
+#define TRI_TANGENT 4 /* normal-mapped: TriExtra holds its tangents */
 typedef struct {
 	V3 p0, p1, p2;
 	int material;
@@ -45,8 +46,9 @@ typedef struct {
 typedef struct {
 	float u0, v0, u1, v1, u2, v2; /* TEXCOORD_1 */
 	float c0[4], c1[4], c2[4];    /* COLOR_0, linear RGBA */
+	float t0[4], t1[4], t2[4];    /* TRI_TANGENT: world-space tangent, w the bitangent's sign */
 	int pad0, pad1;
-} TriExtra; /* 80 */
+} TriExtra; /* 128 */
 
 #define MATERIAL_DOUBLE_SIDED 1
 #define MATERIAL_ALPHA_MASK 2   /* alpha below alpha_cutoff is a hole */
@@ -67,7 +69,9 @@ typedef struct {
 	int mr_tex;         /* Texture index + 1 (0: none): B metallic, G roughness, times the factors */
 	int emissive_tex;   /* Texture index + 1 (0: none): multiplies emission */
 	float base_alpha;   /* baseColorFactor's alpha (MASK, BLEND) */
-	int pad0, pad1, pad2;
+	int normal_tex;     /* Texture index + 1 (0: none): tangent-space normal map */
+	float normal_scale; /* its x and y scale */
+	int pad0;
 } Material; /* 80 */
 
 /* A texture as a material uses it: an RGBA8 image in the shared texel

@@ -86,7 +86,7 @@ ajar_status scene_add_material(Scene *s, const Material *m, uint32_t *id)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: material %u: texture %d does not exist (%u textures)",
 			       s->source, s->nmaterials, m->base_tex, s->ntextures);
 	if (m->mr_tex < 0 || m->mr_tex > (int)s->ntextures || m->emissive_tex < 0 ||
-	    m->emissive_tex > (int)s->ntextures)
+	    m->emissive_tex > (int)s->ntextures || m->normal_tex < 0 || m->normal_tex > (int)s->ntextures)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: material %u: texture %d or %d does not exist (%u textures)",
 			       s->source, s->nmaterials, m->mr_tex - 1, m->emissive_tex - 1, s->ntextures);
 	ajar_status st = grow32((void **)&s->materials, &s->cap_materials, (size_t)s->nmaterials + 1,
@@ -201,7 +201,7 @@ ajar_status scene_add_triangles(Scene *s, const char *what, const float *pos, co
 				const float *uvs, uint32_t nverts, const uint32_t *idx, uint32_t ntris,
 				uint32_t material)
 {
-	return scene_add_triangles_ex(s, what, pos, normals, uvs, NULL, NULL, nverts, idx, ntris, material);
+	return scene_add_triangles_ex(s, what, pos, normals, uvs, NULL, NULL, NULL, nverts, idx, ntris, material);
 }
 
 static void extra_default(TriExtra *e)
@@ -226,7 +226,8 @@ static ajar_status extra_reserve(Scene *s, const char *what, uint32_t ntris)
 }
 
 ajar_status scene_add_triangles_ex(Scene *s, const char *what, const float *pos, const float *normals,
-				   const float *uvs, const float *uvs1, const float *colors, uint32_t nverts,
+				   const float *uvs, const float *uvs1, const float *colors, const float *tangents,
+				   uint32_t nverts,
 				   const uint32_t *idx, uint32_t ntris, uint32_t material)
 {
 	ajar_status st = check_geometry(s, what, pos, nverts, idx, ntris, s->ntris);
@@ -239,7 +240,11 @@ ajar_status scene_add_triangles_ex(Scene *s, const char *what, const float *pos,
 			if (!(colors[i] >= 0.0f && colors[i] <= 1.0f))
 				return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: vertex %zu: colour is not in [0, 1]",
 					       s->source, what, i / 4);
-	if ((uvs1 || colors || s->extra) && (st = extra_reserve(s, what, ntris)))
+	if (tangents && !all_finite(tangents, 4 * (size_t)nverts))
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: a tangent is not finite", s->source, what);
+	if (material < s->nmaterials && !s->materials[material].normal_tex)
+		tangents = NULL; /* only normal maps read them */
+	if ((uvs1 || colors || tangents || s->extra) && (st = extra_reserve(s, what, ntris)))
 		return st;
 	if (material >= s->nmaterials)
 		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: material %u does not exist (%u materials)", s->source,
@@ -311,9 +316,17 @@ ajar_status scene_add_triangles_ex(Scene *s, const char *what, const float *pos,
 				sh->n2 = n[2];
 			}
 		}
-		if (uvs1 || colors) {
+		if (uvs1 || colors || tangents) {
 			TriExtra *e = &s->extra[s->ntris + t];
 			tri->flags |= TRI_EXTRA;
+			if (tangents) {
+				tri->flags |= TRI_TANGENT;
+				for (int c = 0; c < 4; c++) {
+					e->t0[c] = tangents[4 * (size_t)k[0] + c];
+					e->t1[c] = tangents[4 * (size_t)k[1] + c];
+					e->t2[c] = tangents[4 * (size_t)k[2] + c];
+				}
+			}
 			if (uvs1) {
 				e->u0 = uvs1[2 * (size_t)k[0]];
 				e->v0 = uvs1[2 * (size_t)k[0] + 1];

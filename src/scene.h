@@ -70,10 +70,12 @@ ajar_status scene_add_triangles(Scene *s, const char *what, const float *pos, co
 				const float *uvs, uint32_t nverts, const uint32_t *idx, uint32_t ntris,
 				uint32_t material);
 /* scene_add_triangles with a second texture coordinate set (2 floats a
- * vertex) and vertex colours (linear RGBA, 4 floats a vertex), each may
- * be NULL. */
+ * vertex), vertex colours (linear RGBA, 4 floats a vertex) and tangents
+ * (world space xyz and the bitangent's sign w, 4 floats a vertex; used
+ * where the material has a normal map), each may be NULL. */
 ajar_status scene_add_triangles_ex(Scene *s, const char *what, const float *pos, const float *normals,
-				   const float *uvs, const float *uvs1, const float *colors, uint32_t nverts,
+				   const float *uvs, const float *uvs1, const float *colors, const float *tangents,
+				   uint32_t nverts,
 				   const uint32_t *idx, uint32_t ntris, uint32_t material);
 ajar_status scene_add_portal(Scene *s, const char *what, const float *pos, uint32_t nverts,
 			     const uint32_t *idx, uint32_t ntris);

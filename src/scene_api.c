@@ -287,6 +287,8 @@ ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info)
 	info->metallic_roughness_textures = count_images(s, 1);
 	info->emissive_textures = count_images(s, 2);
 	info->texture_bytes = (uint64_t)s->ntexels * sizeof *s->texels;
+	for (uint32_t i = 0; i < s->ntris; i++)
+		info->alpha_triangles += (s->tris[i].flags & TRI_ALPHA) != 0;
 	info->environment = s->env_type == ENV_IMAGE ? 2 : s->env_type == ENV_COLOR ? 1 : 0;
 	V3 lo, hi;
 	scene_bounds(s, &lo, &hi);
