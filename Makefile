@@ -34,10 +34,11 @@ TESTS := $(patsubst tests/%.c,%,$(wildcard tests/test_*.c))
 obj = $(addprefix $(BUILD)/src/,$(addsuffix .o,$(1)))
 DEPS_test_bsdf := $(call obj,error)
 DEPS_test_sampling := $(call obj,error)
-DEPS_test_bvh := $(call obj,error scene lights bvh gltf exr)
+DEPS_test_bvh := $(call obj,error scene bvh gltf exr)
 DEPS_test_lights := $(call obj,error scene lights)
-DEPS_test_scene := $(call obj,error scene lights scene_api gltf exr)
+DEPS_test_scene := $(call obj,error scene scene_api gltf exr)
 DEPS_test_exr := $(call obj,error exr png)
+DEPS_test_confine := $(call obj,error scene scene_api gltf exr png)
 DEPS_test_bdpt := $(BUILD)/tests/kernel_host.o $(BUILD)/tests/mis_oracle.o $(call obj,error scene scene_api gltf exr bvh lights prepare portal_flux)
 DEPS_test_portal := $(DEPS_test_bdpt)
 # Tests that render need the whole library.
@@ -49,6 +50,8 @@ DEPS_test_cli := $(BUILD)/libajar.a
 DEPS_test_multidevice := $(BUILD)/libajar.a
 DEPS_test_integrators := $(BUILD)/libajar.a
 DEPS_test_traversal := $(BUILD)/libajar.a
+DEPS_test_checkpoint := $(BUILD)/libajar.a
+DEPS_test_aov := $(BUILD)/libajar.a
 
 .PHONY: all lib cli tests test test-unit asan demo bench bench-peers install uninstall clean deps help
 all: lib cli
@@ -136,7 +139,7 @@ test:
 	$(Q)sh tests/run.sh $(BUILD) $(TESTS)
 
 # Host tests that need no OpenCL device, under ASan + UBSan.
-ASAN_TESTS := test_bsdf test_sampling test_bvh test_lights test_scene test_exr test_bdpt test_portal
+ASAN_TESTS := test_bsdf test_sampling test_bvh test_lights test_scene test_exr test_bdpt test_portal test_confine
 asan:
 	$(Q)$(MAKE) --no-print-directory deps
 	$(Q)$(MAKE) --no-print-directory MODE=asan $(ASAN_TESTS:%=build/asan/tests/%)

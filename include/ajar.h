@@ -147,6 +147,7 @@ typedef struct {
 	const char *device;      /* selector ("0:0", "cpu", "gpu", name substring), a comma-
 				  * separated list of them or "all" (render on several
 				  * devices at once), or NULL for the first CPU device */
+	uint32_t aov;            /* AJAR_AOV_* bits: first-hit outputs for denoisers */
 } ajar_options;
 void ajar_options_default(ajar_options *o);
 
@@ -219,6 +220,69 @@ ajar_status ajar_write_exr(const char *path, const float *rgba, uint32_t width, 
 ajar_status ajar_read_exr(const char *path, float **rgba, uint32_t *width, uint32_t *height);
 /* Tone-mapped (exposure, sRGB) 8-bit PNG of float RGBA. */
 ajar_status ajar_write_png(const char *path, const float *rgba, uint32_t width, uint32_t height);
+
+/* ---- Appended API: scene files kept in their folder ------------------------ */
+
+/* How ajar_scene_load_with reads a scene. By default every file the scene
+ * names (buffer and image URIs, the environment image in its extras) must
+ * resolve, after ".." and symbolic links, inside the scene file's folder;
+ * anything else fails with AJAR_ERROR_BAD_INPUT naming the URI. A render
+ * service that renders other people's files keeps this default. */
+typedef struct {
+	int allow_outside_files; /* 1: files anywhere may be read (trusted scenes) */
+} ajar_load_options;
+void ajar_load_options_default(ajar_load_options *o);
+/* ajar_scene_load is ajar_scene_load_with(path, NULL, out): confined. */
+ajar_status ajar_scene_load_with(const char *path, const ajar_load_options *o, ajar_scene **out);
+
+/* ---- Appended API: outputs a denoiser takes ------------------------------- */
+
+/* ajar_options.aov bits. Each AOV is an unbiased pixel average (the same
+ * jittered camera rays as the image), identical across devices, passes,
+ * resumes and integrators. Albedo and normal are those of the first
+ * non-specular hit, through mirrors and smooth glass (as Open Image Denoise
+ * asks); an escaped ray adds zeros. */
+#define AJAR_AOV_ALBEDO 1u   /* base colour (textured), linear RGB */
+#define AJAR_AOV_NORMAL 2u   /* world-space shading normal, toward the viewer */
+#define AJAR_AOV_DEPTH 4u    /* distance from the camera to the first hit */
+#define AJAR_AOV_VARIANCE 8u /* variance of the pixel mean of the pixel's own samples */
+#define AJAR_AOV_ALL 15u
+/* The AOV images: width * height * 10 floats, row-major, top row first:
+ * albedo RGB, normal XYZ, depth, variance RGB (zeros for AOVs not asked
+ * for). ajar_renderer_write_exr adds the asked ones to the EXR as
+ * albedo.R/G/B, normal.X/Y/Z, depth.Z, variance.R/G/B. */
+ajar_status ajar_renderer_aovs(ajar_renderer *r, float *px);
+
+/* ---- Appended API: checkpoint and resume ----------------------------------- */
+
+/* A checkpoint holds a render's films (integer sums, splats, strategy
+ * layers), the sample ranges done, the seed, the options and hashes of the
+ * prepared scene and the render parameters. A render stopped and resumed
+ * any number of times gives the same bits as an uninterrupted one on the
+ * same kind of device. Files are written atomically (temporary name, fsync,
+ * rename): a write that fails keeps the previous file. */
+
+/* Writes r's state to `path`. Not while ajar_renderer_render runs (use
+ * ajar_renderer_set_checkpoint for that); call it after a render returns,
+ * whatever its status, to keep the samples done. */
+ajar_status ajar_renderer_write_checkpoint(ajar_renderer *r, const char *path);
+/* During ajar_renderer_render: write a checkpoint to `path` every
+ * `every_seconds` (0: only when a device is dropped) and when a device is
+ * dropped; the devices wait while it is written. A failed write is a
+ * warning (log callback) and the render goes on. NULL path: none. */
+ajar_status ajar_renderer_set_checkpoint(ajar_renderer *r, const char *path, double every_seconds);
+/* The options a checkpoint was made with (device NULL, width and height
+ * resolved) and, if spp_done is not NULL, the samples per pixel it holds
+ * (then the whole file is checked, else only its header). */
+ajar_status ajar_checkpoint_options(const char *path, ajar_options *o, uint32_t *spp_done);
+/* A renderer that continues the checkpoint at `path`. o NULL: the
+ * checkpoint's options; else o must equal them (ajar_checkpoint_options)
+ * except spp, time_limit (total seconds, the checkpoint's time included)
+ * and device. A checkpoint of another scene, version or parameter set, or
+ * a truncated or corrupted one, is AJAR_ERROR_BAD_INPUT; the file is only
+ * read. */
+ajar_status ajar_renderer_resume(const ajar_scene *scene, const char *path, const ajar_options *o,
+				 ajar_renderer **out);
 
 #ifdef __cplusplus
 }

@@ -1,5 +1,6 @@
 /* ajar.cl — the kernel entry points; everything else is in the headers,
  * which the host also compiles for its tests. */
+#include "aov.h"
 #include "film.h"
 #include "layout.h"
 #include "portal.h"
@@ -14,9 +15,11 @@
  * camera (t = 1) land in other pixels: they go to `splat` with 64-bit
  * atomic adds. The host divides both by the samples per pixel. When
  * Params.strategy_len > 0, bdpt's per-strategy layers follow the splat
- * image in the same buffer. */
+ * image in the same buffer. With aov_at > 0, every sample also adds its
+ * first-hit outputs (AOV_CHANNELS longs per pixel, aov.h) to the AOV film
+ * at splat + aov_at, after the layers; the pixel owns them, as in accum. */
 __kernel void render_pass(AJAR_SCENE_BUFFERS(AJAR_KERNEL_ARG) __global long *accum,
-			  __global long *splat, uint sample_first, uint sample_count)
+			  __global long *splat, uint sample_first, uint sample_count, ulong aov_at)
 {
 	SceneView sc;
 	AJAR_SCENE_BUFFERS(AJAR_VIEW_INIT)
@@ -26,6 +29,9 @@ __kernel void render_pass(AJAR_SCENE_BUFFERS(AJAR_KERNEL_ARG) __global long *acc
 		return;
 	float x = (float)(pixel % (uint)cam->width), y = (float)(pixel / (uint)cam->width);
 	long sum[3] = {0, 0, 0};
+	long aov_sum[AOV_CHANNELS];
+	for (int c = 0; c < AOV_CHANNELS; c++)
+		aov_sum[c] = 0;
 	PathVertex light[SUBPATH_MAX], eye[SUBPATH_MAX], back[SUBPATH_MAX], fwd[SUBPATH_MAX];
 	for (uint i = 0; i < sample_count; i++) {
 		Rng rng = rng_init_pixel(params->seed, pixel, sample_first + i);
@@ -46,10 +52,16 @@ __kernel void render_pass(AJAR_SCENE_BUFFERS(AJAR_KERNEL_ARG) __global long *acc
 		sum[0] += film_fixed(L.x, rng_pcg_f(&rng));
 		sum[1] += film_fixed(L.y, rng_pcg_f(&rng));
 		sum[2] += film_fixed(L.z, rng_pcg_f(&rng));
+		if (aov_at)
+			aov_sample(&sc, cam->pos, camera_ray_dir(cam, x + jx, y + jy), L, pixel, sample_first + i,
+				   aov_sum);
 	}
 	accum[3 * pixel + 0] += sum[0];
 	accum[3 * pixel + 1] += sum[1];
 	accum[3 * pixel + 2] += sum[2];
+	if (aov_at)
+		for (int c = 0; c < AOV_CHANNELS; c++)
+			splat[aov_at + AOV_CHANNELS * (ulong)pixel + c] += aov_sum[c];
 }
 
 /* Sizes and offsets of the shared structs as this compiler lays them out. */

@@ -13,6 +13,18 @@
  * group of intermediate-subpath strategies can sample (pt_cross_weight):
  * the image those strategies must reproduce. */
 
+#ifndef AJAR_PT_H
+#define AJAR_PT_H
+#include "bsdf.h"
+#include "bvh.h"
+#include "camera.h"
+#include "lights.h"
+#include "mis.h"
+#include "portal_geometry.h"
+#include "rng.h"
+#include "roulette.h"
+#include "surface.h"
+
 #define PT_CROSS_EDGES 33
 
 /* The test mode's weight of a path of n segments whose eye-side edges
@@ -27,17 +39,6 @@ INLINE float pt_cross_weight(GLOBAL const Params *prm, const int *cnt, int n, in
 		w += j == n - 1 ? last : (j < PT_CROSS_EDGES ? cnt[j] : 0);
 	return (float)w;
 }
-#ifndef AJAR_PT_H
-#define AJAR_PT_H
-#include "bsdf.h"
-#include "bvh.h"
-#include "camera.h"
-#include "lights.h"
-#include "mis.h"
-#include "portal_geometry.h"
-#include "rng.h"
-#include "roulette.h"
-#include "surface.h"
 
 INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 {

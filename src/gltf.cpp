@@ -15,6 +15,7 @@
 #include <tiny_gltf.h>
 
 #include <cerrno>
+#include <climits>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -23,6 +24,9 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include <stdlib.h>
+#include <unistd.h>
 
 #include "error.h"
 #include "gltf.h"
@@ -46,6 +50,9 @@ struct Loader {
 	std::vector<uint32_t> material_ids; /* glTF material -> scene material */
 	int default_material = -1;
 	std::vector<int> image_textures;    /* glTF image -> scene texture or -1 */
+	bool allow_outside = false; /* files outside the scene's folder may be read */
+	std::string root;           /* the scene's folder, symbolic links resolved */
+	std::string refused;        /* the first message about a file outside root */
 };
 
 ajar_status fail(const Loader &L, ajar_status st, const char *fmt, ...) AJAR_PRINTF(3, 4);
@@ -68,6 +75,63 @@ std::string one_line(std::string m)
 		if (c == '\n')
 			c = ';';
 	return m;
+}
+
+/* ---- Files the scene names ------------------------------------------------
+ * A render farm or a web service renders files other people wrote, so by
+ * default every file a scene names (buffers, images, the environment image)
+ * must resolve, after `..` and symbolic links, inside the scene file's
+ * folder. The first refusal is kept in L.refused and becomes the load's
+ * error (tinygltf itself only says "File not found" or warns). */
+
+/* Whether `path` (which exists) lies inside L.root; sets L.refused if not.
+ * `uri` is how the scene named it, for the message. */
+bool confined(Loader &L, const std::string &path, const std::string &uri)
+{
+	if (L.allow_outside)
+		return true;
+	char real[PATH_MAX];
+	if (!realpath(path.c_str(), real))
+		return false;
+	size_t n = L.root.size();
+	bool inside = strncmp(real, L.root.c_str(), n) == 0 && (real[n] == '\0' || real[n] == '/' || L.root == "/");
+	if (!inside && L.refused.empty())
+		L.refused = "'" + uri + "' resolves to " + real + ", outside the scene's folder " + L.root +
+			    " (allow it with --allow-outside-files or ajar_load_options.allow_outside_files)";
+	return inside;
+}
+
+/* tinygltf joins its base directory (or ".") and the URI; the URI again. */
+std::string uri_of(const Loader &L, const std::string &joined)
+{
+	for (const std::string &base : {L.dir + "/", std::string("./")})
+		if (joined.compare(0, base.size(), base) == 0)
+			return joined.substr(base.size());
+	return joined;
+}
+
+/* An absolute URI is an absolute path, not one under the base directory. */
+std::string fs_expand(const std::string &joined, void *user)
+{
+	std::string uri = uri_of(*(const Loader *)user, joined);
+	return !uri.empty() && uri[0] == '/' ? uri : joined;
+}
+
+bool fs_exists(const std::string &path, void *user)
+{
+	Loader &L = *(Loader *)user;
+	return tg::FileExists(path, nullptr) && confined(L, path, uri_of(L, path));
+}
+
+bool fs_read(std::vector<unsigned char> *out, std::string *err, const std::string &path, void *user)
+{
+	Loader &L = *(Loader *)user;
+	if (!confined(L, path, uri_of(L, path))) {
+		if (err)
+			*err += "outside the scene's folder\n";
+		return false;
+	}
+	return tg::ReadWholeFile(out, err, path, nullptr);
 }
 
 /* ---- Accessors ---------------------------------------------------------- */
@@ -443,6 +507,8 @@ ajar_status read_environment(Loader &L, const tg::Value &extras, const char *whe
 		std::string path = name[0] == '/' ? name : L.dir + "/" + name;
 		float *rgba = nullptr;
 		uint32_t w = 0, h = 0;
+		if (access(path.c_str(), F_OK) == 0 && !confined(L, path, name))
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s.extras.environment.image: %s", where, L.refused.c_str());
 		ajar_status st = ajar_read_exr(path.c_str(), &rgba, &w, &h);
 		if (st) {
 			std::string msg = ajar_last_error();
@@ -1193,11 +1259,15 @@ ajar_status load(Loader &L)
 	tg::TinyGLTF loader;
 	std::string err, warn;
 	bool ok;
+	tg::FsCallbacks fs = {fs_exists, fs_expand, fs_read, tg::WriteWholeFile, &L};
+	loader.SetFsCallbacks(fs);
 	if (data.size() >= 4 && memcmp(data.data(), "glTF", 4) == 0)
 		ok = loader.LoadBinaryFromMemory(&L.model, &err, &warn, data.data(), (unsigned)data.size(), L.dir);
 	else
 		ok = loader.LoadASCIIFromString(&L.model, &err, &warn, (const char *)data.data(), (unsigned)data.size(),
 						L.dir);
+	if (!L.refused.empty())
+		return fail(L, AJAR_ERROR_BAD_INPUT, "%s", L.refused.c_str());
 	if (!warn.empty())
 		log_msg(AJAR_LOG_WARNING, "%s: %s", L.file, one_line(warn).c_str());
 	if (!ok)
@@ -1253,7 +1323,9 @@ ajar_status load(Loader &L)
 
 } // namespace
 
-extern "C" ajar_status gltf_load(const char *path, Scene **out)
+extern "C" ajar_status gltf_load(const char *path, Scene **out) { return gltf_load_with(path, 0, out); }
+
+extern "C" ajar_status gltf_load_with(const char *path, int allow_outside_files, Scene **out)
 {
 	*out = nullptr;
 	Scene *s = nullptr;
@@ -1268,6 +1340,9 @@ extern "C" ajar_status gltf_load(const char *path, Scene **out)
 		L.dir = slash ? std::string(path, (size_t)(slash - path)) : std::string(".");
 		if (L.dir.empty())
 			L.dir = "/";
+		L.allow_outside = allow_outside_files != 0;
+		char real[PATH_MAX];
+		L.root = realpath(L.dir.c_str(), real) ? real : L.dir;
 		st = load(L);
 	} catch (const std::bad_alloc &) {
 		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);

@@ -18,6 +18,10 @@ extern "C" {
  * A file that cannot be read is AJAR_ERROR_IO; anything malformed is
  * AJAR_ERROR_BAD_INPUT with a message naming the file and the element. */
 ajar_status gltf_load(const char *path, Scene **out);
+/* The same; files the scene names (buffers, images, the environment image)
+ * must resolve inside the scene file's folder unless allow_outside_files
+ * (AJAR_ERROR_BAD_INPUT naming the URI otherwise). gltf_load confines. */
+ajar_status gltf_load_with(const char *path, int allow_outside_files, Scene **out);
 
 #ifdef __cplusplus
 }

@@ -44,10 +44,6 @@ ajar_status lights_build(const Scene *s, Tri *tris, const TriShade *shade, const
 			 LightTables *out);
 void lights_free(LightTables *t);
 
-/* Whether triangle i of v (tris, shade, extra, textures, texels set) can
- * emit anywhere with emissive texture `tex`: some texel its lookups can
- * read is not black. Triangles that cannot are no emitters. */
-int lights_can_emit(const SceneView *v, uint32_t i, int tex);
 
 /* cdf[0..n] from n non-negative weights (summed in double). With a zero
  * total the table is uniform if `uniform_if_empty`, else all zeros (which

@@ -7,6 +7,7 @@
 #include "error.h"
 #include "exr.h"
 #include "render_info.h"
+#include "../kernels/aov_layout.h"
 #include "../kernels/compat.h"
 #include "../kernels/film.h"
 #include "../kernels/strategies.h"
@@ -46,6 +47,43 @@ static uint32_t header_fill(ajar_renderer *r, Header *h)
 	return sizeof kv / sizeof kv[0] / 2;
 }
 
+/* RGBA plus the AOVs asked for, as the channels denoisers read. */
+static ajar_status write_with_aovs(ajar_renderer *r, const char *path, const float *rgba, const Header *h,
+				   uint32_t nattrs)
+{
+	static const struct {
+		uint32_t bit;
+		int first, count;
+		const char *names[3];
+	} groups[] = {{AJAR_AOV_ALBEDO, 0, 3, {"albedo.R", "albedo.G", "albedo.B"}},
+		      {AJAR_AOV_NORMAL, 3, 3, {"normal.X", "normal.Y", "normal.Z"}},
+		      {AJAR_AOV_DEPTH, 6, 1, {"depth.Z"}},
+		      {AJAR_AOV_VARIANCE, 7, 3, {"variance.R", "variance.G", "variance.B"}}};
+	const char *names[4 + AOV_CHANNELS] = {"R", "G", "B", "A"};
+	int src[4 + AOV_CHANNELS], nch = 4;
+	for (size_t g = 0; g < sizeof groups / sizeof groups[0]; g++)
+		if (h->info.aov & groups[g].bit)
+			for (int c = 0; c < groups[g].count; c++) {
+				src[nch] = groups[g].first + c;
+				names[nch++] = groups[g].names[c];
+			}
+	size_t npix = (size_t)h->info.width * h->info.height;
+	float *aov = malloc(sizeof(float) * AOV_CHANNELS * npix), *px = malloc(sizeof(float) * (size_t)nch * npix);
+	ajar_status st = !aov || !px ? err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory for the AOVs", path)
+				     : ajar_renderer_aovs(r, aov);
+	if (st == AJAR_OK) {
+		for (size_t i = 0; i < npix; i++) {
+			memcpy(&px[nch * i], &rgba[4 * i], 4 * sizeof(float));
+			for (int c = 4; c < nch; c++)
+				px[nch * i + c] = aov[AOV_CHANNELS * i + src[c]];
+		}
+		st = exr_write_channels(path, px, nch, names, h->info.width, h->info.height, h->kv, nattrs);
+	}
+	free(aov);
+	free(px);
+	return st;
+}
+
 ajar_status ajar_renderer_write_exr(ajar_renderer *r, const char *path)
 {
 	float *rgba;
@@ -56,7 +94,10 @@ ajar_status ajar_renderer_write_exr(ajar_renderer *r, const char *path)
 	if ((st = read_image(r, &rgba)) != AJAR_OK)
 		return st;
 	uint32_t n = header_fill(r, &h);
-	st = ajar_write_exr(path, rgba, h.info.width, h.info.height, h.kv, n);
+	if (h.info.aov)
+		st = write_with_aovs(r, path, rgba, &h, n);
+	else
+		st = ajar_write_exr(path, rgba, h.info.width, h.info.height, h.kv, n);
 	free(rgba);
 	return st;
 }

@@ -149,7 +149,7 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	 * portals) do their work, and the portal integrator leaves them out. */
 	p->light_paths = p->integrator != INTEGRATOR_PORTAL || p->num_emitters > 0;
 	/* The intermediate strategies in use (kernels/portal.h), chosen by
-	 * measurement (README, "Integrators"). Where the sky is the only
+	 * measurement (kernels/README.md, "portal"). Where the sky is the only
 	 * light, next-event estimation through the portals takes the direct
 	 * light, and short halves and eye parts of at most 3 vertices do best;
 	 * with emitters behind an opening (door-ajar) the intermediate
@@ -177,8 +177,8 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	if (!p->light_paths && p->portal_s_max > 1)
 		p->portal_s_max = 1; /* larger s needs light subpaths */
 	/* How often a pixel sample traces an intermediate subpath (mis.h,
-	 * MisPortalSet), chosen by measurement at equal time (README,
-	 * Results): with next-event estimation through the portals, the sky
+	 * MisPortalSet), chosen by measurement at equal time (kernels/README.md,
+	 * "portal"): with next-event estimation through the portals, the sky
 	 * needs them seldom; light from emitters behind an opening more often.
 	 * AJAR_PORTAL_RATE in (0, 1] overrides it. Layers without MIS weights
 	 * (tests) take every intermediate subpath. */

@@ -28,7 +28,7 @@ typedef struct {
 } PrepareOptions;
 
 /* The portal integrator's default rates of intermediate subpaths, in
- * scenes lit only by the sky and with emitters (README, Results);
+ * scenes lit only by the sky and with emitters (kernels/README.md, "portal");
  * AJAR_PORTAL_RATE overrides them. */
 #define PORTAL_RATE_SKY 0.1f
 #define PORTAL_RATE_EMITTERS 1.0f

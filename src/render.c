@@ -29,6 +29,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "checkpoint.h"
 #include "device.h"
 #include "error.h"
 #include "exr.h"
@@ -37,6 +38,7 @@
 #include "scene.h"
 #include "render_info.h"
 #include "upload.h"
+#include "../kernels/aov_layout.h"
 #include "../kernels/compat.h"
 #include "../kernels/film.h"
 #include "../kernels/strategies.h"
@@ -45,9 +47,7 @@
 #define DEFAULT_WIDTH 512
 #define MAX_RENDER_DEVICES 16
 
-typedef struct {
-	uint32_t first, count;
-} Range;
+typedef SampleRange Range;
 
 typedef struct {
 	Range *r;
@@ -108,6 +108,15 @@ struct ajar_renderer {
 	int out_of_memory;
 	RenderDevice *last_dropped;
 	double t0;
+	/* Checkpoints (see "Checkpoints" below): */
+	ajar_options opt;     /* resolved, device NULL: what a checkpoint records */
+	RangeList base;       /* ranges of the checkpoint resumed from, held in salvage */
+	char *ckpt_path;      /* written during ajar_renderer_render, or NULL */
+	double ckpt_every, ckpt_last;
+	int pausing;          /* under the lock: no device takes a new range */
+	int hashed;
+	uint64_t scene_hash, params_hash;
+	uint32_t pass_cap; /* test hook AJAR_TEST_PASS_SPP: at most this many samples per pass */
 };
 
 static double seconds(void)
@@ -177,6 +186,8 @@ static ajar_status check_options(const ajar_options *in, ajar_options *out)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "set a sample count or a time limit");
 	if (o->time_limit < 0 || o->time_limit != o->time_limit)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "time limit must be positive");
+	if (o->aov & ~AJAR_AOV_ALL)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "aov: unknown bits 0x%x", o->aov & ~AJAR_AOV_ALL);
 	return AJAR_OK;
 }
 
@@ -200,8 +211,18 @@ static size_t film_bytes(const ajar_renderer *r)
 	return sizeof(cl_long) * 3 * (size_t)r->width * r->height;
 }
 
-/* The splat film, followed by bdpt's per-strategy layers if asked for. */
-static size_t splat_bytes(const ajar_renderer *r) { return film_bytes(r) * (1 + (size_t)r->nlayers); }
+/* Longs before the AOV film in the splat buffer: the splats and layers. */
+static size_t aov_offset(const ajar_renderer *r) { return 3 * (size_t)r->width * r->height * (1 + (size_t)r->nlayers); }
+
+/* The splat film, followed by bdpt's per-strategy layers if asked for and
+ * the first-hit AOVs (aov.h) if asked for: own-pixel sums, but kept here
+ * so every path that reads, salvages, sums and checkpoints films has them. */
+static size_t splat_count(const ajar_renderer *r)
+{
+	return aov_offset(r) + (r->opt.aov ? (size_t)AOV_CHANNELS * r->width * r->height : 0);
+}
+
+static size_t splat_bytes(const ajar_renderer *r) { return sizeof(cl_long) * splat_count(r); }
 
 /* Context, program, scene and films on one device. */
 static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_id plat, cl_device_id id)
@@ -211,7 +232,7 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 	cl_long zero = 0;
 	size_t bytes = film_bytes(r), sbytes = splat_bytes(r);
 	/* One program per integrator (see PARAMS_INTEGRATOR), built with
-	 * device_build_options and what AJAR_CL_OPTIONS adds (README, GPUs). */
+	 * device_build_options and what AJAR_CL_OPTIONS adds (kernels/README.md, "On GPUs"). */
 	const char *extra = getenv("AJAR_CL_OPTIONS");
 	char options[512];
 	if (extra && strlen(extra) > 400)
@@ -240,6 +261,9 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 	CL_TRY(d, clEnqueueFillBuffer(d->queue, rd->splat, &zero, sizeof zero, 0, sbytes, 0, NULL, NULL));
 	CL_TRY(d, clSetKernelArg(rd->k_render, rd->arg_first, sizeof(cl_mem), &rd->accum));
 	CL_TRY(d, clSetKernelArg(rd->k_render, rd->arg_first + 1, sizeof(cl_mem), &rd->splat));
+	/* The AOV film: the same buffer, after the layers (the kernel adds aov_at). */
+	cl_ulong aov_at = r->opt.aov ? aov_offset(r) : 0;
+	CL_TRY(d, clSetKernelArg(rd->k_render, rd->arg_first + 4, sizeof aov_at, &aov_at));
 	CL_TRY(d, clFinish(d->queue));
 	/* An explicit work-group size, measured on PoCL 3.1's CPU device (2
 	 * cores, 128x128 path tracing, first pass = PoCL's cold work-group
@@ -325,7 +349,14 @@ static ajar_status open_devices(ajar_renderer *r, const char *selector)
 	return AJAR_OK;
 }
 
-ajar_status ajar_renderer_create(const ajar_scene *scene, const ajar_options *opt, ajar_renderer **out)
+static ajar_status checkpoint_check(ajar_renderer *r, const Checkpoint *c, const char *path);
+static ajar_status checkpoint_apply(ajar_renderer *r, Checkpoint *c, const char *path);
+
+/* ajar_renderer_create, and ajar_renderer_resume with the checkpoint c read
+ * from `path`: refused after the scene is prepared (its hash), before any
+ * kernel is built; applied once the films exist. */
+static ajar_status renderer_new(const ajar_scene *scene, const ajar_options *opt, Checkpoint *ck,
+				const char *ck_path, ajar_renderer **out)
 {
 	ajar_status st;
 	ajar_options defaults, resolved;
@@ -357,24 +388,41 @@ ajar_status ajar_renderer_create(const ajar_scene *scene, const ajar_options *op
 		r->nlayers += portal_layer_count((int)opt->strategy_len);
 	r->strategy_unweighted = opt->strategy_unweighted;
 	r->strategy_len = (int)opt->strategy_len;
+	r->opt = *opt;
+	r->opt.device = NULL;
+	/* Test hook: AJAR_TEST_PASS_SPP=N caps every pass at N samples per
+	 * pixel, so tests can stop a render at many points. */
+	const char *cap = getenv("AJAR_TEST_PASS_SPP");
+	r->pass_cap = cap ? (uint32_t)strtoul(cap, NULL, 10) : 0;
+	r->opt.width = r->width;
+	r->opt.height = r->height;
 	snprintf(r->scene_name, sizeof r->scene_name, "%s", scene->source ? scene->source : "");
 	PrepareOptions po = {r->width, r->height, (int)opt->integrator, opt->max_depth, opt->seed,
 			     (int)opt->mis, opt->min_depth, opt->strategy_len, opt->strategy_unweighted};
 	if ((st = prepare_scene(scene, &po, &r->data)) != AJAR_OK)
 		goto fail;
+	if (ck && (st = checkpoint_check(r, ck, ck_path)) != AJAR_OK)
+		goto fail;
 	if ((st = open_devices(r, opt->device)) != AJAR_OK)
 		goto fail;
 	r->film = calloc(3 * (size_t)r->width * r->height, sizeof *r->film);
-	r->film_splat = calloc(3 * (size_t)r->width * r->height * (1 + (size_t)r->nlayers), sizeof *r->film_splat);
+	r->film_splat = calloc(splat_count(r), sizeof *r->film_splat);
 	if (!r->film || !r->film_splat) {
 		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory for a %ux%u image", r->width, r->height);
 		goto fail;
 	}
+	if (ck && (st = checkpoint_apply(r, ck, ck_path)) != AJAR_OK)
+		goto fail;
 	*out = r;
 	return AJAR_OK;
 fail:
 	ajar_renderer_destroy(&r);
 	return st;
+}
+
+ajar_status ajar_renderer_create(const ajar_scene *scene, const ajar_options *opt, ajar_renderer **out)
+{
+	return renderer_new(scene, opt, NULL, NULL, out);
 }
 
 void ajar_renderer_destroy(ajar_renderer **rp)
@@ -391,6 +439,8 @@ void ajar_renderer_destroy(ajar_renderer **rp)
 	free(r->salvage);
 	free(r->salvage_splat);
 	free(r->holes.r);
+	free(r->base.r);
+	free(r->ckpt_path);
 	pthread_cond_destroy(&r->cond);
 	pthread_mutex_destroy(&r->lock);
 	free(r);
@@ -421,7 +471,10 @@ ajar_status ajar_renderer_restart(ajar_renderer *r, uint32_t seed)
 	free(r->salvage_splat);
 	r->salvage = r->salvage_splat = NULL;
 	r->holes.n = 0;
+	r->base.n = 0;
 	r->seed = seed;
+	r->opt.seed = seed;
+	r->hashed = 0;
 	r->spp_done = r->next_first = 0;
 	r->elapsed = 0;
 	atomic_store(&r->cancel, 0);
@@ -509,6 +562,8 @@ static int take_range(ajar_renderer *r, RenderDevice *rd, Range *g)
 				count = (uint32_t)share;
 		}
 	}
+	if (r->pass_cap && count > r->pass_cap)
+		count = r->pass_cap;
 	if (r->holes.n) {
 		Range *h = &r->holes.r[r->holes.n - 1];
 		g->first = h->first;
@@ -588,7 +643,7 @@ static int read_films(RenderDevice *rd, long **accum, long **splat)
 /* Adds a dropped device's films to the salvage (under the lock); 0 if out of memory. */
 static int salvage_add(ajar_renderer *r, const long *accum, const long *splat)
 {
-	size_t n = 3 * (size_t)r->width * r->height, ns = n * (1 + (size_t)r->nlayers);
+	size_t n = 3 * (size_t)r->width * r->height, ns = splat_count(r);
 	if (!r->salvage) {
 		r->salvage = calloc(n, sizeof *r->salvage);
 		r->salvage_splat = calloc(ns, sizeof *r->salvage_splat);
@@ -632,6 +687,10 @@ static void *device_thread(void *arg)
 	pthread_mutex_lock(&r->lock);
 	for (;;) {
 		Range g;
+		if (r->pausing) { /* a checkpoint is being written */
+			pthread_cond_wait(&r->cond, &r->lock);
+			continue;
+		}
 		if (!take_range(r, rd, &g)) {
 			/* A pass in flight elsewhere may still fail and return its range. */
 			if (r->in_flight == 0 || stopping(r))
@@ -712,9 +771,11 @@ static void fill_progress(const ajar_renderer *r, ajar_progress *p)
 		p->eta = p->eta < 0 ? fmax(0.0, r->time_limit - elapsed) : fmin(p->eta, fmax(0.0, r->time_limit - elapsed));
 }
 
-/* Logs a warning for every device dropped since the last call (unlocked). */
-static void report_drops(ajar_renderer *r)
+/* Logs a warning for every device dropped since the last call (unlocked);
+ * returns how many. */
+static int report_drops(ajar_renderer *r)
 {
+	int drops = 0;
 	for (uint32_t i = 0; i < r->ndev; i++) {
 		RenderDevice *rd = &r->devs[i];
 		pthread_mutex_lock(&r->lock);
@@ -723,13 +784,17 @@ static void report_drops(ajar_renderer *r)
 		for (uint32_t j = 0; j < r->ndev; j++)
 			left += r->devs[j].alive;
 		rd->reported |= fresh;
+		drops += fresh;
 		pthread_mutex_unlock(&r->lock);
 		if (fresh && left)
 			log_msg(AJAR_LOG_WARNING,
 				"device %s (%s) dropped: %s; its unfinished samples go to the %u other device%s",
 				rd->dev.name, rd->dev.selector, rd->error, left, left == 1 ? "" : "s");
 	}
+	return drops;
 }
+
+static void checkpoint_during(ajar_renderer *r);
 
 ajar_status ajar_renderer_render(ajar_renderer *r, ajar_progress_fn fn, void *user)
 {
@@ -737,6 +802,7 @@ ajar_status ajar_renderer_render(ajar_renderer *r, ajar_progress_fn fn, void *us
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_render: renderer is NULL");
 	pthread_mutex_lock(&r->lock);
 	r->t0 = seconds() - r->elapsed;
+	r->ckpt_last = seconds();
 	r->running = 0;
 	for (uint32_t i = 0; i < r->ndev; i++) {
 		RenderDevice *rd = &r->devs[i];
@@ -762,10 +828,14 @@ ajar_status ajar_renderer_render(ajar_renderer *r, ajar_progress_fn fn, void *us
 		ajar_progress p;
 		fill_progress(r, &p);
 		pthread_mutex_unlock(&r->lock);
-		report_drops(r);
+		int dropped = report_drops(r);
 		if (callbacks && !atomic_load(&r->cancel) && fn(&p, user))
 			ajar_renderer_cancel(r);
 		pthread_mutex_lock(&r->lock);
+		/* After a cancel the caller writes the last checkpoint itself. */
+		if (r->ckpt_path && !stopping(r) && work_left(r) > 0 &&
+		    (dropped || seconds() - r->ckpt_last >= r->ckpt_every))
+			checkpoint_during(r);
 		pthread_cond_broadcast(&r->cond); /* wakes idle devices after a cancel */
 	}
 	pthread_mutex_unlock(&r->lock);
@@ -802,6 +872,8 @@ ajar_status ajar_renderer_render(ajar_renderer *r, ajar_progress_fn fn, void *us
 
 /* ---- Reduction and output --------------------------------------------------- */
 
+static ajar_status reduce(ajar_renderer *r);
+
 ajar_status ajar_renderer_image(ajar_renderer *r, float *rgba, uint32_t *width, uint32_t *height)
 {
 	if (!r)
@@ -812,7 +884,58 @@ ajar_status ajar_renderer_image(ajar_renderer *r, float *rgba, uint32_t *width, 
 		*height = r->height;
 	if (!rgba)
 		return AJAR_OK;
-	size_t n = 3 * (size_t)r->width * r->height, ns = n * (1 + (size_t)r->nlayers);
+	ajar_status st = reduce(r);
+	if (st != AJAR_OK)
+		return st;
+	size_t n = 3 * (size_t)r->width * r->height;
+	long *sum = r->film, *sum_splat = r->film_splat;
+	double scale = r->spp_done ? 1.0 / ((double)FILM_SCALE * r->spp_done) : 0.0;
+	for (size_t i = 0; i < n / 3; i++) {
+		for (int c = 0; c < 3; c++)
+			rgba[4 * i + c] = (float)((double)(sum[3 * i + c] + sum_splat[3 * i + c]) * scale);
+		rgba[4 * i + 3] = 1.0f;
+	}
+	return AJAR_OK;
+}
+
+ajar_status ajar_renderer_aovs(ajar_renderer *r, float *px)
+{
+	if (!r || !px)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_aovs: NULL argument");
+	if (!r->opt.aov)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "the renderer keeps no AOVs (set ajar_options.aov)");
+	ajar_status st = reduce(r);
+	if (st != AJAR_OK)
+		return st;
+	size_t npix = (size_t)r->width * r->height;
+	const long *a = r->film_splat + aov_offset(r);
+	double n = r->spp_done, inv = n > 0 ? 1.0 / ((double)FILM_SCALE * n) : 0.0;
+	double inv_sq = n > 0 ? 1.0 / ((double)AOV_SQ_SCALE * n) : 0.0;
+	static const uint32_t bit[AOV_CHANNELS] = {AJAR_AOV_ALBEDO, AJAR_AOV_ALBEDO, AJAR_AOV_ALBEDO,
+						   AJAR_AOV_NORMAL, AJAR_AOV_NORMAL, AJAR_AOV_NORMAL,
+						   AJAR_AOV_DEPTH,  AJAR_AOV_VARIANCE, AJAR_AOV_VARIANCE,
+						   AJAR_AOV_VARIANCE};
+	for (size_t i = 0; i < npix; i++) {
+		const long *p = a + AOV_CHANNELS * i;
+		float *o = px + AOV_CHANNELS * i;
+		for (int c = 0; c < 7; c++)
+			o[c] = (r->opt.aov & bit[c]) ? (float)((double)p[c] * inv) : 0.0f;
+		/* Sample variance of the pixel's own estimates over n, from
+		 * sum(x) (the own-pixel film) and sum(x^2). */
+		for (int c = 0; c < 3; c++) {
+			double m = (double)r->film[3 * i + c] * inv, m2 = (double)p[7 + c] * inv_sq;
+			o[7 + c] = (r->opt.aov & AJAR_AOV_VARIANCE) && n > 1 ? (float)(fmax(0.0, m2 - m * m) / (n - 1))
+									       : 0.0f;
+		}
+	}
+	return AJAR_OK;
+}
+
+/* Sums the salvage and every live device's films into r->film and
+ * r->film_splat: integer sums, the same bits whatever the device count. */
+static ajar_status reduce(ajar_renderer *r)
+{
+	size_t n = 3 * (size_t)r->width * r->height, ns = splat_count(r);
 	long *sum = r->film, *sum_splat = r->film_splat;
 	if (r->salvage) {
 		memcpy(sum, r->salvage, n * sizeof *sum);
@@ -836,12 +959,6 @@ ajar_status ajar_renderer_image(ajar_renderer *r, float *rgba, uint32_t *width, 
 			sum_splat[i] += s[i];
 		free(a);
 		free(s);
-	}
-	double scale = r->spp_done ? 1.0 / ((double)FILM_SCALE * r->spp_done) : 0.0;
-	for (size_t i = 0; i < n / 3; i++) {
-		for (int c = 0; c < 3; c++)
-			rgba[4 * i + c] = (float)((double)(sum[3 * i + c] + sum_splat[3 * i + c]) * scale);
-		rgba[4 * i + 3] = 1.0f;
 	}
 	return AJAR_OK;
 }
@@ -868,9 +985,294 @@ void render_info(const ajar_renderer *r, RenderInfo *info)
 	info->strategy_len = r->strategy_len;
 	info->strategy_unweighted = r->strategy_unweighted;
 	info->layers = r->film_splat + 3 * (size_t)r->width * r->height;
+	info->aov = r->opt.aov;
 }
 
 ajar_status ajar_devices(ajar_device_info *out, uint32_t capacity, uint32_t *count)
 {
 	return device_list(out, capacity, count);
+}
+
+/* ---- Checkpoints ------------------------------------------------------------
+ * A checkpoint holds the reduced integer films and the sample ranges they
+ * hold. Resumed, the films become the salvage (the host part every image
+ * adds), the ranges the base, and the gaps below the highest range go back
+ * to the pool, so the continued render hands out exactly the sample indices
+ * an uninterrupted one would have: the sums, and so the image, are the same
+ * bits. The scene hash covers the prepared arrays (what the kernels read:
+ * geometry, materials, textures, environment, light tables), the params
+ * hash the kernels' parameters (options and derived rates). */
+
+static void ensure_hashes(ajar_renderer *r)
+{
+	if (r->hashed)
+		return;
+	const SceneData *d = &r->data;
+	uint64_t h = 0;
+#define AJAR_HASH_FIELD(type, name) \
+	if ((void *)d->name != (void *)d->params) \
+		h = checkpoint_hash(h, d->name, sizeof(type) * d->n_##name);
+	AJAR_SCENE_BUFFERS(AJAR_HASH_FIELD)
+#undef AJAR_HASH_FIELD
+	r->scene_hash = h;
+	r->params_hash = checkpoint_hash(0, d->params, sizeof *d->params);
+	r->hashed = 1;
+}
+
+static int range_before(const void *a, const void *b)
+{
+	const Range *x = a, *y = b;
+	return x->first < y->first ? -1 : x->first > y->first;
+}
+
+/* The checkpoint of r now (films reduced; c->ranges malloc'ed, the films
+ * borrowed from r). Devices must be idle. */
+static ajar_status checkpoint_gather(ajar_renderer *r, Checkpoint *c)
+{
+	memset(c, 0, sizeof *c);
+	ajar_status st = reduce(r);
+	if (st != AJAR_OK)
+		return st;
+	ensure_hashes(r);
+	snprintf(c->version, sizeof c->version, "%s", AJAR_VERSION_STRING);
+	snprintf(c->scene, sizeof c->scene, "%s", r->scene_name);
+	c->scene_hash = r->scene_hash;
+	c->params_hash = r->params_hash;
+	const ajar_options *o = &r->opt;
+	c->width = r->width;
+	c->height = r->height;
+	c->integrator = (uint32_t)o->integrator;
+	c->max_depth = o->max_depth;
+	c->min_depth = o->min_depth;
+	c->seed = r->seed;
+	c->mis = (uint32_t)o->mis;
+	c->strategy_len = o->strategy_len;
+	c->strategy_unweighted = (uint32_t)o->strategy_unweighted;
+	c->spp = r->spp_target;
+	c->aov = o->aov;
+	c->time_limit = r->time_limit;
+	c->elapsed = r->elapsed;
+	size_t n = r->base.n;
+	for (uint32_t i = 0; i < r->ndev; i++)
+		n += r->devs[i].done.n;
+	c->ranges = malloc(sizeof *c->ranges * (n ? n : 1));
+	if (!c->ranges)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory for a checkpoint");
+	memcpy(c->ranges, r->base.r, sizeof *c->ranges * r->base.n);
+	n = r->base.n;
+	for (uint32_t i = 0; i < r->ndev; i++) {
+		memcpy(c->ranges + n, r->devs[i].done.r, sizeof *c->ranges * r->devs[i].done.n);
+		n += r->devs[i].done.n;
+	}
+	qsort(c->ranges, n, sizeof *c->ranges, range_before);
+	uint64_t total = 0;
+	c->nranges = 0;
+	for (size_t i = 0; i < n; i++) {
+		Range *last = c->nranges ? &c->ranges[c->nranges - 1] : NULL;
+		total += c->ranges[i].count;
+		if (last && last->first + last->count == c->ranges[i].first)
+			last->count += c->ranges[i].count;
+		else
+			c->ranges[c->nranges++] = c->ranges[i];
+	}
+	if (total != r->spp_done) { /* every sample index in the films is in exactly one range */
+		free(c->ranges);
+		c->ranges = NULL;
+		return err_set(AJAR_ERROR_DEVICE, "checkpoint: the films hold %u samples per pixel, the ranges %llu",
+			       r->spp_done, (unsigned long long)total);
+	}
+	c->film[CKPT_ACCUM] = r->film;
+	c->nfilm[CKPT_ACCUM] = 3 * (size_t)r->width * r->height;
+	c->film[CKPT_SPLAT] = r->film_splat;
+	c->nfilm[CKPT_SPLAT] = aov_offset(r);
+	c->film[CKPT_AOV] = r->film_splat + aov_offset(r);
+	c->nfilm[CKPT_AOV] = splat_count(r) - aov_offset(r);
+	return AJAR_OK;
+}
+
+static ajar_status write_checkpoint(ajar_renderer *r, const char *path)
+{
+	Checkpoint c;
+	ajar_status st = checkpoint_gather(r, &c);
+	if (st == AJAR_OK)
+		st = checkpoint_write(path, &c);
+	free(c.ranges);
+	return st;
+}
+
+ajar_status ajar_renderer_write_checkpoint(ajar_renderer *r, const char *path)
+{
+	if (!r || !path || !path[0])
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_write_checkpoint: NULL argument");
+	return write_checkpoint(r, path);
+}
+
+/* From the render loop, under the lock: waits until no pass is in flight,
+ * sums the films, lets the devices go on and writes the file meanwhile
+ * (the sums are the main thread's own arrays). A failed write keeps the
+ * previous file. */
+static void checkpoint_during(ajar_renderer *r)
+{
+	r->pausing = 1;
+	while (r->in_flight > 0)
+		pthread_cond_wait(&r->cond, &r->lock);
+	pthread_mutex_unlock(&r->lock);
+	r->elapsed = seconds() - r->t0;
+	Checkpoint c;
+	ajar_status st = checkpoint_gather(r, &c);
+	pthread_mutex_lock(&r->lock);
+	r->pausing = 0;
+	pthread_cond_broadcast(&r->cond);
+	pthread_mutex_unlock(&r->lock);
+	if (st == AJAR_OK)
+		st = checkpoint_write(r->ckpt_path, &c);
+	free(c.ranges);
+	if (st != AJAR_OK)
+		log_msg(AJAR_LOG_WARNING, "checkpoint not written (the previous one is kept): %s", ajar_last_error());
+	r->ckpt_last = seconds();
+	pthread_mutex_lock(&r->lock);
+}
+
+ajar_status ajar_renderer_set_checkpoint(ajar_renderer *r, const char *path, double every)
+{
+	if (!r)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_set_checkpoint: renderer is NULL");
+	if (!(every >= 0) || every > 1e9)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "checkpoint interval %g s: must be 0 or more", every);
+	char *p = path && path[0] ? strdup(path) : NULL;
+	if (path && path[0] && !p)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory");
+	free(r->ckpt_path);
+	r->ckpt_path = p;
+	r->ckpt_every = every > 0 ? every : 1e30;
+	return AJAR_OK;
+}
+
+static void options_from_checkpoint(const Checkpoint *c, ajar_options *o)
+{
+	ajar_options_default(o);
+	o->width = c->width;
+	o->height = c->height;
+	o->spp = c->spp;
+	o->time_limit = c->time_limit;
+	o->integrator = (ajar_integrator)c->integrator;
+	o->max_depth = c->max_depth;
+	o->min_depth = c->min_depth;
+	o->seed = c->seed;
+	o->mis = (ajar_mis)c->mis;
+	o->strategy_len = c->strategy_len;
+	o->strategy_unweighted = (int)c->strategy_unweighted;
+	o->aov = c->aov;
+}
+
+ajar_status ajar_checkpoint_options(const char *path, ajar_options *o, uint32_t *spp_done)
+{
+	if (!path || !o)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_checkpoint_options: NULL argument");
+	Checkpoint c;
+	ajar_status st = checkpoint_read(path, &c, spp_done == NULL);
+	if (st != AJAR_OK)
+		return st;
+	options_from_checkpoint(&c, o);
+	if (spp_done) {
+		uint64_t n = 0;
+		for (uint32_t i = 0; i < c.nranges; i++)
+			n += c.ranges[i].count;
+		*spp_done = (uint32_t)n;
+	}
+	checkpoint_free(&c);
+	return AJAR_OK;
+}
+
+static ajar_status checkpoint_check(ajar_renderer *r, const Checkpoint *c, const char *path)
+{
+	ensure_hashes(r);
+	if (c->scene_hash != r->scene_hash)
+		return err_set(AJAR_ERROR_BAD_INPUT,
+			       "%s: checkpoint is of another scene (it was made from %s, and this scene differs from it); "
+			       "it cannot be resumed here",
+			       path, c->scene[0] ? c->scene : "?");
+	if (c->params_hash != r->params_hash)
+		return err_set(AJAR_ERROR_BAD_INPUT,
+			       "%s: checkpoint was made with other render parameters (the options agree, so an "
+			       "environment variable such as AJAR_PORTAL_RATE differs); it cannot be resumed here",
+			       path);
+	return AJAR_OK;
+}
+
+static ajar_status checkpoint_apply(ajar_renderer *r, Checkpoint *c, const char *path)
+{
+	size_t n = 3 * (size_t)r->width * r->height, ns = aov_offset(r);
+	if (c->nfilm[CKPT_ACCUM] != n || c->nfilm[CKPT_SPLAT] != ns || c->nfilm[CKPT_AOV] != splat_count(r) - ns)
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: checkpoint is corrupted (film sizes)", path);
+	long *splat = realloc(c->film[CKPT_SPLAT], sizeof *splat * (splat_count(r) ? splat_count(r) : 1));
+	if (!splat)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory");
+	memcpy(splat + ns, c->film[CKPT_AOV], sizeof *splat * (splat_count(r) - ns));
+	c->film[CKPT_SPLAT] = splat;
+	uint32_t end = 0;
+	uint64_t done = 0;
+	for (uint32_t i = 0; i < c->nranges; i++) {
+		Range g = c->ranges[i];
+		if (g.first > end && !ranges_push(&r->holes, (Range){end, g.first - end}))
+			return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory");
+		if (!ranges_push(&r->base, g))
+			return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory");
+		end = g.first + g.count;
+		done += g.count;
+	}
+	if (r->spp_target && r->spp_target < end)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT,
+			       "%s: the checkpoint holds %llu samples per pixel (indices up to %u); a sample count of %u "
+			       "is too few to continue it",
+			       path, (unsigned long long)done, end, r->spp_target);
+	r->salvage = c->film[CKPT_ACCUM];
+	r->salvage_splat = c->film[CKPT_SPLAT];
+	c->film[CKPT_ACCUM] = c->film[CKPT_SPLAT] = NULL;
+	r->spp_done = (uint32_t)done;
+	r->next_first = end;
+	r->elapsed = c->elapsed;
+	return AJAR_OK;
+}
+
+ajar_status ajar_renderer_resume(const ajar_scene *scene, const char *path, const ajar_options *o,
+				 ajar_renderer **out)
+{
+	if (!out)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_resume: out is NULL");
+	*out = NULL;
+	if (!scene || !path)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_resume: NULL argument");
+	Checkpoint c;
+	ajar_status st = checkpoint_read(path, &c, 0);
+	if (st != AJAR_OK)
+		return st;
+	ajar_options want;
+	options_from_checkpoint(&c, &want);
+	if (o) {
+		/* Only the budget and the devices may change. */
+		const char *differs = o->width != want.width || o->height != want.height ? "width/height"
+				      : o->integrator != want.integrator			 ? "integrator"
+				      : o->max_depth != want.max_depth			 ? "max_depth"
+				      : o->min_depth != want.min_depth			 ? "min_depth"
+				      : o->seed != want.seed				 ? "seed"
+				      : o->mis != want.mis				 ? "mis"
+				      : o->strategy_len != want.strategy_len		 ? "strategy_len"
+				      : o->strategy_unweighted != want.strategy_unweighted ? "strategy_unweighted"
+				      : o->aov != want.aov				 ? "aov"
+											   : NULL;
+		if (differs) {
+			checkpoint_free(&c);
+			return err_set(AJAR_ERROR_INVALID_ARGUMENT,
+				       "%s: options.%s differs from the checkpoint's (only spp, time_limit and device "
+				       "may change when resuming)",
+				       path, differs);
+		}
+		want.spp = o->spp;
+		want.time_limit = o->time_limit;
+		want.device = o->device;
+	}
+	st = renderer_new(scene, &want, &c, path, out);
+	checkpoint_free(&c);
+	return st;
 }

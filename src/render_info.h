@@ -16,6 +16,7 @@ typedef struct {
 	/* The strategy layers, fixed point, 3 * width * height each; current
 	 * after ajar_renderer_image. */
 	const long *layers;
+	uint32_t aov; /* AJAR_AOV_* bits the EXR adds (ajar_renderer_aovs) */
 } RenderInfo;
 
 void render_info(const ajar_renderer *r, RenderInfo *info);

@@ -87,6 +87,12 @@ ajar_status scene_set_env_image(Scene *s, uint32_t w, uint32_t h, float *rgb, fl
 /* Bounds of all renderable triangles (portals included). */
 void scene_bounds(const Scene *s, V3 *bmin, V3 *bmax);
 uint32_t scene_count_emissive(const Scene *s);
+/* Triangle i of v (tris, shade, extra and textures set): its texture
+ * coordinates for texture `tex` (its set and transform) in texels, and
+ * whether it can emit anywhere with emissive texture `tex` (some texel
+ * its lookups can read is not black; those that cannot are no emitters). */
+void scene_tri_texel_coords(const SceneView *v, uint32_t i, int tex, double x[3], double y[3]);
+int scene_tri_can_emit(const SceneView *v, uint32_t i, int tex);
 /* The camera to render with: the scene's, or, if it has none, a view along
  * -Z framing the bounding sphere (yfov 45 degrees). */
 void scene_camera(const Scene *s, V3 *pos, V3 *forward, V3 *up, float *yfov);

@@ -23,6 +23,22 @@ ajar_status ajar_scene_load(const char *path, ajar_scene **out)
 	return gltf_load(path, out);
 }
 
+void ajar_load_options_default(ajar_load_options *o)
+{
+	if (o)
+		memset(o, 0, sizeof *o);
+}
+
+ajar_status ajar_scene_load_with(const char *path, const ajar_load_options *o, ajar_scene **out)
+{
+	if (!out)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_scene_load_with: out is NULL");
+	*out = NULL;
+	if (!path || !*path)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_scene_load_with: no path");
+	return gltf_load_with(path, o ? o->allow_outside_files : 0, out);
+}
+
 ajar_status ajar_scene_create(ajar_scene **out)
 {
 	if (!out)

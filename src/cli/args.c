@@ -91,6 +91,30 @@ static int parse_integrator(const char *opt, const char *s, ajar_integrator *out
 	return args_usage_error("%s: '%s' is not one of pt, bdpt, portal", opt, s);
 }
 
+/* --aov: a comma-separated list of albedo, normal, depth, variance. */
+static int parse_aov(const char *opt, const char *s, uint32_t *out)
+{
+	static const struct {
+		const char *name;
+		uint32_t bit;
+	} aovs[] = {{"albedo", AJAR_AOV_ALBEDO}, {"normal", AJAR_AOV_NORMAL}, {"depth", AJAR_AOV_DEPTH},
+		    {"variance", AJAR_AOV_VARIANCE}};
+	*out = 0;
+	for (const char *p = s; *p;) {
+		size_t n = strcspn(p, ",");
+		size_t k = 0;
+		while (k < sizeof aovs / sizeof aovs[0] && (strlen(aovs[k].name) != n || strncmp(p, aovs[k].name, n)))
+			k++;
+		if (k == sizeof aovs / sizeof aovs[0])
+			return args_usage_error("%s: '%.*s' is not one of albedo, normal, depth, variance", opt, (int)n, p);
+		*out |= aovs[k].bit;
+		p += n;
+		if (*p == ',' && *++p == '\0')
+			return args_usage_error("%s: '%s' ends with a comma", opt, s);
+	}
+	return EXIT_OK;
+}
+
 int args_parse_render(int argc, char **argv, RenderArgs *a)
 {
 	memset(a, 0, sizeof *a);
@@ -121,6 +145,11 @@ int args_parse_render(int argc, char **argv, RenderArgs *a)
 		}
 		if (!strcmp(arg, "--unweighted")) {
 			a->opt.strategy_unweighted = 1;
+			a->given |= GIVEN_UNWEIGHTED;
+			continue;
+		}
+		if (!strcmp(arg, "--allow-outside-files")) {
+			a->allow_outside_files = 1;
 			continue;
 		}
 		/* Every other option takes a value: "--opt value" or "--opt=value". */
@@ -139,7 +168,8 @@ int args_parse_render(int argc, char **argv, RenderArgs *a)
 		}
 		static const char *const known[] = {"-o", "--output", "--spp", "--time", "--size", "--integrator",
 						    "--max-depth", "--seed", "--device", "--png", "--min-depth",
-						    "--mis", "--strategies", "--strategy-len", "--exposure"};
+						    "--mis", "--strategies", "--strategy-len", "--exposure",
+						    "--checkpoint", "--checkpoint-every", "--resume", "--aov"};
 		size_t k = 0;
 		while (k < sizeof known / sizeof known[0] && strcmp(name, known[k]) != 0)
 			k++;
@@ -159,6 +189,14 @@ int args_parse_render(int argc, char **argv, RenderArgs *a)
 			a->png = val;
 		else if (!strcmp(name, "--device"))
 			a->opt.device = val;
+		else if (!strcmp(name, "--checkpoint"))
+			a->checkpoint = val;
+		else if (!strcmp(name, "--resume"))
+			a->resume = val;
+		else if (!strcmp(name, "--aov"))
+			rc = parse_aov(name, val, &a->opt.aov);
+		else if (!strcmp(name, "--checkpoint-every"))
+			rc = parse_seconds(name, val, &a->checkpoint_every);
 		else if (!strcmp(name, "--spp")) {
 			rc = parse_u32(name, val, 1, UINT32_MAX, &a->opt.spp);
 			spp_given = 1;
@@ -195,6 +233,17 @@ int args_parse_render(int argc, char **argv, RenderArgs *a)
 			rc = parse_u32(name, val, 0, UINT32_MAX, &a->opt.seed);
 		if (rc != EXIT_OK)
 			return rc;
+		static const struct {
+			const char *name;
+			unsigned bit;
+		} bits[] = {{"--size", GIVEN_SIZE},	    {"--integrator", GIVEN_INTEGRATOR},
+			    {"--max-depth", GIVEN_MAX_DEPTH}, {"--min-depth", GIVEN_MIN_DEPTH},
+			    {"--seed", GIVEN_SEED},	    {"--mis", GIVEN_MIS},
+			    {"--strategy-len", GIVEN_STRATEGY_LEN}, {"--spp", GIVEN_SPP},
+			    {"--time", GIVEN_TIME}, {"--aov", GIVEN_AOV}};
+		for (size_t b = 0; b < sizeof bits / sizeof bits[0]; b++)
+			if (!strcmp(name, bits[b].name))
+				a->given |= bits[b].bit;
 	}
 	if (!a->scene)
 		return args_usage_error("no scene given");
@@ -202,6 +251,15 @@ int args_parse_render(int argc, char **argv, RenderArgs *a)
 		return args_usage_error("no output given (-o OUT.exr)");
 	if (a->png && strcmp(a->png, a->exr) == 0)
 		return args_usage_error("--png: '%s' is also the EXR output", a->png);
+	const char *ckpt = a->checkpoint ? a->checkpoint : a->resume;
+	if (ckpt && (!strcmp(ckpt, a->exr) || (a->png && !strcmp(ckpt, a->png)) ||
+		     (a->strategies && !strcmp(ckpt, a->strategies))))
+		return args_usage_error("%s: '%s' is also an image output", a->checkpoint ? "--checkpoint" : "--resume",
+					ckpt);
+	if (a->checkpoint_every > 0 && !ckpt)
+		return args_usage_error("--checkpoint-every needs --checkpoint FILE or --resume FILE");
+	if (!(a->checkpoint_every > 0))
+		a->checkpoint_every = 60;
 	if (a->strategies) {
 		a->opt.strategy_len = strategy_len ? strategy_len : 4;
 		if (!strcmp(a->strategies, a->exr) || (a->png && !strcmp(a->strategies, a->png)))

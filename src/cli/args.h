@@ -27,7 +27,27 @@ typedef struct {
 	ajar_options opt;  /* spp, time_limit, size, integrator, depth, seed, device */
 	int quiet;
 	int help;          /* --help was given: print render help, nothing else */
+	int allow_outside_files; /* --allow-outside-files */
+	const char *checkpoint;  /* --checkpoint FILE, or NULL */
+	double checkpoint_every; /* --checkpoint-every SECONDS (default 60) */
+	const char *resume;      /* --resume FILE, or NULL */
+	unsigned given;          /* GIVEN_* bits: options set on the command line */
 } RenderArgs;
+
+/* Options a resumed render takes from its checkpoint (RenderArgs.given). */
+enum {
+	GIVEN_SIZE = 1 << 0,
+	GIVEN_INTEGRATOR = 1 << 1,
+	GIVEN_MAX_DEPTH = 1 << 2,
+	GIVEN_MIN_DEPTH = 1 << 3,
+	GIVEN_SEED = 1 << 4,
+	GIVEN_MIS = 1 << 5,
+	GIVEN_STRATEGY_LEN = 1 << 6,
+	GIVEN_UNWEIGHTED = 1 << 7,
+	GIVEN_SPP = 1 << 8,
+	GIVEN_TIME = 1 << 9,
+	GIVEN_AOV = 1 << 10
+};
 
 /* Parses the arguments after `render`. Returns EXIT_OK or EXIT_USAGE
  * (after printing the error). */

@@ -72,6 +72,22 @@ static const char usage_render[] =
 	"                         sum to the image of paths of up to N segments\n"
 	"  --unweighted           the strategy layers without MIS weights\n"
 	"  --seed N               random seed (same seed, device and options: same image)\n"
+	"  --aov LIST             add channels a denoiser takes to the EXR, any of\n"
+	"                         albedo (albedo.R/G/B), normal (normal.X/Y/Z), depth\n"
+	"                         (depth.Z) and variance (variance.R/G/B), comma-separated;\n"
+	"                         albedo and normal of the first non-specular hit\n"
+	"                         (through mirrors and glass), depth of the first hit\n"
+	"  --checkpoint FILE      keep the render resumable: write its state to FILE every\n"
+	"                         --checkpoint-every SECONDS (default 60), when a device\n"
+	"                         fails and when the render stops (also on Ctrl-C)\n"
+	"  --resume FILE          continue the render FILE holds (with its options; only\n"
+	"                         --spp, --time and --device may change, to extend it); the\n"
+	"                         result equals an uninterrupted render bit for bit. FILE\n"
+	"                         is updated as the render goes on unless --checkpoint\n"
+	"                         names another\n"
+	"  --allow-outside-files  let the scene read files outside its folder (by default\n"
+	"                         every URI and the environment image must resolve, after\n"
+	"                         '..' and symbolic links, inside the scene file's folder)\n"
 	"  --device SELECTOR      platform:device index (e.g. 0:1), cpu, gpu, a part of the\n"
 	"                         device name, a comma-separated list of these, or all:\n"
 	"                         several devices render at once; see 'ajar devices'\n"
@@ -81,7 +97,8 @@ static const char usage_render[] =
 	"  -h, --help             this text\n"
 	"\n"
 	"Ctrl-C (SIGINT) or SIGTERM stops after the current pass and writes the image so\n"
-	"far (exit code 5); a second one ends the program at once.\n";
+	"far (exit code 5), and the checkpoint with --checkpoint; a second one ends the\n"
+	"program at once.\n";
 
 /* ---- Errors ---------------------------------------------------------------- */
 
@@ -114,9 +131,12 @@ static void report(ajar_status st, const char *file)
 
 /* Loads a scene; a scene that cannot be read is bad input (exit 2) even
  * when the library calls it an I/O error: exit 4 is for outputs. */
-static int load_scene(const char *path, ajar_scene **scene)
+static int load_scene(const char *path, int allow_outside_files, ajar_scene **scene)
 {
-	ajar_status st = ajar_scene_load(path, scene);
+	ajar_load_options lo;
+	ajar_load_options_default(&lo);
+	lo.allow_outside_files = allow_outside_files;
+	ajar_status st = ajar_scene_load_with(path, &lo, scene);
 	if (st == AJAR_OK)
 		return EXIT_OK;
 	report(st, path);
@@ -254,6 +274,76 @@ static int write_outputs(ajar_renderer *r, const RenderArgs *a)
 	return EXIT_OK;
 }
 
+static const char *mis_name(ajar_mis m) { return m == AJAR_MIS_BALANCE ? "balance" : "power"; }
+
+/* --resume: the options come from the checkpoint; an option given on the
+ * command line must agree with it, except --spp, --time and --device,
+ * which extend the budget or move the render. */
+static int resume_options(RenderArgs *a)
+{
+	ajar_options ck;
+	ajar_status st = ajar_checkpoint_options(a->resume, &ck, NULL);
+	if (st != AJAR_OK) {
+		report(st, a->resume);
+		return st == AJAR_ERROR_IO ? EXIT_BAD_INPUT : exit_code(st);
+	}
+	const ajar_options *o = &a->opt;
+	char mine[64] = "", theirs[64] = "";
+	const char *opt = NULL;
+#define CONFLICT(bit, name, cond, fmt, mv, cv)                               \
+	if (!opt && (a->given & (bit)) && (cond)) {                          \
+		opt = name;                                                  \
+		snprintf(mine, sizeof mine, fmt, mv);                        \
+		snprintf(theirs, sizeof theirs, fmt, cv);                    \
+	}
+	if ((a->given & GIVEN_SIZE) && (o->width != ck.width || o->height != ck.height)) {
+		opt = "--size";
+		snprintf(mine, sizeof mine, "%ux%u", o->width, o->height);
+		snprintf(theirs, sizeof theirs, "%ux%u", ck.width, ck.height);
+	}
+	CONFLICT(GIVEN_INTEGRATOR, "--integrator", o->integrator != ck.integrator, "%s",
+		 args_integrator_name(o->integrator), args_integrator_name(ck.integrator));
+	CONFLICT(GIVEN_MAX_DEPTH, "--max-depth", o->max_depth != ck.max_depth, "%u", o->max_depth, ck.max_depth);
+	CONFLICT(GIVEN_MIN_DEPTH, "--min-depth", o->min_depth != ck.min_depth, "%u", o->min_depth, ck.min_depth);
+	CONFLICT(GIVEN_SEED, "--seed", o->seed != ck.seed, "%u", o->seed, ck.seed);
+	CONFLICT(GIVEN_MIS, "--mis", o->mis != ck.mis, "%s", mis_name(o->mis), mis_name(ck.mis));
+	CONFLICT(GIVEN_AOV, "--aov", o->aov != ck.aov, "(0x%x)", o->aov, ck.aov);
+	CONFLICT(GIVEN_STRATEGY_LEN, "--strategy-len", o->strategy_len != ck.strategy_len, "%u", o->strategy_len,
+		 ck.strategy_len);
+#undef CONFLICT
+	if (!opt && (a->given & GIVEN_UNWEIGHTED) && !ck.strategy_unweighted)
+		return args_usage_error("--unweighted: the checkpoint %s keeps weighted strategy layers", a->resume);
+	if (opt)
+		return args_usage_error("%s %s: the checkpoint %s was rendered with %s %s; a resumed render keeps "
+					"its options (only --spp, --time and --device may change)",
+					opt, mine, a->resume, opt, theirs);
+	if (a->strategies && ck.strategy_len == 0)
+		return args_usage_error("--strategies: the checkpoint %s keeps no strategy layers", a->resume);
+	const char *device = o->device;
+	uint32_t spp = o->spp;
+	double time_limit = o->time_limit;
+	a->opt = ck;
+	a->opt.device = device;
+	if (a->given & GIVEN_SPP)
+		a->opt.spp = spp;
+	if (a->given & GIVEN_TIME)
+		a->opt.time_limit = time_limit;
+	return EXIT_OK;
+}
+
+/* The last checkpoint of a render that has samples; 0 or EXIT_IO. */
+static int final_checkpoint(ajar_renderer *r, const RenderArgs *a, const char *path)
+{
+	ajar_status st = ajar_renderer_write_checkpoint(r, path);
+	if (st != AJAR_OK) {
+		report(st, path);
+		return EXIT_IO;
+	}
+	if (!a->quiet)
+		fprintf(stderr, "ajar: checkpoint %s holds %u spp\n", path, ajar_renderer_spp(r));
+	return EXIT_OK;
+}
+
 /* One line per device when several rendered: who did which share. */
 static void print_device_shares(const ajar_renderer *r)
 {
@@ -277,8 +367,12 @@ static int cmd_render(int argc, char **argv)
 		fputs(usage_render, stdout);
 		return EXIT_OK;
 	}
+	const char *ckpt = a.checkpoint ? a.checkpoint : a.resume;
 	if ((rc = check_output("-o", a.exr)) != EXIT_OK || (a.png && (rc = check_output("--png", a.png)) != EXIT_OK) ||
-	    (a.strategies && (rc = check_output("--strategies", a.strategies)) != EXIT_OK))
+	    (a.strategies && (rc = check_output("--strategies", a.strategies)) != EXIT_OK) ||
+	    (ckpt && (rc = check_output(a.checkpoint ? "--checkpoint" : "--resume", ckpt)) != EXIT_OK))
+		return rc;
+	if (a.resume && (rc = resume_options(&a)) != EXIT_OK)
 		return rc;
 
 	Progress progress;
@@ -288,13 +382,16 @@ static int cmd_render(int argc, char **argv)
 
 	ajar_scene *scene = NULL;
 	ajar_renderer *r = NULL;
-	if ((rc = load_scene(a.scene, &scene)) != EXIT_OK)
+	if ((rc = load_scene(a.scene, a.allow_outside_files, &scene)) != EXIT_OK)
 		goto done;
 	if (g_interrupted) {
 		rc = interrupted_early();
 		goto done;
 	}
-	ajar_status st = ajar_renderer_create(scene, &a.opt, &r);
+	ajar_status st = a.resume ? ajar_renderer_resume(scene, a.resume, &a.opt, &r)
+				  : ajar_renderer_create(scene, &a.opt, &r);
+	if (st == AJAR_OK && ckpt)
+		st = ajar_renderer_set_checkpoint(r, ckpt, a.checkpoint_every);
 	if (st != AJAR_OK) {
 		report(st, NULL);
 		rc = exit_code(st);
@@ -313,30 +410,45 @@ static int cmd_render(int argc, char **argv)
 			snprintf(budget + strlen(budget), sizeof budget - strlen(budget), "%s%g s",
 				 a.opt.spp ? ", at most " : "", a.opt.time_limit);
 		const char *device = ajar_renderer_device_name(r);
-		fprintf(stderr, "ajar: rendering %s with %s (%s) on %s\n", a.scene,
-			args_integrator_name(a.opt.integrator), budget, device ? device : "?");
+		char from[64] = "";
+		if (a.resume)
+			snprintf(from, sizeof from, " from %u spp", ajar_renderer_spp(r));
+		fprintf(stderr, "ajar: %s %s with %s (%s%s) on %s\n", a.resume ? "resuming" : "rendering", a.scene,
+			args_integrator_name(a.opt.integrator), budget, from, device ? device : "?");
 	}
 
 	st = ajar_renderer_render(r, on_progress, &progress);
 	progress_break_line(&progress);
+	uint32_t spp = ajar_renderer_spp(r);
 	if (st != AJAR_OK && st != AJAR_ERROR_CANCELLED) {
-		report(st, NULL);
+		/* A device failure keeps what the others rendered. */
+		if (ckpt && spp > 0 && st == AJAR_ERROR_DEVICE) {
+			char *msg = strdup(ajar_last_error());
+			final_checkpoint(r, &a, ckpt);
+			if (msg)
+				fprintf(stderr, "ajar: error: %s\n", msg);
+			free(msg);
+		} else {
+			report(st, NULL);
+		}
 		rc = exit_code(st);
 		goto done;
 	}
-	uint32_t spp = ajar_renderer_spp(r);
 	if (spp == 0) {
 		rc = interrupted_early();
 		goto done;
 	}
 	if ((rc = write_outputs(r, &a)) != EXIT_OK)
 		goto done;
+	if (ckpt && (rc = final_checkpoint(r, &a, ckpt)) != EXIT_OK)
+		goto done;
 	const ajar_progress *last = &progress.last;
 	char elapsed[24];
 	progress_format_time(last->elapsed, elapsed, sizeof elapsed);
 	if (st == AJAR_ERROR_CANCELLED || g_interrupted) {
-		fprintf(stderr, "ajar: interrupted after %u spp (%s); wrote %s%s%s\n", spp, elapsed, a.exr,
-			a.png ? " and " : "", a.png ? a.png : "");
+		fprintf(stderr, "ajar: interrupted after %u spp (%s); wrote %s%s%s%s%s\n", spp, elapsed, a.exr,
+			a.png ? " and " : "", a.png ? a.png : "", ckpt ? "; continue with --resume " : "",
+			ckpt ? ckpt : "");
 		rc = EXIT_INTERRUPTED;
 	} else if (!a.quiet) {
 		fprintf(stderr, "ajar: done: %u spp in %s (%.3g Msamples/s); wrote %s%s%s\n", spp, elapsed,
@@ -405,15 +517,18 @@ static int cmd_devices(int argc, char **argv)
 static int cmd_info(int argc, char **argv)
 {
 	if (argc == 1 && (!strcmp(argv[0], "-h") || !strcmp(argv[0], "--help"))) {
-		fputs("usage: ajar info SCENE.gltf|SCENE.glb\n", stdout);
+		fputs("usage: ajar info [--allow-outside-files] SCENE.gltf|SCENE.glb\n", stdout);
 		return EXIT_OK;
 	}
+	int allow_outside_files = argc == 2 && !strcmp(argv[0], "--allow-outside-files");
+	argc -= allow_outside_files;
+	argv += allow_outside_files;
 	if (argc != 1)
 		return args_usage_error("info: expects one scene, got %d arguments", argc);
 	if (argv[0][0] == '-')
 		return args_usage_error("info: unknown option '%s'", argv[0]);
 	ajar_scene *scene = NULL;
-	int rc = load_scene(argv[0], &scene);
+	int rc = load_scene(argv[0], allow_outside_files, &scene);
 	if (rc != EXIT_OK)
 		return rc;
 	ajar_scene_info in;

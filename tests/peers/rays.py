@@ -1,7 +1,7 @@
 """rays.py — Ajar's ray queries against Embree's, on one core
 (`sh tests/peers/run.sh rays`; tests/peers/README.md).
 
-A path sample's cost is mostly its ray queries (README, Results), so this
+A path sample's cost is mostly its ray queries (kernels/README.md, "Cost"), so this
 compares the two tracers alone: closest-hit rays per second for 2^20
 incoherent rays (origins uniform in the scene's bounds, directions uniform on
 the sphere), one thread each, on the same core. Ajar's figure is
