@@ -122,6 +122,7 @@ typedef struct {
 	uint32_t base_color_textures, metallic_roughness_textures, emissive_textures;
 	uint64_t texture_bytes;  /* texel memory on a device */
 	uint64_t alpha_triangles; /* triangles whose alpha (MASK, BLEND) rays test */
+	uint32_t normal_textures; /* images used as normal maps */
 } ajar_scene_info;
 ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info);
 

@@ -269,11 +269,11 @@ ajar_status ajar_scene_set_environment_image(ajar_scene *s, const char *exr_path
 
 static int texture_of(const Material *m, int which)
 {
-	return which == 0 ? m->base_tex : which == 1 ? m->mr_tex - 1 : m->emissive_tex - 1;
+	return which == 0 ? m->base_tex : which == 1 ? m->mr_tex - 1 : which == 2 ? m->emissive_tex - 1 : m->normal_tex - 1;
 }
 
 /* Distinct images behind the textures of one kind: which = 0 base colour,
- * 1 metallic-roughness, 2 emissive. */
+ * 1 metallic-roughness, 2 emissive, 3 normal. */
 static uint32_t count_images(const ajar_scene *s, int which)
 {
 	uint32_t n = 0;
@@ -302,6 +302,7 @@ ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info)
 	info->base_color_textures = count_images(s, 0);
 	info->metallic_roughness_textures = count_images(s, 1);
 	info->emissive_textures = count_images(s, 2);
+	info->normal_textures = count_images(s, 3);
 	info->texture_bytes = (uint64_t)s->ntexels * sizeof *s->texels;
 	for (uint32_t i = 0; i < s->ntris; i++)
 		info->alpha_triangles += (s->tris[i].flags & TRI_ALPHA) != 0;

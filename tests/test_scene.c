@@ -899,6 +899,7 @@ static void test_khronos_assets(void **state)
 	}
 	assert_int_equal(mask, 3);
 	assert_int_equal(blend, 1);
+	assert_int_equal(in.normal_textures, 1);
 	assert_true(in.alpha_triangles > 0);
 	ajar_scene_destroy(&s);
 

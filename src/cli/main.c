@@ -544,8 +544,9 @@ static int cmd_info(int argc, char **argv)
 	printf("materials:    %u\n", in.materials);
 	printf("emissive:     %u triangles\n", in.emissive_triangles);
 	printf("portals:      %u objects, %u triangles\n", in.portals, in.portal_triangles);
-	printf("textures:     %u (%u base colour, %u metallic-roughness, %u emissive; %.1f MiB)\n", in.textures,
-	       in.base_color_textures, in.metallic_roughness_textures, in.emissive_textures,
+	printf("textures:     %u (%u base colour, %u metallic-roughness, %u emissive, %u normal; %.1f MiB)\n",
+	       in.textures, in.base_color_textures, in.metallic_roughness_textures, in.emissive_textures,
+	       in.normal_textures,
 	       (double)in.texture_bytes / (1024.0 * 1024.0));
 	printf("alpha-tested: %llu triangles\n", (unsigned long long)in.alpha_triangles);
 	printf("environment:  %s\n", in.environment >= 0 && in.environment <= 2 ? env[in.environment] : "?");
