@@ -41,6 +41,7 @@ DEPS_test_exr := $(call obj,error exr png)
 DEPS_test_confine := $(call obj,error scene scene_api gltf exr png)
 DEPS_test_bdpt := $(BUILD)/tests/kernel_host.o $(BUILD)/tests/mis_oracle.o $(call obj,error scene scene_api gltf exr bvh lights prepare portal_flux)
 DEPS_test_portal := $(DEPS_test_bdpt)
+DEPS_test_punctual := $(DEPS_test_bdpt)
 # Tests that render need the whole library.
 DEPS_test_layout := $(BUILD)/libajar.a
 DEPS_test_render := $(BUILD)/libajar.a
@@ -114,6 +115,19 @@ $(BUILD)/kernel_source.c: $(KERNELS) $(BUILD)/embed_kernels
 $(BUILD)/kernel_source.o: $(BUILD)/kernel_source.c
 	$(Q)$(CC) -std=c11 $(WARN) -O0 -c -o $@ $<
 
+# The BSDF's albedo tables (energy compensation) are integrated from the
+# kernels' own microfacet code by a build tool, one build for every MODE
+# (always -O2, no sanitizers: the same bits), and kept in the tree so the
+# kernels can include them; deterministic, so regenerating changes nothing.
+TABLE_SRC := src/tools/bsdf_tables.c kernels/microfacet.h kernels/sampling.h kernels/fastmath.h kernels/vec.h kernels/compat.h
+build/tools/bsdf_tables: $(TABLE_SRC)
+	@mkdir -p $(@D)
+	$(Q)$(CC) -std=c11 -D_GNU_SOURCE -ffp-contract=off $(WARN) -O2 -o $@ $< -lm
+
+kernels/bsdf_tables.h: build/tools/bsdf_tables
+	@echo "  GEN     $@"
+	$(Q)$< > $@.tmp && mv $@.tmp $@
+
 $(BUILD)/tests/%.o: tests/%.c
 	@mkdir -p $(@D)
 	@echo "  CC      $<"
@@ -139,7 +153,7 @@ test:
 	$(Q)sh tests/run.sh $(BUILD) $(TESTS)
 
 # Host tests that need no OpenCL device, under ASan + UBSan.
-ASAN_TESTS := test_bsdf test_sampling test_bvh test_lights test_scene test_exr test_bdpt test_portal test_confine
+ASAN_TESTS := test_bsdf test_sampling test_bvh test_lights test_scene test_exr test_bdpt test_portal test_confine test_punctual
 asan:
 	$(Q)$(MAKE) --no-print-directory deps
 	$(Q)$(MAKE) --no-print-directory MODE=asan $(ASAN_TESTS:%=build/asan/tests/%)

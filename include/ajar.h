@@ -105,6 +105,30 @@ ajar_status ajar_scene_set_environment_color(ajar_scene *s, const float rgb[3]);
 /* Equirectangular OpenEXR, +Y up, importance-sampled. */
 ajar_status ajar_scene_set_environment_image(ajar_scene *s, const char *exr_path, float strength);
 
+/* KHR_lights_punctual lights, in glTF's units: a directional light's
+ * intensity is illuminance in lux, a point or spot light's luminous
+ * intensity in candela; Ajar renders them as Blender's glTF importer does
+ * by default ("Standard"): 683 lm/W, so radiance-like RGB = colour x
+ * intensity / 683 (W/m^2 perpendicular to a directional light, W/sr from a
+ * point or spot light). */
+typedef enum { AJAR_LIGHT_DIRECTIONAL = 0, AJAR_LIGHT_POINT = 1, AJAR_LIGHT_SPOT = 2 } ajar_light_type;
+typedef struct {
+	ajar_light_type type;
+	float position[3];  /* point, spot: world space */
+	float direction[3]; /* directional, spot: the way the light travels (glTF: the node's -Z) */
+	float color[3];     /* linear RGB multiplier, >= 0 */
+	float intensity;    /* lux (directional) or candela (point, spot), >= 0 */
+	float range;        /* point, spot: distance where the light ends; 0 = infinite */
+	float inner_cone;   /* spot: radians, 0 <= inner < outer */
+	float outer_cone;   /* spot: radians, outer <= pi/2 */
+} ajar_light;
+/* A white point light of 1 cd at the origin pointing down -Z, cones 0 and pi/4
+ * (the glTF defaults). */
+void ajar_light_default(ajar_light *l);
+ajar_status ajar_scene_add_light(ajar_scene *s, const ajar_light *l);
+/* Light `index` (0 .. ajar_scene_info.lights - 1) as added or loaded. */
+ajar_status ajar_scene_light_get(const ajar_scene *s, uint32_t index, ajar_light *out);
+
 typedef struct {
 	uint64_t triangles;
 	uint32_t materials;
@@ -123,6 +147,7 @@ typedef struct {
 	uint64_t texture_bytes;  /* texel memory on a device */
 	uint64_t alpha_triangles; /* triangles whose alpha (MASK, BLEND) rays test */
 	uint32_t normal_textures; /* images used as normal maps */
+	uint32_t lights;         /* KHR_lights_punctual lights (ajar_scene_light_get) */
 } ajar_scene_info;
 ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info);
 

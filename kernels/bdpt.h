@@ -14,7 +14,15 @@
  *
  * Light subpaths leave an emitter by power, a uniform point on it and a
  * cosine direction, or the environment by its importance, from a disk of
- * the scene's bounding radius perpendicular to the direction. The camera
+ * the scene's bounding radius perpendicular to the direction, or a
+ * punctual light (KHR_lights_punctual, chosen in the emitters' table):
+ * a point or spot light in a direction on the sphere or in the outer
+ * cone, a directional light along a line through the portals or the disk
+ * (lights.h, sun_line_sample). A punctual light is a delta in position or
+ * direction: no ray hits it (no s = 0), the camera does not see it (no
+ * s = 1, t = 1, as in pt), and next-event estimation (s = 1) and light
+ * subpaths (s >= 2) both reach it with the probability of its choice,
+ * which cancels in the MIS ratios (mis.h). The camera
  * direction density is that of a uniform point on the whole image (camera.h):
  * with one light path per pixel sample, light tracing takes W H times as
  * many samples per pixel as each eye strategy and has W H times smaller
@@ -38,20 +46,22 @@ INLINE int bdpt_mis_path(const SceneView *sc, const PathVertex *l, int s, const 
 		mv[i].pf = l[i].pf;
 		mv[i].pr = l[i].pr;
 		mv[i].delta = l[i].delta;
-		mv[i].infinite = l[i].type == VERTEX_ENV;
+		mv[i].infinite = vertex_infinite(&l[i]);
 	}
 	for (int j = 0; j < t; j++) {
 		MisVertex *m = &mv[k - 1 - j];
 		m->pf = e[j].pf;
 		m->pr = e[j].pr;
 		m->delta = e[j].delta;
-		m->infinite = e[j].type == VERTEX_ENV;
+		m->infinite = vertex_infinite(&e[j]);
 	}
 	/* The connection's ends scatter through non-delta lobes on this path,
 	 * whatever their subpaths sampled next (pbrt does the same). */
 	if (s > 0)
 		mv[s - 1].delta = 0;
 	mv[s].delta = 0;
+	if (s > 0) /* a punctual light (mis.h) */
+		mv[0].delta = vertex_delta_light(&l[0]);
 	const PathVertex *x0 = s > 0 ? &l[0] : &e[t - 1];
 	/* x_1 and x_2 (k >= 3 for the second): light vertices, then eye vertices. */
 	const PathVertex *x1 = s >= 2 ? &l[1] : (s == 1 ? &e[t - 1] : &e[t - 2]);
@@ -139,6 +149,47 @@ INLINE V3 bdpt_scatter(const PathVertex *v, V3 wi, int mode)
 	return bdpt_scatter_pdf(v, wi, mode, &pdf_w);
 }
 
+/* A light subpath from punctual light i (chosen with probability pf):
+ * from a point or spot light in a direction by punctual_dir_sample (u3,
+ * u4), its intensity windowed by the first hit's distance; from a
+ * directional light along a line by sun_line_sample (u1, u3, u4), parallel
+ * rays whose density is per perpendicular area. */
+INLINE int bdpt_punctual_subpath(const SceneView *sc, PathVertex *l, int i, float pf, float u1, float u3, float u4,
+				 int max_verts, Rng *rng)
+{
+	GLOBAL const PunctualLight *pl = &sc->punctual[i];
+	PathVertex *y = &l[0];
+	y->tri = i;
+	y->pf = pf;
+	if (!(pf > 0.0f))
+		return 0;
+	y->beta = v3(1.0f / pf, 1.0f / pf, 1.0f / pf);
+	if (pl->type == LIGHT_DIRECTIONAL) {
+		V3 o;
+		float pdf_perp;
+		y->type = VERTEX_SUN;
+		y->p = v3_neg(pl->dir);
+		y->ng = y->ns = y->wo = pl->dir;
+		if (!sun_line_sample(sc, pl, u1, u3, u4, &o, &pdf_perp))
+			return 1;
+		V3 beta = v3_scale(pl->intensity, 1.0f / (pf * pdf_perp));
+		return vertex_walk(sc, l, 1, max_verts, o, pl->dir, beta, pdf_perp, 1, 1, 0, rng);
+	}
+	y->type = VERTEX_PUNCTUAL;
+	y->p = pl->pos;
+	V3 dir = punctual_dir_sample(pl, u3, u4);
+	float pdf_dir = punctual_dir_pdf(pl, dir);
+	y->ng = y->ns = y->wo = dir;
+	if (!(pdf_dir > 0.0f) || max_verts < 2 ||
+	    !vertex_trace(sc, l, 1, pl->pos, dir, v3(0.0f, 0.0f, 0.0f), pdf_dir, 0, 1, 0))
+		return 1;
+	/* I(w) window(d) cos / d^2 over (pf pdf_dir cos / d^2). */
+	l[1].beta = v3_scale(punctual_intensity(pl, dir, v3_len(v3_sub(l[1].p, pl->pos))), 1.0f / (pf * pdf_dir));
+	if (v3_is_zero(l[1].beta))
+		return 1;
+	return vertex_extend(sc, l, 2, max_verts, 1, 0, fmax(v3_maxc(l[1].beta), 1e-30f), rng);
+}
+
 /* Traces the light subpath into l[]; returns its vertex count (0 if the
  * scene has nothing to start from). */
 CALLED int bdpt_light_subpath(const SceneView *sc, PathVertex *l, int max_verts, Rng *rng)
@@ -177,8 +228,16 @@ CALLED int bdpt_light_subpath(const SceneView *sc, PathVertex *l, int max_verts,
 	}
 	float u = fmin((u_sel - ps) / (1.0f - ps), 0.99999994f), pdf_a;
 	V3 p, n;
-	int tri = emitter_sample(sc, u, u1, u2, &p, &n, &pdf_a);
-	if (tri < 0 || !(pdf_a > 0.0f))
+	int k = light_pick(sc, u);
+	if (k < 0)
+		return 0;
+	if (k >= prm->num_emitters) {
+		int i = k - prm->num_emitters;
+		return bdpt_punctual_subpath(sc, l, i, (1.0f - ps) * sc->punctual[i].pdf_select, u1, u3, u4, max_verts,
+					     rng);
+	}
+	int tri = emitter_point(sc, k, u1, u2, &p, &n, &pdf_a);
+	if (!(pdf_a > 0.0f))
 		return 0;
 	y->type = VERTEX_LIGHT;
 	y->p = p;
@@ -274,7 +333,8 @@ INLINE V3 bdpt_to_camera(const SceneView *sc, const PathVertex *y, int origin, c
 	V3 zero = v3(0.0f, 0.0f, 0.0f);
 	V3 d = v3_sub(cam->pos, y->p);
 	float d2 = v3_len2(d), px, py, cos_c;
-	if (!(d2 > 0.0f) || y->type == VERTEX_ENV)
+	/* A punctual light itself is never seen (as in pt, whose rays never hit it). */
+	if (!(d2 > 0.0f) || vertex_infinite(y) || (origin && vertex_delta_light(y)))
 		return zero;
 	V3 w = v3_scale(d, 1.0f / sqrt(d2));
 	if (!camera_raster(cam, v3_neg(w), &px, &py, &cos_c))
@@ -323,23 +383,25 @@ CALLED int bdpt_eye_subpath(const SceneView *sc, float px, float py, PathVertex 
  * (densities.h, bdpt_light_records). */
 INLINE void bdpt_light_vertex(PathVertex *y, const LightSample *ls)
 {
-	y->type = ls->is_env ? VERTEX_ENV : VERTEX_LIGHT;
-	y->p = ls->is_env ? ls->wi : ls->p;
+	int sun = ls->delta && !(ls->dist < AJAR_INF);
+	y->type = ls->is_env ? VERTEX_ENV : sun ? VERTEX_SUN : ls->delta ? VERTEX_PUNCTUAL : VERTEX_LIGHT;
+	y->p = ls->is_env || sun ? ls->wi : ls->p;
 	y->ng = y->ns = y->wo = ls->n;
 	y->base = v3(0.0f, 0.0f, 0.0f);
 	y->beta = v3(1.0f, 1.0f, 1.0f);
 	y->delta = 0;
 	y->material = -1;
-	y->tri = ls->tri; /* the portal direction density needs the emitter */
+	y->tri = ls->delta ? ls->light : ls->tri; /* the portal direction density needs the emitter */
 	y->cross = 0;
-	y->pf = ls->is_env ? ls->pdf_w : ls->pdf_w * fabs(v3_dot(ls->n, ls->wi)) / (ls->dist * ls->dist);
+	/* A punctual light's: the probability of its choice. */
+	y->pf = ls->is_env || ls->delta ? ls->pdf_w : ls->pdf_w * fabs(v3_dot(ls->n, ls->wi)) / (ls->dist * ls->dist);
 	y->pr = 0.0f;
 }
 
 /* Whether the light sample is unoccluded from surface vertex z. */
 INLINE int bdpt_nee_visible(const SceneView *sc, const PathVertex *z, const LightSample *ls)
 {
-	if (ls->is_env)
+	if (ls->is_env || !(ls->dist < AJAR_INF)) /* the sky, a directional light */
 		return !bvh_occluded(sc, ray_offset(z->p, z->ng, ls->wi), ls->wi, AJAR_INF);
 	return segment_clear(sc, z->p, z->ng, ls->p, ls->n);
 }
@@ -373,7 +435,8 @@ CALLED void bdpt_strategies(const SceneView *sc, PathVertex *l, int nl, PathVert
 
 	/* t = 1: every light vertex to the camera. */
 	for (int s = 1; s <= nl && s <= depth; s++)
-		bdpt_light_to_camera(sc, l, s, &e[0], out, rng);
+		if (s > 1 || !vertex_delta_light(&l[0])) /* a punctual light is not seen */
+			bdpt_light_to_camera(sc, l, s, &e[0], out, rng);
 
 	for (int t = 2; t <= ne; t++) {
 		PathVertex *z = &e[t - 1];

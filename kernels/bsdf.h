@@ -1,16 +1,33 @@
 /* bsdf.h — glTF metallic-roughness as one BSDF: evaluation, sampling, pdfs.
  *
  * Three lobes, mixed by the glTF weights (base_color is factor x texture):
- *   metal   weight metallic: GGX conductor, Schlick Fresnel with F0 = base_color;
+ *   metal   weight metallic: GGX conductor, Schlick Fresnel with F0 = base_color,
+ *           plus Kulla and Conty's (2017) multiple-scattering lobe
+ *           Fms (1 - E1(mu_o)) (1 - E1(mu_i)) / (pi (1 - E1avg)), where E1 is
+ *           the single-scattering albedo with Fresnel 1 and
+ *           Fms = Favg^2 E1avg / (1 - Favg (1 - E1avg)) (Favg = F0 + (1 - F0)/21,
+ *           Schlick's cosine-weighted mean): with F = 1 it returns exactly the
+ *           energy single scattering loses, and colours it as the light
+ *           bouncing between coloured microfacets;
  *   plastic weight (1 - metallic)(1 - transmission): a GGX dielectric coat
  *           with Fs(c) = specular * Schlick(F0 = ((ior-1)/(ior+1))^2, c), over
- *           a diffuse base_color / pi * (1 - Fs(cos_o)) * (1 - Fs(cos_i)).
- *           The product of the two (1 - F) factors is reciprocal and keeps
- *           the albedo <= 1 at grazing angles, where glTF's fresnel_mix with
- *           F(h.wo) does not; specular = 0 gives exactly base_color / pi
- *           (KHR_materials_specular scales the whole Fresnel term, as glTF does);
+ *           a diffuse base that receives what the coat does not reflect:
+ *           base_color (1 - Es(mu_o)) (1 - Es(mu_i)) / (pi (1 - Esavg)), Es the
+ *           coat's directional albedo (Fresnel included) and Esavg its
+ *           cosine-weighted mean. Reciprocal, and a white base gives a
+ *           directional albedo Es + (1 - Es) = 1 at every angle and roughness
+ *           (the energy the coat's single scattering loses goes to the base);
+ *           specular = 0 gives exactly base_color / pi (KHR_materials_specular
+ *           scales the whole Fresnel term, as glTF does);
  *   glass   weight (1 - metallic) transmission: rough dielectric (Walter et
- *           al. 2007) with exact Fresnel, transmission tinted by base_color.
+ *           al. 2007) with exact Fresnel, transmission tinted by base_color,
+ *           plus Kulla and Conty's multiple scattering for dielectrics: four
+ *           cosine-shaped lobes (reflection outside and inside, refraction
+ *           each way) c (1 - G(mu_o)) (1 - G'(mu_i)) / pi, G and G' the
+ *           single-scattering albedos (reflection + refraction) of wo's and
+ *           wi's sides, the constants c solved in bsdf_setup so that a white
+ *           glass loses nothing from either side and the pair of refraction
+ *           lobes obeys the adjoint relation (bsdf_glass_ms).
  * GGX alpha = roughness^2. Metal and glass with alpha < BSDF_DELTA_ALPHA are
  * delta lobes (mirror, smooth glass); the plastic coat never is: its alpha is
  * clamped to >= BSDF_MIN_ALPHA. Microfacet terms: height-correlated Smith G2
@@ -23,13 +40,23 @@
  * normals); both must also lie on the right side of the shading normal n, or
  * the BSDF is 0. Glass's outside (ior on the far side) is the side ng points to.
  *
+ * E1, Es and G come from bsdf_tables.h (src/tools/bsdf_tables.c integrates
+ * them from microfacet.h at build time), bilinear in sqrt(alpha) and
+ * sqrt(mu) (glass: trilinear, with (ior - 1) / (ior + 1));
+ * the averages are those of the interpolated tables, so the compensation
+ * is exact for the tables as read.
+ *
  * Lobe selection for sampling is proportional to weight x albedo estimate at
- * the outgoing direction; pdf_w is the mixture over all non-delta lobes, so
- * sampling and bsdf_eval agree, and integrates to 1 - P(delta lobes). */
+ * the outgoing direction (the cosine-shaped lobes, diffuse base and the
+ * metal's and glass's multiple-scattering reflection, are sampled alike;
+ * the glass's multiple-scattering refraction by a cosine on the far side);
+ * pdf_w is the mixture over all non-delta lobes, so sampling and bsdf_eval
+ * agree, and integrates to 1 - P(delta lobes). */
 #ifndef AJAR_BSDF_H
 #define AJAR_BSDF_H
 #include "types.h"
-#include "sampling.h"
+#include "microfacet.h"
+#include "bsdf_tables.h"
 
 #define BSDF_RADIANCE 0   /* wo points toward the camera (eye paths) */
 #define BSDF_IMPORTANCE 1 /* wo points toward the light (light paths); no eta^2 scaling on refraction */
@@ -45,6 +72,18 @@ typedef struct {
 	V3 base_color;   /* linear, in [0, 1] */
 	float metallic, alpha, transmission, ior, specular;
 	int flags;       /* the Material's MATERIAL_* flags */
+	/* Energy compensation, set by bsdf_setup: the coat's albedo is
+	 * coat_s1 E1 + coat_sw Ew, its mean coat_eavg; metal_eavg is E1avg at
+	 * alpha and metal_fms the multiple-scattering colour Fms. */
+	float coat_s1, coat_sw, coat_eavg, metal_eavg;
+	V3 metal_fms;
+	/* Rough glass: where (ior, alpha) falls in the glass tables, the share
+	 * of the lost energy that multiple scattering transmits from outside
+	 * (glass_x) and from inside (glass_y), and the lobes' constants c_oo,
+	 * c_ii, c_oi, c_io (bsdf_glass_ms). */
+	int glass_k, glass_i;
+	float glass_wk, glass_wr, glass_x, glass_y;
+	float glass_c[4];
 } Bsdf;
 
 typedef struct {
@@ -55,12 +94,70 @@ typedef struct {
 	int delta;
 } BsdfSample;
 
-/* Selection probabilities of the four sampled lobes for one outgoing direction. */
+/* Selection probabilities of the seven sampled lobes for one outgoing
+ * direction (ms: the metal's multiple scattering; glass_r, glass_t: the
+ * glass's), and the albedos at it that bsdf_eval_local reuses. */
 typedef struct {
-	float metal, coat, diffuse, glass;
+	float metal, coat, diffuse, glass, ms, glass_r, glass_t;
+	float e_metal, e_coat, e_glass; /* E1 at alpha, Es, Go or Gi */
 } BsdfLobes;
 
-INLINE float bsdf_clamp01(float x) { return fmin(fmax(x, 0.0f), 1.0f); }
+/* Where (alpha, mu) falls in bsdf_tables.h's grid: the lower row and column
+ * and the weights of the upper ones. */
+typedef struct {
+	int i, j;
+	float wr, wm;
+} BsdfTabAt;
+
+INLINE BsdfTabAt bsdf_tab_at(float alpha, float mu)
+{
+	BsdfTabAt a;
+	float x = bsdf_clamp01(sqrt(fmax(alpha, 0.0f))) * (BSDF_TAB_NR - 1);
+	float y = sqrt(bsdf_clamp01(mu)) * (BSDF_TAB_NMU - 1);
+	a.i = min((int)x, BSDF_TAB_NR - 2);
+	a.j = min((int)y, BSDF_TAB_NMU - 2);
+	a.wr = x - (float)a.i;
+	a.wm = y - (float)a.j;
+	return a;
+}
+
+INLINE float bsdf_tab2(CONSTANT float *t, BsdfTabAt a)
+{
+	CONSTANT float *r0 = t + a.i * BSDF_TAB_NMU + a.j, *r1 = r0 + BSDF_TAB_NMU;
+	float v0 = r0[0] + (r0[1] - r0[0]) * a.wm, v1 = r1[0] + (r1[1] - r1[0]) * a.wm;
+	return v0 + (v1 - v0) * a.wr;
+}
+
+/* A per-roughness table (the averages), linear in sqrt(alpha). */
+INLINE float bsdf_tab1(CONSTANT float *t, BsdfTabAt a) { return t[a.i] + (t[a.i + 1] - t[a.i]) * a.wr; }
+
+/* The glass tables: blocks of BSDF_TAB_GR x BSDF_TAB_GMU per ior node;
+ * trilinear in (t, sqrt(alpha), sqrt(mu)), or bilinear for the averages. */
+INLINE float bsdf_tab3(CONSTANT float *t, int k, int i, float wk, float wr, float mu)
+{
+	float y = sqrt(bsdf_clamp01(mu)) * (BSDF_TAB_GMU - 1);
+	int j = min((int)y, BSDF_TAB_GMU - 2);
+	float wm = y - (float)j, v[4];
+	for (int c = 0; c < 4; c++) {
+		CONSTANT float *r = t + ((k + (c >> 1)) * BSDF_TAB_GR + i + (c & 1)) * BSDF_TAB_GMU + j;
+		v[c] = r[0] + (r[1] - r[0]) * wm;
+	}
+	float v0 = v[0] + (v[1] - v[0]) * wr, v1 = v[2] + (v[3] - v[2]) * wr;
+	return v0 + (v1 - v0) * wk;
+}
+
+INLINE float bsdf_tab3avg(CONSTANT float *t, int k, int i, float wk, float wr)
+{
+	CONSTANT float *r0 = t + k * BSDF_TAB_GR + i, *r1 = r0 + BSDF_TAB_GR;
+	float v0 = r0[0] + (r0[1] - r0[0]) * wr, v1 = r1[0] + (r1[1] - r1[0]) * wr;
+	return v0 + (v1 - v0) * wk;
+}
+
+INLINE float bsdf_w_metal(const Bsdf *bs) { return bs->metallic; }
+INLINE float bsdf_w_plastic(const Bsdf *bs) { return (1.0f - bs->metallic) * (1.0f - bs->transmission); }
+INLINE float bsdf_w_glass(const Bsdf *bs) { return (1.0f - bs->metallic) * bs->transmission; }
+INLINE int bsdf_smooth(const Bsdf *bs) { return bs->alpha < BSDF_DELTA_ALPHA; }
+INLINE float bsdf_coat_alpha(const Bsdf *bs) { return fmax(bs->alpha, BSDF_MIN_ALPHA); }
 
 /* The BSDF of material m with metallic and roughness given (textured, surface.h). */
 INLINE void bsdf_setup_mr(Bsdf *bs, GLOBAL const Material *m, V3 base_color, float metallic, float roughness, V3 ns,
@@ -84,6 +181,52 @@ INLINE void bsdf_setup_mr(Bsdf *bs, GLOBAL const Material *m, V3 base_color, flo
 	bs->ior = fmin(fmax(m->ior, BSDF_MIN_IOR), BSDF_MAX_IOR);
 	bs->specular = bsdf_clamp01(m->specular);
 	bs->flags = m->flags;
+	bs->coat_s1 = bs->coat_sw = bs->coat_eavg = bs->metal_eavg = 0.0f;
+	bs->metal_fms = v3(0.0f, 0.0f, 0.0f);
+	if (bsdf_w_plastic(bs) > 0.0f && bs->specular > 0.0f) {
+		float q = (bs->ior - 1.0f) / (bs->ior + 1.0f);
+		BsdfTabAt a = bsdf_tab_at(bsdf_coat_alpha(bs), 1.0f);
+		bs->coat_s1 = bs->specular * q * q;
+		bs->coat_sw = bs->specular - bs->coat_s1;
+		bs->coat_eavg = bs->coat_s1 * bsdf_tab1(bsdf_tab_e1avg, a) + bs->coat_sw * bsdf_tab1(bsdf_tab_ewavg, a);
+	}
+	bs->glass_k = bs->glass_i = 0;
+	bs->glass_wk = bs->glass_wr = bs->glass_x = bs->glass_y = 0.0f;
+	bs->glass_c[0] = bs->glass_c[1] = bs->glass_c[2] = bs->glass_c[3] = 0.0f;
+	if (bsdf_w_glass(bs) > 0.0f && !bsdf_smooth(bs)) {
+		float q = (bs->ior - 1.0f) / (bs->ior + 1.0f) * ((BSDF_TAB_GE - 1) / BSDF_TAB_GT_MAX);
+		float x = bsdf_clamp01(sqrt(bs->alpha)) * (BSDF_TAB_GR - 1);
+		bs->glass_k = min((int)q, BSDF_TAB_GE - 2);
+		bs->glass_i = min((int)x, BSDF_TAB_GR - 2);
+		bs->glass_wk = bsdf_clamp01(q - (float)bs->glass_k);
+		bs->glass_wr = x - (float)bs->glass_i;
+		int k = bs->glass_k, i = bs->glass_i;
+		float wk = bs->glass_wk, wr = bs->glass_wr;
+		float lo = fmax(1.0f - bsdf_tab3avg(bsdf_tab_goavg, k, i, wk, wr), 1e-7f);
+		float li = fmax(1.0f - bsdf_tab3avg(bsdf_tab_giavg, k, i, wk, wr), 1e-7f);
+		float fa = bsdf_tab_gfavg[k] + (bsdf_tab_gfavg[k + 1] - bsdf_tab_gfavg[k]) * wk;
+		float eta2 = bs->ior * bs->ior;
+		/* Energy: from outside c_oo lo + c_oi li = 1, from inside
+		 * c_ii li + c_io lo = 1; the adjoint relation of refraction
+		 * (radiance f divided by eta^2) needs c_io = c_oi / eta^2. From
+		 * outside the lost light is transmitted in the share 1 - Favg,
+		 * as single scattering transmits it, unless that asks more than
+		 * everything of the inside (glass_y <= 1). */
+		float xo = fmin(1.0f - fa, eta2 * li / lo);
+		bs->glass_x = xo;
+		bs->glass_y = fmin(xo * lo / (eta2 * li), 1.0f);
+		bs->glass_c[0] = (1.0f - xo) / lo;
+		bs->glass_c[1] = (1.0f - bs->glass_y) / li;
+		bs->glass_c[2] = xo / li;
+		bs->glass_c[3] = xo / (li * eta2);
+	}
+	if (bsdf_w_metal(bs) > 0.0f && !bsdf_smooth(bs)) {
+		float e = bsdf_tab1(bsdf_tab_e1avg, bsdf_tab_at(bs->alpha, 1.0f));
+		V3 fa = v3_add(v3_scale(bs->base_color, 20.0f / 21.0f), v3(1.0f / 21.0f, 1.0f / 21.0f, 1.0f / 21.0f));
+		bs->metal_eavg = e;
+		bs->metal_fms = v3(fa.x * fa.x * e / (1.0f - fa.x * (1.0f - e)), fa.y * fa.y * e / (1.0f - fa.y * (1.0f - e)),
+				   fa.z * fa.z * e / (1.0f - fa.z * (1.0f - e)));
+	}
 }
 
 /* The BSDF of material m, its metallic and roughness untextured. */
@@ -91,12 +234,6 @@ INLINE void bsdf_setup(Bsdf *bs, GLOBAL const Material *m, V3 base_color, V3 ns,
 {
 	bsdf_setup_mr(bs, m, base_color, m->metallic, m->roughness, ns, ng);
 }
-
-INLINE float bsdf_w_metal(const Bsdf *bs) { return bs->metallic; }
-INLINE float bsdf_w_plastic(const Bsdf *bs) { return (1.0f - bs->metallic) * (1.0f - bs->transmission); }
-INLINE float bsdf_w_glass(const Bsdf *bs) { return (1.0f - bs->metallic) * bs->transmission; }
-INLINE int bsdf_smooth(const Bsdf *bs) { return bs->alpha < BSDF_DELTA_ALPHA; }
-INLINE float bsdf_coat_alpha(const Bsdf *bs) { return fmax(bs->alpha, BSDF_MIN_ALPHA); }
 
 /* Contains some delta lobe (smooth metal or glass with a non-zero weight). */
 INLINE int bsdf_has_delta(const Bsdf *bs)
@@ -106,14 +243,6 @@ INLINE int bsdf_has_delta(const Bsdf *bs)
 
 /* No non-delta lobe at all: skip light sampling and connections. */
 INLINE int bsdf_is_delta(const Bsdf *bs) { return bsdf_smooth(bs) && !(bsdf_w_plastic(bs) > 0.0f); }
-
-/* (1 - c)^5, Schlick's Fresnel weight. */
-INLINE float bsdf_schlick_w(float c)
-{
-	float m = bsdf_clamp01(1.0f - c);
-	float m2 = m * m;
-	return m2 * m2 * m;
-}
 
 INLINE V3 bsdf_fresnel_metal(const Bsdf *bs, float c)
 {
@@ -129,106 +258,47 @@ INLINE float bsdf_fresnel_coat(const Bsdf *bs, float c)
 	return bs->specular * (f0 + (1.0f - f0) * bsdf_schlick_w(c));
 }
 
-/* Exact unpolarised dielectric Fresnel reflectance; cos_i > 0 on the side of
- * the incident direction, eta = eta_transmitted / eta_incident. */
-INLINE float bsdf_fresnel_dielectric(float cos_i, float eta)
+/* The coat's directional albedo Es(mu), Fresnel included. */
+INLINE float bsdf_coat_albedo(const Bsdf *bs, float mu)
 {
-	cos_i = bsdf_clamp01(cos_i);
-	float sin2_t = (1.0f - cos_i * cos_i) / (eta * eta);
-	if (sin2_t >= 1.0f)
-		return 1.0f; /* total internal reflection */
-	float cos_t = sqrt(1.0f - sin2_t);
-	float r_par = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-	float r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-	return 0.5f * (r_par * r_par + r_perp * r_perp);
+	BsdfTabAt a = bsdf_tab_at(bsdf_coat_alpha(bs), mu);
+	return bs->coat_s1 * bsdf_tab2(bsdf_tab_e1, a) + bs->coat_sw * bsdf_tab2(bsdf_tab_ew, a);
 }
 
-/* GGX normal distribution of a unit local h; written with the tangential
- * part so it stays accurate near h = z at tiny alpha. */
-INLINE float ggx_d(V3 h, float alpha)
+/* The metal's single-scattering albedo with Fresnel 1, E1(mu). */
+INLINE float bsdf_metal_albedo(const Bsdf *bs, float mu) { return bsdf_tab2(bsdf_tab_e1, bsdf_tab_at(bs->alpha, mu)); }
+
+/* The diffuse base's factor (1 - Es(mu_o)) (1 - Es(mu_i)) / (pi (1 - Esavg)). */
+INLINE float bsdf_base_factor(const Bsdf *bs, float e_o, float mu_i)
 {
-	if (h.z <= 0.0f)
-		return 0.0f;
-	float a2 = alpha * alpha;
-	float d = h.x * h.x + h.y * h.y + a2 * h.z * h.z;
-	return a2 / (AJAR_PI * d * d);
+	if (!(bs->specular > 0.0f))
+		return AJAR_INV_PI; /* no coat: exactly Lambertian */
+	return (1.0f - e_o) * (1.0f - bsdf_coat_albedo(bs, mu_i)) * AJAR_INV_PI / (1.0f - bs->coat_eavg);
 }
 
-/* Smith Lambda of GGX. */
-INLINE float ggx_lambda(V3 w, float alpha)
+/* Multiple scattering of the metal without its colour Fms. */
+INLINE float bsdf_ms_factor(const Bsdf *bs, float e_o, float mu_i)
 {
-	float z2 = w.z * w.z;
-	if (!(z2 > 0.0f))
-		return AJAR_INF;
-	float a2t2 = alpha * alpha * (w.x * w.x + w.y * w.y) / z2;
-	return 0.5f * (sqrt(1.0f + a2t2) - 1.0f);
+	return (1.0f - e_o) * (1.0f - bsdf_metal_albedo(bs, mu_i)) * AJAR_INV_PI / fmax(1.0f - bs->metal_eavg, 1e-7f);
 }
 
-INLINE float ggx_g2(V3 wo, V3 wi, float alpha)
+/* Single-scattering albedo of rough glass at mu, reflection and
+ * transmission together, from outside (Go) or inside (Gi). */
+INLINE float bsdf_glass_albedo(const Bsdf *bs, int outside, float mu)
 {
-	return 1.0f / (1.0f + ggx_lambda(wo, alpha) + ggx_lambda(wi, alpha));
+	return bsdf_tab3(outside ? bsdf_tab_go : bsdf_tab_gi, bs->glass_k, bs->glass_i, bs->glass_wk, bs->glass_wr, mu);
 }
 
-/* Density of the visible normal h seen from wo (wo.z > 0):
- * G1(wo) max(0, wo.h) D(h) / wo.z. */
-INLINE float ggx_pdf_visible(V3 wo, V3 h, float alpha)
+/* Multiple scattering of rough glass as energy (importance transport),
+ * without the tint: c (1 - G(mu_o)) (1 - G'(mu_i)) / pi, G of wo's side
+ * and G' of wi's, c = c_oo, c_ii (reflection) or c_oi, c_io (refraction
+ * from outside, inside). Reciprocal as the adjoint needs; a white glass
+ * loses nothing from either side. */
+INLINE float bsdf_glass_ms(const Bsdf *bs, int outside, int reflect, float e_o, float mu_i)
 {
-	float c = v3_dot(wo, h);
-	if (c <= 0.0f)
-		return 0.0f;
-	return ggx_d(h, alpha) * c / ((1.0f + ggx_lambda(wo, alpha)) * wo.z);
-}
-
-/* Visible-normal sampling (Heitz 2018): stretch wo to the alpha = 1
- * configuration, sample the projected hemisphere as a disk whose lower half
- * is squashed by the view's slope, unstretch. */
-INLINE V3 ggx_sample_visible(V3 wo, float alpha, float u1, float u2)
-{
-	V3 vh = v3_norm(v3(alpha * wo.x, alpha * wo.y, wo.z));
-	float len2 = vh.x * vh.x + vh.y * vh.y;
-	V3 t1 = len2 > 1e-14f ? v3_scale(v3(-vh.y, vh.x, 0.0f), 1.0f / sqrt(len2)) : v3(1.0f, 0.0f, 0.0f);
-	V3 t2 = v3_cross(vh, t1);
-	float r = sqrt(u1), sp, cp;
-	fast_sincos(AJAR_PI * (2.0f * u2 - 1.0f), &sp, &cp);
-	float p1 = r * cp, p2 = r * sp;
-	float s = 0.5f * (1.0f + vh.z);
-	p2 = (1.0f - s) * sqrt(fmax(0.0f, 1.0f - p1 * p1)) + s * p2;
-	V3 nh = v3_add(v3_add(v3_scale(t1, p1), v3_scale(t2, p2)),
-		       v3_scale(vh, sqrt(fmax(0.0f, 1.0f - p1 * p1 - p2 * p2))));
-	return v3_norm(v3(alpha * nh.x, alpha * nh.y, fmax(1e-7f, nh.z)));
-}
-
-INLINE V3 bsdf_reflect(V3 w, V3 h) { return v3_sub(v3_scale(h, 2.0f * v3_dot(w, h)), w); }
-
-/* Refraction of w (on the side h points to) through h; eta = eta_t / eta_i.
- * Returns 0 on total internal reflection. */
-INLINE int bsdf_refract(V3 w, V3 h, float eta, V3 *wt)
-{
-	float cos_i = v3_dot(w, h);
-	float sin2_t = fmax(0.0f, 1.0f - cos_i * cos_i) / (eta * eta);
-	if (sin2_t >= 1.0f)
-		return 0;
-	float cos_t = sqrt(1.0f - sin2_t);
-	*wt = v3_add(v3_scale(w, -1.0f / eta), v3_scale(h, cos_i / eta - cos_t));
-	return 1;
-}
-
-/* Half vector of a refraction pair in the flipped frame (wo.z > 0 > wi.z):
- * Walter's generalized h, oriented to +z; 0 if degenerate or if either
- * direction is on the wrong side of the microfacet. */
-INLINE int bsdf_half_refract(V3 wo, V3 wi, float eta, V3 *h)
-{
-	V3 m = v3_add(wo, v3_scale(wi, eta));
-	float l2 = v3_len2(m);
-	if (!(l2 > 1e-20f))
-		return 0;
-	m = v3_scale(m, 1.0f / sqrt(l2));
-	if (m.z < 0.0f)
-		m = v3_neg(m);
-	if (!(v3_dot(wo, m) > 0.0f) || !(v3_dot(wi, m) < 0.0f))
-		return 0;
-	*h = m;
-	return 1;
+	int wi_outside = reflect ? outside : !outside;
+	float c = bs->glass_c[reflect ? (outside ? 0 : 1) : (outside ? 2 : 3)];
+	return c * (1.0f - e_o) * (1.0f - bsdf_glass_albedo(bs, wi_outside, mu_i)) * AJAR_INV_PI;
 }
 
 /* Pure Lambertian (glTF with specular 0, no metal, no transmission) and
@@ -238,21 +308,33 @@ INLINE int bsdf_lambert(const Bsdf *bs)
 	return bs->metallic == 0.0f && bs->transmission == 0.0f && bs->specular == 0.0f && v3_maxc(bs->base_color) > 0.0f;
 }
 
-/* Lobe selection for outgoing cos_o > 0: weight x albedo estimate. */
-INLINE BsdfLobes bsdf_lobes(const Bsdf *bs, float cos_o)
+/* Lobe selection for outgoing cos_o > 0 on the side of relative ior eta:
+ * weight x albedo estimate. */
+INLINE BsdfLobes bsdf_lobes(const Bsdf *bs, float cos_o, float eta)
 {
 	BsdfLobes p;
-	float fc = bsdf_fresnel_coat(bs, cos_o);
-	p.metal = bsdf_w_metal(bs) * v3_avg(bsdf_fresnel_metal(bs, cos_o));
-	p.coat = bsdf_w_plastic(bs) * fc;
-	p.diffuse = bsdf_w_plastic(bs) * (1.0f - fc) * v3_avg(bs->base_color);
-	p.glass = bsdf_w_glass(bs);
-	float sum = p.metal + p.coat + p.diffuse + p.glass;
+	float wm = bsdf_w_metal(bs), wp = bsdf_w_plastic(bs);
+	p.e_metal = wm > 0.0f && !bsdf_smooth(bs) ? bsdf_metal_albedo(bs, cos_o) : 1.0f;
+	p.e_coat = wp > 0.0f && bs->specular > 0.0f ? bsdf_coat_albedo(bs, cos_o) : 0.0f; /* 0 without a coat */
+	p.metal = wm * v3_avg(bsdf_fresnel_metal(bs, cos_o)) * p.e_metal;
+	p.ms = wm * v3_avg(bs->metal_fms) * (1.0f - p.e_metal);
+	p.coat = wp * p.e_coat;
+	p.diffuse = wp * (1.0f - p.e_coat) * v3_avg(bs->base_color);
+	float wg = bsdf_w_glass(bs);
+	p.e_glass = wg > 0.0f && !bsdf_smooth(bs) ? bsdf_glass_albedo(bs, eta > 1.0f, cos_o) : 1.0f;
+	float xs = eta > 1.0f ? bs->glass_x : bs->glass_y;
+	p.glass = wg * p.e_glass;
+	p.glass_r = wg * (1.0f - p.e_glass) * (1.0f - xs);
+	p.glass_t = wg * (1.0f - p.e_glass) * xs * v3_avg(bs->base_color);
+	float sum = p.metal + p.coat + p.diffuse + p.glass + p.ms + p.glass_r + p.glass_t;
 	float inv = sum > 0.0f ? 1.0f / sum : 0.0f;
 	p.metal *= inv;
 	p.coat *= inv;
 	p.diffuse *= inv;
 	p.glass *= inv;
+	p.ms *= inv;
+	p.glass_r *= inv;
+	p.glass_t *= inv;
 	return p;
 }
 
@@ -280,7 +362,7 @@ INLINE V3 bsdf_eval_local(const Bsdf *bs, V3 wo, V3 wi, float eta, int mode, flo
 		*pdf_w = wi.z > 0.0f ? wi.z * AJAR_INV_PI : 0.0f;
 		return wi.z > 0.0f ? v3_scale(bs->base_color, AJAR_INV_PI) : f;
 	}
-	BsdfLobes p = bsdf_lobes(bs, wo.z);
+	BsdfLobes p = bsdf_lobes(bs, wo.z, eta);
 	int smooth = bsdf_smooth(bs);
 	if (wi.z > 0.0f) {
 		V3 h = v3_norm(v3_add(wo, wi));
@@ -290,25 +372,28 @@ INLINE V3 bsdf_eval_local(const Bsdf *bs, V3 wo, V3 wi, float eta, int mode, flo
 		if (!smooth && bsdf_w_metal(bs) > 0.0f) {
 			float spec = ggx_d(h, bs->alpha) * ggx_g2(wo, wi, bs->alpha) * inv4;
 			f = v3_madd(f, bsdf_fresnel_metal(bs, cos_oh), bsdf_w_metal(bs) * spec);
-			pdf += p.metal * ggx_pdf_visible(wo, h, bs->alpha) * jac;
+			f = v3_madd(f, bs->metal_fms, bsdf_w_metal(bs) * bsdf_ms_factor(bs, p.e_metal, wi.z));
+			pdf += p.metal * ggx_pdf_visible(wo, h, bs->alpha) * jac + p.ms * pdf_cosine_hemisphere_w(wi.z);
 		}
 		float wp = bsdf_w_plastic(bs);
 		if (wp > 0.0f) {
 			float a = bsdf_coat_alpha(bs);
 			float spec = ggx_d(h, a) * ggx_g2(wo, wi, a) * inv4 * bsdf_fresnel_coat(bs, cos_oh);
-			float kd = (1.0f - bsdf_fresnel_coat(bs, wo.z)) * (1.0f - bsdf_fresnel_coat(bs, wi.z)) * AJAR_INV_PI;
+			float kd = bsdf_base_factor(bs, p.e_coat, wi.z);
 			f = v3_add(f, v3_madd(v3(wp * spec, wp * spec, wp * spec), bs->base_color, wp * kd));
 			pdf += p.coat * ggx_pdf_visible(wo, h, a) * jac + p.diffuse * pdf_cosine_hemisphere_w(wi.z);
 		}
 		if (!smooth && bsdf_w_glass(bs) > 0.0f) {
 			float fr = bsdf_fresnel_dielectric(cos_oh, eta);
 			float spec = ggx_d(h, bs->alpha) * ggx_g2(wo, wi, bs->alpha) * inv4 * fr;
-			float wg = bsdf_w_glass(bs) * spec;
+			float wg = bsdf_w_glass(bs) * (spec + bsdf_glass_ms(bs, eta > 1.0f, 1, p.e_glass, wi.z));
 			f = v3_add(f, v3(wg, wg, wg));
-			pdf += p.glass * fr * ggx_pdf_visible(wo, h, bs->alpha) * jac;
+			pdf += p.glass * fr * ggx_pdf_visible(wo, h, bs->alpha) * jac + p.glass_r * pdf_cosine_hemisphere_w(wi.z);
 		}
 	} else if (wi.z < 0.0f && !smooth && bsdf_w_glass(bs) > 0.0f) {
 		V3 h;
+		float t = bsdf_glass_ms(bs, eta > 1.0f, 0, p.e_glass, -wi.z);
+		pdf = p.glass_t * pdf_cosine_hemisphere_w(-wi.z);
 		if (bsdf_half_refract(wo, wi, eta, &h)) {
 			float cos_oh = v3_dot(wo, h), cos_ih = v3_dot(wi, h);
 			/* Fresnel from the rarer medium's side (F(theta_i, eta) =
@@ -319,13 +404,13 @@ INLINE V3 bsdf_eval_local(const Bsdf *bs, V3 wo, V3 wi, float eta, int mode, flo
 					       : bsdf_fresnel_dielectric(-cos_ih, 1.0f / eta);
 			float denom = cos_ih + cos_oh / eta;
 			denom *= denom;
-			float t = ggx_d(h, bs->alpha) * ggx_g2(wo, wi, bs->alpha) * (1.0f - fr) *
-				  fabs(cos_ih * cos_oh / (wo.z * wi.z * denom));
-			if (mode == BSDF_RADIANCE)
-				t /= eta * eta;
-			f = v3_scale(bs->base_color, bsdf_w_glass(bs) * t);
-			pdf = p.glass * (1.0f - fr) * ggx_pdf_visible(wo, h, bs->alpha) * fabs(cos_ih) / denom;
+			t += ggx_d(h, bs->alpha) * ggx_g2(wo, wi, bs->alpha) * (1.0f - fr) *
+			     fabs(cos_ih * cos_oh / (wo.z * wi.z * denom));
+			pdf += p.glass * (1.0f - fr) * ggx_pdf_visible(wo, h, bs->alpha) * fabs(cos_ih) / denom;
 		}
+		if (mode == BSDF_RADIANCE)
+			t /= eta * eta;
+		f = v3_scale(bs->base_color, bsdf_w_glass(bs) * t);
 	}
 	*pdf_w = pdf;
 	return f;
@@ -396,7 +481,7 @@ INLINE float bsdf_pdf_w(const Bsdf *bs, V3 wo, V3 wi)
 INLINE float bsdf_glass_delta_prob(const Bsdf *bs, V3 wo, float eta, int reflect)
 {
 	float fr = bsdf_fresnel_dielectric(wo.z, eta);
-	return bsdf_lobes(bs, wo.z).glass * (reflect ? fr : 1.0f - fr);
+	return bsdf_lobes(bs, wo.z, eta).glass * (reflect ? fr : 1.0f - fr);
 }
 
 /* Returns 0 if no sample. For delta samples f is the lobe's weight (Fresnel
@@ -412,7 +497,7 @@ CALLED int bsdf_sample(const Bsdf *bs, V3 wo, float u0, float u1, float u2, int 
 	if (!(lo.z > 0.0f))
 		return 0;
 	float eta = bsdf_eta(bs, so);
-	BsdfLobes p = bsdf_lobes(bs, lo.z);
+	BsdfLobes p = bsdf_lobes(bs, lo.z, eta);
 	int smooth = bsdf_smooth(bs), reflect = 1;
 	V3 li;
 	/* Lobe by u0; u0 is then rescaled within the lobe and reused for the
@@ -433,10 +518,15 @@ CALLED int bsdf_sample(const Bsdf *bs, V3 wo, float u0, float u1, float u2, int 
 		li = bsdf_reflect(lo, ggx_sample_visible(lo, bs->alpha, u1, u2));
 	} else if (u0 < p.metal + p.coat) {
 		li = bsdf_reflect(lo, ggx_sample_visible(lo, bsdf_coat_alpha(bs), u1, u2));
-	} else if (u0 < p.metal + p.coat + p.diffuse) {
+	} else if (u0 < p.metal + p.coat + p.diffuse + p.ms + p.glass_r) {
+		/* diffuse base, metal or glass multiple scattering (reflection) */
 		li = sample_cosine_hemisphere(u1, u2);
+	} else if (u0 < p.metal + p.coat + p.diffuse + p.ms + p.glass_r + p.glass_t) {
+		li = sample_cosine_hemisphere(u1, u2); /* glass multiple scattering, refraction */
+		li.z = -li.z;
+		reflect = 0;
 	} else if (p.glass > 0.0f) {
-		float ug = fmin((u0 - (p.metal + p.coat + p.diffuse)) / p.glass, 0.99999994f);
+		float ug = fmin((u0 - (p.metal + p.coat + p.diffuse + p.ms + p.glass_r + p.glass_t)) / p.glass, 0.99999994f);
 		V3 h = smooth ? v3(0.0f, 0.0f, 1.0f) : ggx_sample_visible(lo, bs->alpha, u1, u2);
 		float cos_oh = v3_dot(lo, h);
 		float fr = bsdf_fresnel_dielectric(cos_oh, eta);

@@ -47,6 +47,14 @@ static inline long atom_add(long *p, long v) { long old = *p; *p += v; return ol
 #define CALLED static inline
 #endif
 
+/* Read-only tables at program scope (bsdf_tables.h): __constant on the
+ * device; the host declares them static const. */
+#ifdef AJAR_DEVICE
+#define CONSTANT __constant
+#else
+#define CONSTANT const
+#endif
+
 #define AJAR_PI 3.14159265358979323846f
 #define AJAR_INV_PI 0.31830988618379067154f
 #define AJAR_INV_2PI 0.15915494309189533577f

@@ -12,6 +12,8 @@
  * (VERTEX_LIGHT on an emitter's front face, or VERTEX_ENV) toward w. */
 INLINE V3 bdpt_emitted(const SceneView *sc, const PathVertex *l, V3 w)
 {
+	if (vertex_delta_light(l)) /* never seen: no strategy connects to its position */
+		return v3(0.0f, 0.0f, 0.0f);
 	if (l->type == VERTEX_ENV)
 		return env_radiance(sc, l->p);
 	return emitter_radiance(sc, l->tri, l->p, w);
@@ -23,6 +25,8 @@ INLINE float bdpt_origin_pdf(const SceneView *sc, const PathVertex *l)
 	float ps = sc->params->env_pdf_select;
 	if (l->type == VERTEX_ENV)
 		return ps * env_pdf_w(sc, l->p);
+	if (vertex_delta_light(l)) /* the probability of the choice; its delta cancels */
+		return (1.0f - ps) * sc->punctual[l->tri].pdf_select;
 	return (1.0f - ps) * emitter_pdf_a(sc, l->tri, l->p);
 }
 
@@ -33,6 +37,8 @@ INLINE float bdpt_nee_pdf(const SceneView *sc, const PathVertex *l, const PathVe
 	float ps = sc->params->env_pdf_select;
 	if (l->type == VERTEX_ENV)
 		return ps * env_nee_pdf_w(sc, x->p, vertex_nee_normal(x, from), l->p);
+	if (vertex_delta_light(l)) /* as the light subpath's origin: pn_0 = pf_0 */
+		return (1.0f - ps) * sc->punctual[l->tri].pdf_select;
 	return (1.0f - ps) * emitter_pdf_a(sc, l->tri, l->p);
 }
 
@@ -48,9 +54,16 @@ INLINE void bdpt_light_records(const SceneView *sc, MisVertex *mv, const PathVer
 
 /* Density with which the light vertex's emission sampling produces `to`
  * (pf_1): cosine-weighted directions from emitters, a disk of radius R
- * for the environment (parallel rays: per perpendicular area). */
+ * for the environment (parallel rays: per perpendicular area), a point or
+ * spot light's directions, a directional light's lines (lights.h). */
 INLINE float bdpt_emission_pdf(const SceneView *sc, const PathVertex *l, const PathVertex *to)
 {
+	if (l->type == VERTEX_SUN) /* parallel lines, per perpendicular area (lights.h) */
+		return sun_line_pdf(sc, &sc->punctual[l->tri], to->p) * fabs(v3_dot(to->ng, l->p));
+	if (l->type == VERTEX_PUNCTUAL) {
+		V3 d = v3_sub(to->p, l->p);
+		return vertex_density_a(l, to, punctual_dir_pdf(&sc->punctual[l->tri], v3_norm(d)));
+	}
 	if (l->type == VERTEX_ENV) {
 		float r = sc->params->scene_radius;
 		return fabs(v3_dot(to->ng, l->p)) / (AJAR_PI * r * r);
@@ -66,8 +79,8 @@ INLINE float bdpt_emission_pdf(const SceneView *sc, const PathVertex *l, const P
  * on its other side (wo), for the mode of the subpath v belongs to. */
 INLINE float bdpt_bsdf_pdf_w(const PathVertex *v, const PathVertex *from, const PathVertex *to, int mode)
 {
-	V3 wo = from->type == VERTEX_ENV ? from->p : v3_norm(v3_sub(from->p, v->p));
-	V3 wi = to->type == VERTEX_ENV ? to->p : v3_norm(v3_sub(to->p, v->p));
+	V3 wo = vertex_infinite(from) ? from->p : v3_norm(v3_sub(from->p, v->p));
+	V3 wi = vertex_infinite(to) ? to->p : v3_norm(v3_sub(to->p, v->p));
 	return bsdf_pdf_w(&v->bs, wo, wi); /* densities do not depend on the transport mode */
 }
 

@@ -7,7 +7,8 @@
 
 #define AJAR_LAYOUT_TYPES(X) \
 	X(BvhNode, 256) X(Tri, 48) X(TriShade, 64) X(TriExtra, 128) X(Material, 80) X(Texture, 48) \
-	X(Emitter, 16) X(PortalTri, 64) X(Camera, 64) X(Params, 208)
+	X(Emitter, 16) X(PortalTri, 64) X(Camera, 64) X(Params, 224) \
+	X(PunctualLight, 64)
 
 #define AJAR_LAYOUT_FIELDS(X)                                                          \
 	X(BvhNode, lo_x) X(BvhNode, lo_z) X(BvhNode, hi_x) X(BvhNode, hi_z) X(BvhNode, child)\
@@ -38,5 +39,10 @@
 	X(Params, strategy_len) X(Params, strategy_unweighted) X(Params, cross_filter)  \
 	X(Params, cross_lo) X(Params, cross_hi) X(Params, portal_s_max)                   \
 	X(Params, portal_sp_max) X(Params, portal_tp_max) X(Params, light_paths) \
-	X(Params, portal_t_max) X(Params, portal_rate)
+	X(Params, portal_t_max) X(Params, portal_rate) X(Params, num_lights)          \
+	X(Params, light_power)                                                          \
+	X(PunctualLight, pos) X(PunctualLight, type) X(PunctualLight, dir)            \
+	X(PunctualLight, pdf_select) X(PunctualLight, intensity) X(PunctualLight, range)\
+	X(PunctualLight, cos_outer) X(PunctualLight, cone_scale)                       \
+	X(PunctualLight, disk_radius)
 #endif

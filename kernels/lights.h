@@ -1,7 +1,8 @@
 /* lights.h — evaluating and sampling what emits light: emissive triangles
- * (one-sided, front = CCW) and the environment (env.h, env_portal.h), for
- * next-event estimation, and the portal triangles where intermediate
- * subpaths start. Tables come from src/lights.c and src/portal_flux.c.
+ * (one-sided, front = CCW), punctual lights (KHR_lights_punctual: point,
+ * spot, directional) and the environment (env.h, env_portal.h), for
+ * next-event estimation and light subpaths, and the portal triangles where
+ * intermediate subpaths start. Tables come from src/lights.c and src/portal_flux.c.
  * Every pdf names its measure: _a area, _w solid angle. */
 #ifndef AJAR_KERNEL_LIGHTS_H
 #define AJAR_KERNEL_LIGHTS_H
@@ -10,6 +11,7 @@
 #include "bvh.h"
 #include "env_portal.h"
 #include "surface.h"
+#include "portal_geometry.h"
 
 /* Emitted radiance of emitter triangle `tri` at its point p, front face:
  * the material's emission times its emissive texture (sRGB colour) and,
@@ -96,19 +98,18 @@ INLINE float emitter_pdf_a(const SceneView *sc, int tri, V3 p)
 	return sc->emitters[e].pdf_select / sc->emitters[e].area;
 }
 
-/* Picks an emitter (or emitter cell) by power (u_sel) and a uniform point
- * on it (u1, u2): position *p, unit front normal *n, *pdf_a including the
- * selection. Returns the triangle index, or -1 if there are no emitters. */
-INLINE int emitter_sample(const SceneView *sc, float u_sel, float u1, float u2, V3 *p, V3 *n,
-			  float *pdf_a)
+/* Index in emitter_cdf chosen by u_sel: an emitter below num_emitters,
+ * a punctual light from there on; -1 if the table is empty. */
+INLINE int light_pick(const SceneView *sc, float u_sel)
 {
 	float p_sel, u_rest;
-	*pdf_a = 0.0f;
-	*p = v3(0.0f, 0.0f, 0.0f);
-	*n = v3(0.0f, 0.0f, 1.0f);
-	int k = sample_cdf(sc->emitter_cdf, sc->params->num_emitters, u_sel, &p_sel, &u_rest);
-	if (k < 0)
-		return -1;
+	return sample_cdf(sc->emitter_cdf, sc->params->num_emitters + sc->params->num_lights, u_sel, &p_sel, &u_rest);
+}
+
+/* A uniform point on emitter (or emitter cell) k (see emitter_sample);
+ * returns its triangle. */
+INLINE int emitter_point(const SceneView *sc, int k, float u1, float u2, V3 *p, V3 *n, float *pdf_a)
+{
 	GLOBAL const Emitter *e = &sc->emitters[k];
 	GLOBAL const Tri *t = &sc->tris[e->tri];
 	int level = EMITTER_LEVEL(e->cell);
@@ -127,6 +128,155 @@ INLINE int emitter_sample(const SceneView *sc, float u_sel, float u1, float u2, 
 	return e->tri;
 }
 
+/* Picks an emitter by power (u_sel) and a uniform point on it (u1, u2):
+ * position *p, unit front normal *n, *pdf_a including the selection.
+ * Returns the triangle index, or -1 if there are no emitters or the choice
+ * fell on a punctual light (which shares the table, after the emitters:
+ * callers that do not take punctual lights lose that share, which their
+ * densities, summing over emitter points only, already leave out). */
+INLINE int emitter_sample(const SceneView *sc, float u_sel, float u1, float u2, V3 *p, V3 *n,
+			  float *pdf_a)
+{
+	*pdf_a = 0.0f;
+	*p = v3(0.0f, 0.0f, 0.0f);
+	*n = v3(0.0f, 0.0f, 1.0f);
+	int k = light_pick(sc, u_sel);
+	if (k < 0 || k >= sc->params->num_emitters)
+		return -1;
+	return emitter_point(sc, k, u1, u2, p, n, pdf_a);
+}
+
+/* Radiant intensity (W/sr) of point or spot light `l` toward unit w at
+ * distance d, with the spec's windows (KHR_lights_punctual): a spot's
+ * t^2, t = clamp((cos - cos outer) / (cos inner - cos outer), 0, 1), and
+ * `range`'s clamp(1 - (d / range)^4, 0, 1). */
+INLINE V3 punctual_intensity(GLOBAL const PunctualLight *l, V3 w, float d)
+{
+	float k = 1.0f;
+	if (l->type == LIGHT_SPOT) {
+		float t = fmin(fmax((v3_dot(w, l->dir) - l->cos_outer) * l->cone_scale, 0.0f), 1.0f);
+		k = t * t;
+	}
+	if (l->range > 0.0f) {
+		float r = d / l->range, r2 = r * r;
+		k *= fmin(fmax(1.0f - r2 * r2, 0.0f), 1.0f);
+	}
+	return v3_scale(l->intensity, k);
+}
+
+/* What punctual light `l` sends to point x: *wi (unit, from x toward the
+ * light), *dist (AJAR_INF for a directional light) and the irradiance it
+ * gives a surface perpendicular to wi: I(-wi) / d^2, or E. */
+INLINE V3 punctual_arrive(GLOBAL const PunctualLight *l, V3 x, V3 *wi, float *dist)
+{
+	if (l->type == LIGHT_DIRECTIONAL) {
+		*wi = v3_neg(l->dir);
+		*dist = AJAR_INF;
+		return l->intensity;
+	}
+	V3 to = v3_sub(l->pos, x);
+	float d2 = v3_len2(to);
+	*dist = sqrt(d2);
+	*wi = v3(0.0f, 0.0f, 1.0f);
+	if (!(d2 > 0.0f))
+		return v3(0.0f, 0.0f, 0.0f);
+	*wi = v3_scale(to, 1.0f / *dist);
+	return v3_scale(punctual_intensity(l, v3_neg(*wi), *dist), 1.0f / d2);
+}
+
+/* Solid-angle density with which a light subpath leaves point or spot
+ * light `l` in unit direction w: uniform on the sphere, or uniform in the
+ * spot's outer cone (its light is zero outside). */
+INLINE float punctual_dir_pdf(GLOBAL const PunctualLight *l, V3 w)
+{
+	if (l->type != LIGHT_SPOT)
+		return pdf_uniform_sphere_w();
+	if (!(v3_dot(w, l->dir) >= l->cos_outer))
+		return 0.0f;
+	return 1.0f / (2.0f * AJAR_PI * (1.0f - l->cos_outer));
+}
+
+/* A light subpath's direction from point or spot light `l` (density
+ * punctual_dir_pdf). */
+INLINE V3 punctual_dir_sample(GLOBAL const PunctualLight *l, float u1, float u2)
+{
+	if (l->type != LIGHT_SPOT)
+		return sample_uniform_sphere(u1, u2);
+	float c = 1.0f - u1 * (1.0f - l->cos_outer);
+	float sn = sqrt(fmax(0.0f, 1.0f - c * c)), phi = 2.0f * AJAR_PI * u2;
+	V3 t, b;
+	v3_basis(l->dir, &t, &b);
+	return v3_from_local(v3(sn * cos(phi), sn * sin(phi), c), t, b, l->dir);
+}
+
+/* A directional light's light subpaths are parallel rays along l->dir.
+ * Without portals their lines cross a disk of the scene's radius
+ * perpendicular to it uniformly. With portals, all but SUN_DISK_SHARE of
+ * them pass through a point on a portal triangle (picked by portal_cdf,
+ * uniform on it), so that light subpaths go where an opening lets the
+ * light in; the share on the disk keeps every line the light sends into
+ * the scene at a positive density (a sunlit outside wall, an opening
+ * without a portal), so a zero density always means a zero contribution,
+ * as the MIS weights assume. The density per unit area perpendicular to
+ * l->dir of the line through x: SUN_DISK_SHARE / (pi R^2) within the disk
+ * (all of it without portals), plus (1 - SUN_DISK_SHARE) times the sum
+ * over the portal triangles the whole line crosses of p_A / |cos| (p_A =
+ * pdf_select / area, cos between its normal and the light). */
+#define SUN_DISK_SHARE 0.1f
+
+INLINE float sun_line_pdf(const SceneView *sc, GLOBAL const PunctualLight *l, V3 x)
+{
+	int np = sc->params->num_portals;
+	float r = sc->params->scene_radius, R = l->disk_radius, t;
+	V3 q = v3_sub(x, sc->params->scene_center);
+	V3 perp = v3_sub(q, v3_scale(l->dir, v3_dot(q, l->dir)));
+	float disk = v3_len2(perp) <= R * R ? 1.0f / (AJAR_PI * R * R) : 0.0f;
+	if (np == 0)
+		return disk;
+	/* The line from behind the scene's bounding sphere, as a segment. */
+	V3 o = v3_sub(x, v3_scale(l->dir, v3_dot(q, l->dir) + 2.0f * r));
+	V3 d = v3_scale(l->dir, 4.0f * r);
+	float p = 0.0f;
+	for (int i = 0; i < np; i++) {
+		GLOBAL const PortalTri *pt = &sc->portals[i];
+		float c = fabs(v3_dot(pt->n, l->dir));
+		if (c > 0.0f && pt->area > 0.0f && portal_tri_crossing(o, d, 1.0f, pt->p0, pt->p1, pt->p2, &t))
+			p += pt->pdf_select / (pt->area * c);
+	}
+	return SUN_DISK_SHARE * disk + (1.0f - SUN_DISK_SHARE) * p;
+}
+
+/* Samples a line of directional light `l`: *o, a point on it behind the
+ * scene's bounding sphere (the ray o + t l->dir, t > 0, meets everything
+ * the light reaches along it), and its density *pdf_perp (sun_line_pdf).
+ * Returns 0 if there is none. */
+INLINE int sun_line_sample(const SceneView *sc, GLOBAL const PunctualLight *l, float u_sel, float u1, float u2, V3 *o,
+			   float *pdf_perp)
+{
+	GLOBAL const Params *prm = sc->params;
+	float r = prm->scene_radius;
+	V3 x;
+	if (prm->num_portals == 0 || u_sel < SUN_DISK_SHARE) {
+		float dx, dy;
+		V3 t, b;
+		v3_basis(l->dir, &t, &b);
+		sample_concentric_disk(u1, u2, &dx, &dy);
+		x = v3_add(prm->scene_center, v3_add(v3_scale(t, dx * l->disk_radius), v3_scale(b, dy * l->disk_radius)));
+	} else {
+		float p_sel, u_rest;
+		float u = fmin((u_sel - SUN_DISK_SHARE) / (1.0f - SUN_DISK_SHARE), 0.99999994f);
+		int k = sample_cdf(sc->portal_cdf, prm->num_portals, u, &p_sel, &u_rest);
+		if (k < 0)
+			return 0;
+		GLOBAL const PortalTri *pt = &sc->portals[k];
+		V3 n;
+		sample_triangle_point(pt->p0, pt->p1, pt->p2, u1, u2, &x, &n);
+	}
+	*pdf_perp = sun_line_pdf(sc, l, x);
+	*o = v3_sub(x, v3_scale(l->dir, v3_dot(v3_sub(x, prm->scene_center), l->dir) + 1.001f * r));
+	return *pdf_perp > 0.0f;
+}
+
 typedef struct {
 	V3 p;        /* point on the emitter (x itself for the environment) */
 	V3 n;        /* unit light normal (-wi for the environment) */
@@ -136,18 +286,40 @@ typedef struct {
 	float pdf_w; /* solid angle at x, selection included */
 	int is_env;
 	int tri;     /* the emitter triangle, -1 for the environment */
+	int light;   /* the punctual light, -1 for others */
+	int delta;   /* a punctual light: Le is irradiance (W/m^2 perpendicular to wi),
+		      * pdf_w the probability of the choice; no other strategy samples it */
 } LightSample;
 
-/* The emitter half of light_sample: an emitter by power (u), a uniform
- * point on it (u1, u2), chosen in all with probability p_emitters. */
+/* The emitter half of light_sample: an emitter or a punctual light by
+ * power (u), a uniform point on an emitter (u1, u2), chosen in all with
+ * probability p_emitters. */
 INLINE int light_sample_emitter(const SceneView *sc, V3 x, float u, float u1, float u2, float p_emitters,
 				LightSample *ls)
 {
 	float pdf_a;
 	V3 p, n;
-	int tri = emitter_sample(sc, u, u1, u2, &p, &n, &pdf_a);
-	if (tri < 0)
+	ls->light = -1;
+	ls->delta = 0;
+	int k = light_pick(sc, u);
+	if (k < 0)
 		return 0;
+	if (k >= sc->params->num_emitters) {
+		/* A punctual light: its position or direction is fixed. */
+		GLOBAL const PunctualLight *l = &sc->punctual[k - sc->params->num_emitters];
+		ls->Le = punctual_arrive(l, x, &ls->wi, &ls->dist);
+		if (!(l->pdf_select > 0.0f) || v3_is_zero(ls->Le))
+			return 0;
+		ls->is_env = 0;
+		ls->tri = -1;
+		ls->light = k - sc->params->num_emitters;
+		ls->delta = 1;
+		ls->p = l->type == LIGHT_DIRECTIONAL ? x : l->pos;
+		ls->n = v3_neg(ls->wi);
+		ls->pdf_w = p_emitters * l->pdf_select;
+		return 1;
+	}
+	int tri = emitter_point(sc, k, u1, u2, &p, &n, &pdf_a);
 	V3 to = v3_sub(p, x);
 	float dist2 = v3_len2(to);
 	if (!(dist2 > 0.0f))
@@ -170,8 +342,9 @@ INLINE int light_sample_emitter(const SceneView *sc, V3 x, float u, float u1, fl
 
 /* Next-event estimation from shading point x with normal n: the
  * environment with probability Params.env_pdf_select (through the portals
- * that show x the sky, weighed by n, env_portal.h), else an emitter by
- * power and a uniform point on it. Returns 0 when there is nothing to
+ * that show x the sky, weighed by n, env_portal.h), else an emitter or a
+ * punctual light by power (a uniform point on an emitter; a punctual
+ * light's own position or direction, ls->delta). Returns 0 when there is nothing to
  * sample or the sample cannot carry light (emitter seen from behind or
  * edge-on, zero distance, zero density); the caller then adds nothing. */
 CALLED int light_sample(const SceneView *sc, V3 x, V3 n, float u_sel, float u1, float u2, LightSample *ls)
@@ -179,6 +352,8 @@ CALLED int light_sample(const SceneView *sc, V3 x, V3 n, float u_sel, float u1, 
 	float ps = sc->params->env_pdf_select;
 	ls->is_env = 0;
 	ls->tri = -1;
+	ls->light = -1;
+	ls->delta = 0;
 	ls->pdf_w = 0.0f;
 	ls->Le = v3(0.0f, 0.0f, 0.0f);
 	if (u_sel < ps) {

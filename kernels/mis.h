@@ -44,7 +44,9 @@ INLINE float mis_balance(float a, float b)
 typedef struct {
 	float pf, pr;
 	float pn;     /* x_0 only: its density as a next-event sample from x_1 */
-	int delta;    /* scattered by a delta lobe: never a connection end */
+	int delta;    /* scattered by a delta lobe: never a connection end; on x_0, a
+		       * punctual light: s = 0 is impossible, s = 1 (next-event estimation)
+		       * is not, but for a path to the camera alone (the light unseen) */
 	int infinite; /* the environment: cannot connect to the camera */
 } MisVertex;
 
@@ -66,7 +68,8 @@ CALLED float mis_path_weight(const MisVertex *v, int k, int s, int heuristic)
 			r *= mis_remap0(v[0].pn) / mis_remap0(v[0].pr);
 		else
 			r *= mis_remap0(v[i].pf) / mis_remap0(v[i].pr) / (i == 1 ? pn_pf : 1.0f);
-		if (!v[i].delta && !v[i + 1].delta && !(v[i].infinite && i + 1 == k - 1))
+		if ((i == 0 || !v[i].delta) && !v[i + 1].delta &&
+		    !((v[i].infinite || v[i].delta) && i + 1 == k - 1))
 			sum += mis_term(r, heuristic);
 	}
 	r = 1.0f;
@@ -75,7 +78,7 @@ CALLED float mis_path_weight(const MisVertex *v, int k, int s, int heuristic)
 			r *= mis_remap0(v[0].pr) / mis_remap0(v[0].pn);
 		else
 			r *= mis_remap0(v[i].pr) / mis_remap0(v[i].pf) * (i == 1 ? pn_pf : 1.0f);
-		if (!v[i].delta && (i == 0 || !v[i - 1].delta))
+		if (!v[i].delta && (i <= 1 || !v[i - 1].delta))
 			sum += mis_term(r, heuristic);
 	}
 	return 1.0f / sum;
@@ -118,10 +121,10 @@ typedef struct {
 INLINE int mis_bdpt_valid(const MisVertex *v, int k, int s)
 {
 	if (s == 0)
-		return 1;
-	if (s >= k || v[s - 1].delta || v[s].delta)
+		return !v[0].delta;
+	if (s >= k || (s >= 2 && v[s - 1].delta) || v[s].delta)
 		return 0;
-	return !(v[s - 1].infinite && s == k - 1);
+	return !((v[s - 1].infinite || v[s - 1].delta) && s == k - 1);
 }
 
 /* Logs of the remapped densities of x_0 .. x_{n-1}: lf stays 0 unless
@@ -240,7 +243,8 @@ INLINE float mis_union_sum(const MisVertex *v, int k, int n, const float *PF, co
 		float base = lpsum[m] + beta * (set.lrate - lcur);
 		/* s in [0, m] with a valid light connection ... */
 		for (int s = max(0, m + 1 - set.sp_max); s <= m && s <= set.s_max; s++) {
-			if (s > 0 && (v[s - 1].delta || v[s].delta))
+			/* x_0's delta flag: a punctual light, for s = 1 only (mis.h, MisVertex) */
+			if ((s == 0 && v[0].delta) || (s >= 2 && v[s - 1].delta) || (s > 0 && v[s].delta))
 				continue;
 			float left = base + beta * (mis_lpf(PF, lpn, s) + PR[m] - PR[s]);
 			/* ... and t' >= 1 with m + t' <= k - 2 and a valid eye connection. */

@@ -76,7 +76,7 @@ INLINE float path_pr(const SceneView *sc, const PathRef *P, const MisVertex *mv,
 		return 1.0f;
 	if (i == k - 2) {
 		GLOBAL const Camera *cam = &sc->params->camera;
-		V3 d = x[i]->type == VERTEX_ENV ? v3_neg(x[i]->p) : v3_norm(v3_sub(x[i]->p, cam->pos));
+		V3 d = vertex_infinite(x[i]) ? v3_neg(x[i]->p) : v3_norm(v3_sub(x[i]->p, cam->pos));
 		return vertex_density_a(x[k - 1], x[i], camera_pdf_w(cam, v3_dot(d, cam->forward)));
 	}
 	if (mv[i + 1].delta)
@@ -102,21 +102,24 @@ INLINE float portal_direction_psa(const SceneView *sc, GLOBAL const PortalTri *p
 {
 	float ps = sc->params->env_pdf_select;
 	V3 to_m; /* from w toward x_m */
-	float guided = 0.0f;
-	if (xm->type == VERTEX_ENV) {
+	float guided = 0.0f; /* never toward a punctual light (portal.h) */
+	if (vertex_infinite(xm)) {
 		to_m = xm->p;
-		float pe = env_pdf_w(sc, to_m);
-		if (pt->env_side != 0)
-			pe = (float)pt->env_side * v3_dot(to_m, pt->n) > 0.0f ? pe + env_pdf_w(sc, portal_mirror(to_m, pt->n))
-									 : 0.0f;
-		guided = ps * pe;
+		if (xm->type == VERTEX_ENV) {
+			float pe = env_pdf_w(sc, to_m);
+			if (pt->env_side != 0)
+				pe = (float)pt->env_side * v3_dot(to_m, pt->n) > 0.0f
+					     ? pe + env_pdf_w(sc, portal_mirror(to_m, pt->n))
+					     : 0.0f;
+			guided = ps * pe;
+		}
 	} else {
 		V3 d = v3_sub(xm->p, w);
 		float dist = v3_len(d);
 		if (!(dist > 0.0f))
 			return 0.0f;
 		to_m = v3_scale(d, 1.0f / dist);
-		if (xm->tri >= 0 && sc->tris[xm->tri].emitter >= 0) {
+		if (xm->type != VERTEX_PUNCTUAL && xm->tri >= 0 && sc->tris[xm->tri].emitter >= 0) {
 			float cos_l = -v3_dot(xm->ng, to_m); /* ng is the front face */
 			guided = cos_l > 0.0f ? (1.0f - ps) * emitter_pdf_a(sc, xm->tri, xm->p) * dist * dist / cos_l : 0.0f;
 		}
@@ -134,7 +137,7 @@ INLINE float portal_pair_log(const SceneView *sc, GLOBAL const PortalTri *pt, co
 {
 	float pa = pt->pdf_select / pt->area;
 	float g;
-	if (a->type == VERTEX_ENV) {
+	if (vertex_infinite(a)) {
 		g = fabs(v3_dot(b->ng, a->p));
 	} else {
 		V3 d = v3_sub(b->p, a->p);
@@ -155,9 +158,9 @@ INLINE float path_pair_logsum(const SceneView *sc, const PathRef *P, int i, floa
 			      int *found)
 {
 	const PathVertex *a = P->x[i], *b = P->x[i + 1];
-	V3 o = a->type == VERTEX_ENV ? b->p : a->p;
-	V3 d = a->type == VERTEX_ENV ? a->p : v3_sub(b->p, a->p);
-	float tmax = a->type == VERTEX_ENV ? AJAR_INF : 1.0f;
+	V3 o = vertex_infinite(a) ? b->p : a->p;
+	V3 d = vertex_infinite(a) ? a->p : v3_sub(b->p, a->p);
+	float tmax = vertex_infinite(a) ? AJAR_INF : 1.0f;
 	float sum = -AJAR_INF, hair2 = 1e-8f * sc->params->scene_radius * sc->params->scene_radius;
 	*found = 0;
 	if (w0) {
@@ -196,7 +199,7 @@ INLINE void path_records_part(const SceneView *sc, const PathRef *P, int heurist
 		mv[i].pf = x[i]->pf;
 		mv[i].pr = x[i]->pr;
 		mv[i].delta = x[i]->delta;
-		mv[i].infinite = x[i]->type == VERTEX_ENV;
+		mv[i].infinite = vertex_infinite(x[i]);
 	}
 	/* Connection ends, the light and the camera scatter through non-delta
 	 * lobes on this path whatever their subpaths did next. */
@@ -207,6 +210,7 @@ INLINE void path_records_part(const SceneView *sc, const PathRef *P, int heurist
 	for (int j = 0; j < 2; j++)
 		for (int i = conn[j]; conn[j] >= 0 && i <= conn[j] + 1 && i < nr; i++)
 			mv[i].delta = 0;
+	mv[0].delta = vertex_delta_light(x[0]); /* a punctual light (mis.h) */
 	/* Densities the subpaths could not know. A next-event light vertex
 	 * (s = 1, t >= 2) carries its own sample density, which is pn, and
 	 * its pr when the caller stored it (bdpt_nee). */
@@ -341,6 +345,17 @@ INLINE int mis_record_delta(const MisRecord *r) { return r->bits & 1; }
 INLINE int mis_record_infinite(const MisRecord *r) { return r->bits >> 1 & 1; }
 INLINE int mis_record_cross(const MisRecord *r) { return r->bits >> 2; }
 
+/* Whether strategies with j light-side vertices x_0..x_{j-1} can connect
+ * to x_j, from the records of x_0..: never at a delta vertex; x_0's delta
+ * flag marks a punctual light, which j = 0 cannot reach and j = 1 (next-event
+ * estimation) can (mis.h). */
+INLINE int mis_record_light_conn(const MisRecord *r, int j)
+{
+	if (j == 0)
+		return !mis_record_delta(&r[0]);
+	return !((j >= 2 && mis_record_delta(&r[j - 1])) || mis_record_delta(&r[j]));
+}
+
 typedef struct {
 	MisRecord r[2 * SUBPATH_MAX]; /* x_0 .. x_m and edges 0 .. m */
 	int m;
@@ -432,12 +447,12 @@ CALLED void path_light_end(const SceneView *sc, MisPortalSet set, const PathVert
 	float x[2 * SUBPATH_MAX];
 	int nx = 0;
 	for (int j = 0; j <= m; j++)
-		if (j == 0 || !(mis_record_delta(&L->r[j - 1]) || mis_record_delta(&L->r[j])))
+		if (mis_record_light_conn(L->r, j))
 			x[nx++] = beta * (mis_lpf(PF, L->lpn, j) - PR[j]);
 	L->bdpt = mis_logsumexp(x, nx);
 	nx = 0;
 	for (int j = max(0, m + 1 - set.sp_max); j <= m && j <= set.s_max; j++)
-		if (j == 0 || !(mis_record_delta(&L->r[j - 1]) || mis_record_delta(&L->r[j])))
+		if (mis_record_light_conn(L->r, j))
 			x[nx++] = beta * (mis_lpf(PF, L->lpn, j) + PR[m] - PR[j]);
 	L->pair = mis_logsumexp(x, nx);
 	int S = set.s_max + set.sp_max; /* edges past it pair no strategy */
@@ -541,7 +556,7 @@ CALLED float path_join_weight(const SceneView *sc, MisPortalSet set, const MisLi
 	/* bdpt: s' <= m, s' = m + 1, s' >= m + 2 */
 	float lpf_m1 = m == 0 ? lpn : L->pf_m1; /* LPF(m + 1) */
 	float total = fast_exp(g + L->bdpt);
-	if (!(mis_record_delta(&L->r[m]) || mis_record_delta(&r[0])))
+	if (!((m >= 1 && mis_record_delta(&L->r[m])) || mis_record_delta(&r[0])))
 		total += fast_exp(g + beta * (lpf_m1 - pr_m1));
 	total += fast_exp(g + beta * (L->pf_m1 + L->lf_next - pr_m1) + E->bdpt);
 	/* intermediate strategies pairing on edge m */

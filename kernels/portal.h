@@ -13,6 +13,9 @@
  * light subpath (s >= 2), to a fresh light sample (s = 1), or are the light
  * (s = 0). The -> half traces w, like a light subpath, and its vertices
  * connect to the eye subpath (t >= 2) or to the camera (t = 1, splatted).
+ * Punctual lights reach the <- half only by next-event estimation (s = 1)
+ * and light subpaths (s >= 2): the half never hits one, and a guided
+ * direction never aims at one (portal_guided_sample).
  * The portal is invisible, so w_0 is no path vertex: the pair x_m, x_{m+1}
  * (the first hits of the two halves) has density p_A q(w) G(x_m, x_{m+1})
  * and the contribution carries 1 / (p_A q(w)).
@@ -52,7 +55,12 @@ INLINE int portal_guided_sample(const SceneView *sc, GLOBAL const PortalTri *pt,
 		return 1;
 	}
 	LightSample ls;
-	if (!light_sample_emitter(sc, w0, fmin((u_sel - ps) / (1.0f - ps), 0.99999994f), u1, u2, 1.0f - ps, &ls))
+	/* Not at a punctual light: its light reaches the <- half by next-event
+	 * estimation and light subpaths; a guided direction at it would be a
+	 * delta direction that no other strategy samples. That share of the
+	 * guided samples is lost, which portal_direction_psa leaves out. */
+	if (!light_sample_emitter(sc, w0, fmin((u_sel - ps) / (1.0f - ps), 0.99999994f), u1, u2, 1.0f - ps, &ls) ||
+	    ls.delta)
 		return 0;
 	*wl = ls.wi;
 	*dist = ls.dist;

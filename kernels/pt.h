@@ -99,13 +99,16 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 				float pdf_bsdf_w;
 				V3 f = bsdf_eval_fwd(&bs, wo, ls.wi, BSDF_RADIANCE, &pdf_bsdf_w);
 				if (!v3_is_zero(f)) {
-					int clear = ls.is_env ? !bvh_occluded(sc, ray_offset(s.p, s.ng, ls.wi), ls.wi, AJAR_INF)
-							      : segment_clear(sc, s.p, s.ng, ls.p, ls.n);
+					int far = ls.is_env || !(ls.dist < AJAR_INF); /* the sky, a directional light */
+					int clear = far ? !bvh_occluded(sc, ray_offset(s.p, s.ng, ls.wi), ls.wi, AJAR_INF)
+							: segment_clear(sc, s.p, s.ng, ls.p, ls.n);
 					if (clear) {
 						int c_nee = !prm->cross_filter ? 0
-								: ls.is_env ? portal_crossings(sc, s.p, ls.wi, 1)
+								: far ? portal_crossings(sc, s.p, ls.wi, 1)
 									    : portal_crossings(sc, s.p, ls.p, 0);
-						float w = mis_power(ls.pdf_w, pdf_bsdf_w) * pt_cross_weight(prm, cnt, depth + 2, c_nee);
+						/* A punctual light is sampled by next-event estimation alone. */
+						float w = (ls.delta ? 1.0f : mis_power(ls.pdf_w, pdf_bsdf_w)) *
+							  pt_cross_weight(prm, cnt, depth + 2, c_nee);
 						float k = fabs(v3_dot(s.ns, ls.wi)) * w / ls.pdf_w;
 						L = v3_add(L, v3_scale(v3_mul(v3_mul(beta, f), ls.Le), k));
 					}

@@ -122,6 +122,26 @@ typedef struct {
 	int env_side;     /* +1 / -1: the side of n the environment lies behind; 0 none */
 } PortalTri; /* 64 */
 
+/* KHR_lights_punctual light (src/lights.c converts glTF's photometric
+ * units at 683 lm/W). A delta light: no ray hits it, next-event estimation
+ * and light subpaths reach it deterministically. Chosen by power in the
+ * same CDF as the emitters, after them (emitter_cdf[num_emitters + i]). */
+#define LIGHT_DIRECTIONAL 0
+#define LIGHT_POINT 1
+#define LIGHT_SPOT 2
+typedef struct {
+	V3 pos;           /* point, spot */
+	int type;         /* LIGHT_* */
+	V3 dir;           /* unit, the way the light travels */
+	float pdf_select; /* probability of choosing it in emitter_cdf */
+	V3 intensity;     /* W/sr (point, spot), W/m^2 perpendicular (directional) */
+	float range;      /* 0 = infinite */
+	float cos_outer;  /* spot: cosine of the outer cone angle (point: -1) */
+	float cone_scale; /* spot: 1 / max(0.001, cos inner - cos outer) */
+	float disk_radius;/* directional: radius of the disk light subpaths start on */
+	float pad0;
+} PunctualLight; /* 64 */
+
 #define ENV_NONE 0
 #define ENV_COLOR 1
 #define ENV_IMAGE 2
@@ -187,7 +207,10 @@ typedef struct {
 	int portal_t_max;       /* intermediate strategies use at most this many eye vertices */
 	float portal_rate;      /* 200, probability that a pixel sample traces an intermediate subpath */
 	int pad1;
-} Params; /* 208 */
+	int num_lights;         /* 208, PunctualLight */
+	float light_power;      /* their total power estimate (src/lights.c) */
+	int pad2, pad3;
+} Params; /* 224 */
 
 /* Layout of the float array `env`: for an ENV_IMAGE of W x H,
  *   [0, 3WH)                    linear RGB radiance, row-major, row 0 = top
@@ -214,6 +237,7 @@ typedef struct {
 	X(PortalTri, portals)     \
 	X(float, portal_cdf)      \
 	X(TriExtra, extra)        \
+	X(PunctualLight, punctual) \
 	X(Params, params)
 
 /* What device code sees of the scene: one pointer per array. */

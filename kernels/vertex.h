@@ -22,6 +22,8 @@
 #define VERTEX_LIGHT 1   /* the point where a light subpath starts on an emitter */
 #define VERTEX_ENV 2     /* the environment: p holds the unit direction to the sky */
 #define VERTEX_SURFACE 3
+#define VERTEX_PUNCTUAL 4 /* a point or spot light: p its position, tri its index in sc->punctual */
+#define VERTEX_SUN 5      /* a directional light: p the unit direction toward it, tri its index */
 
 /* Maximum vertices of one subpath; bdpt needs max_depth + 1 eye vertices. */
 #define SUBPATH_MAX 33
@@ -46,11 +48,18 @@ typedef struct {
 		       * vertex (rebuilding it was 17% of door-ajar's portal time) */
 } PathVertex;
 
+/* A vertex at infinity (p a direction): the environment or a directional light. */
+INLINE int vertex_infinite(const PathVertex *v) { return v->type == VERTEX_ENV || v->type == VERTEX_SUN; }
+
+/* A punctual light: no ray hits it (s = 0 is impossible), and it is never
+ * a connection end but as the fixed end of next-event estimation. */
+INLINE int vertex_delta_light(const PathVertex *v) { return v->type == VERTEX_PUNCTUAL || v->type == VERTEX_SUN; }
+
 /* Area density at `to` of a direction sampled at `from` with solid-angle
  * density pdf_w; unchanged (solid angle) when `to` is at infinity. */
 INLINE float vertex_density_a(const PathVertex *from, const PathVertex *to, float pdf_w)
 {
-	if (to->type == VERTEX_ENV)
+	if (vertex_infinite(to))
 		return pdf_w;
 	V3 d = v3_sub(to->p, from->p);
 	float d2 = v3_len2(d);
@@ -66,7 +75,7 @@ INLINE float vertex_density_a(const PathVertex *from, const PathVertex *to, floa
  * whichever walk made x. */
 INLINE V3 vertex_nee_normal(const PathVertex *x, const PathVertex *from)
 {
-	V3 w = from->type == VERTEX_ENV ? from->p : v3_sub(from->p, x->p);
+	V3 w = vertex_infinite(from) ? from->p : v3_sub(from->p, x->p);
 	return v3_dot(x->ns, w) < 0.0f ? v3_neg(x->ns) : x->ns;
 }
 
@@ -132,7 +141,7 @@ CALLED int vertex_trace(const SceneView *sc, PathVertex *path, int n, V3 o, V3 d
 	else
 		v->pr = pa;
 	if (portals) /* the edge to prev, or, from the sky, the ray back out */
-		v->cross = prev->type == VERTEX_ENV ? portal_crossings(sc, v->p, prev->p, 1)
+		v->cross = vertex_infinite(prev) ? portal_crossings(sc, v->p, prev->p, 1)
 						    : portal_crossings(sc, prev->p, v->p, 0);
 	return 1;
 }

@@ -39,7 +39,7 @@ namespace tg = tinygltf;
  * other cannot be shown correctly and is refused. */
 const char *const supported_extensions[] = {
 	"KHR_materials_emissive_strength", "KHR_materials_ior", "KHR_materials_specular",
-	"KHR_materials_transmission", "KHR_mesh_quantization", "KHR_texture_transform",
+	"KHR_materials_transmission", "KHR_mesh_quantization", "KHR_lights_punctual", "KHR_texture_transform",
 };
 
 struct Loader {
@@ -1180,6 +1180,52 @@ ajar_status load_camera_node(Loader &L, int ni, const double world[16])
 	return st ? st : read_resolution(L, n.extras, where);
 }
 
+/* A node's KHR_lights_punctual light: at the node's world position,
+ * pointing down its world -Z (scale affects neither the light's range nor
+ * its intensity). */
+ajar_status load_light_node(Loader &L, int ni, const double world[16])
+{
+	const tg::Node &n = L.model.nodes[(size_t)ni];
+	auto it = n.extensions.find("KHR_lights_punctual");
+	if (it == n.extensions.end())
+		return AJAR_OK;
+	const tg::Value *v = value_member(it->second, "light");
+	if (!v || !v->IsNumber())
+		return fail(L, AJAR_ERROR_BAD_INPUT, "nodes[%d]: KHR_lights_punctual has no light index", ni);
+	double li = v->GetNumberAsDouble();
+	if (!(li >= 0.0 && li < (double)L.model.lights.size()) || li != std::floor(li))
+		return fail(L, AJAR_ERROR_BAD_INPUT, "nodes[%d]: KHR_lights_punctual light %g does not exist (%zu lights)", ni,
+			    li, L.model.lights.size());
+	const tg::Light &gl = L.model.lights[(size_t)li];
+	ajar_light l;
+	memset(&l, 0, sizeof l);
+	l.color[0] = l.color[1] = l.color[2] = 1.0f; /* the spec's default */
+	if (gl.type == "directional")
+		l.type = AJAR_LIGHT_DIRECTIONAL;
+	else if (gl.type == "point")
+		l.type = AJAR_LIGHT_POINT;
+	else if (gl.type == "spot")
+		l.type = AJAR_LIGHT_SPOT;
+	else
+		return fail(L, AJAR_ERROR_BAD_INPUT, "KHR_lights_punctual.lights[%g]: unknown type '%s'", li, gl.type.c_str());
+	if (!gl.color.empty() && gl.color.size() != 3)
+		return fail(L, AJAR_ERROR_BAD_INPUT, "KHR_lights_punctual.lights[%g]: color has %zu numbers, expected 3", li,
+			    gl.color.size());
+	for (size_t k = 0; k < gl.color.size(); k++)
+		l.color[k] = (float)gl.color[k];
+	l.intensity = (float)gl.intensity;
+	l.range = (float)gl.range; /* tinygltf: 0 when absent (infinite) */
+	l.inner_cone = (float)gl.spot.innerConeAngle;
+	l.outer_cone = (float)gl.spot.outerConeAngle;
+	for (int k = 0; k < 3; k++) {
+		l.position[k] = (float)world[12 + k];
+		l.direction[k] = (float)-world[8 + k];
+	}
+	char what[96];
+	snprintf(what, sizeof what, "nodes[%d]: KHR_lights_punctual.lights[%g]", ni, li);
+	return scene_add_light(L.s, what, &l);
+}
+
 /* Depth-first, parents before children, in file order, so "the first
  * camera" is well defined. */
 ajar_status walk_nodes(Loader &L, const std::vector<int> &roots, const char *roots_what)
@@ -1216,6 +1262,8 @@ ajar_status walk_nodes(Loader &L, const std::vector<int> &roots, const char *roo
 		if (n.mesh >= 0 && (st = load_mesh_node(L, ni, world)))
 			return st;
 		if (n.camera >= 0 && !L.s->has_camera && (st = load_camera_node(L, ni, world)))
+			return st;
+		if ((st = load_light_node(L, ni, world)))
 			return st;
 		for (size_t k = n.children.size(); k-- > 0;) {
 			int ch = n.children[k];

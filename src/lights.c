@@ -225,6 +225,88 @@ static ajar_status build_portals(PortalTri *portals, uint32_t n, LightTables *ou
 	return AJAR_OK;
 }
 
+/* glTF's photometric units to Ajar's radiometric ones: Blender's glTF
+ * importer's default ("Standard") converts at 683 lm/W, so a scene
+ * exported from Blender renders alike in both. */
+#define LUMENS_PER_WATT 683.0
+
+/* Power estimate of a punctual light, for its share of the light choice:
+ * any positive value is unbiased (the densities read the table), it only
+ * decides where samples go. A directional light: its irradiance over the
+ * cross-section its light subpaths start from (the portals' projected
+ * area, or the disk of the scene's radius). */
+static double punctual_power(const PunctualLight *l, const PortalTri *portals, uint32_t nportal_tris)
+{
+	double lum = v3_lum(l->intensity);
+	if (l->type == LIGHT_POINT)
+		return 4.0 * AJAR_PI * lum;
+	if (l->type == LIGHT_SPOT)
+		return 2.0 * AJAR_PI * (1.0 - (double)l->cos_outer) * lum;
+	double a = 0.0;
+	for (uint32_t j = 0; j < nportal_tris; j++)
+		a += (double)portals[j].area * fabs((double)v3_dot(portals[j].n, l->dir));
+	if (nportal_tris == 0)
+		a = AJAR_PI * (double)l->disk_radius * l->disk_radius;
+	return lum * a;
+}
+
+/* The punctual lights in device form, and emitter_cdf rebuilt over the
+ * emitters and then the lights, by power. */
+static ajar_status build_punctual(const Scene *s, const PortalTri *portals, uint32_t nportal_tris, float scene_radius,
+				  LightTables *out)
+{
+	uint32_t ne = out->nemitters, nl = s->nlights;
+	out->nlights = nl;
+	out->lights = calloc(nl ? nl : 1, sizeof(PunctualLight));
+	if (!out->lights)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "lights: out of memory for %u lights", nl);
+	if (nl == 0)
+		return AJAR_OK;
+	float *cdf = calloc((size_t)ne + nl + 1, sizeof(float));
+	double *power = calloc((size_t)ne + nl, sizeof(double));
+	if (!cdf || !power) {
+		free(cdf);
+		free(power);
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "lights: out of memory for %u lights", nl);
+	}
+	/* The emitters' (textured) powers, as build_emitters weighed them. */
+	for (uint32_t k = 0; k < ne; k++)
+		power[k] = (double)out->emitters[k].pdf_select * out->emitter_power;
+	double lp = 0.0;
+	for (uint32_t i = 0; i < nl; i++) {
+		const ajar_light *a = &s->lights[i];
+		PunctualLight *l = &out->lights[i];
+		double k = 1.0 / LUMENS_PER_WATT * a->intensity;
+		l->type = a->type == AJAR_LIGHT_DIRECTIONAL ? LIGHT_DIRECTIONAL
+			  : a->type == AJAR_LIGHT_SPOT      ? LIGHT_SPOT
+							    : LIGHT_POINT;
+		l->pos = v3(a->position[0], a->position[1], a->position[2]);
+		l->dir = v3(a->direction[0], a->direction[1], a->direction[2]);
+		l->intensity = v3((float)(k * a->color[0]), (float)(k * a->color[1]), (float)(k * a->color[2]));
+		l->range = l->type == LIGHT_DIRECTIONAL ? 0.0f : a->range;
+		l->cos_outer = -1.0f;
+		l->cone_scale = 0.0f;
+		if (l->type == LIGHT_SPOT) {
+			double co = cos((double)a->outer_cone), ci = cos((double)a->inner_cone);
+			l->cos_outer = (float)co;
+			l->cone_scale = (float)(1.0 / fmax(0.001, ci - co));
+		}
+		l->disk_radius = scene_radius;
+		power[ne + i] = punctual_power(l, portals, nportal_tris);
+		lp += power[ne + i];
+	}
+	cdf_build(cdf, power, ne + nl, 0);
+	for (uint32_t k = 0; k < ne; k++)
+		out->emitters[k].pdf_select = cdf[k + 1] - cdf[k];
+	for (uint32_t i = 0; i < nl; i++)
+		out->lights[i].pdf_select = cdf[ne + i + 1] - cdf[ne + i];
+	free(out->emitter_cdf);
+	out->emitter_cdf = cdf;
+	out->light_power = (float)lp;
+	free(power);
+	return AJAR_OK;
+}
+
 ajar_status lights_build(const Scene *s, Tri *tris, const TriShade *shade, const TriExtra *extra, uint32_t ntris, const Material *mats,
 			 PortalTri *portals, uint32_t nportal_tris, V3 scene_center, float scene_radius,
 			 LightTables *out)
@@ -232,7 +314,8 @@ ajar_status lights_build(const Scene *s, Tri *tris, const TriShade *shade, const
 	ajar_status st;
 	memset(out, 0, sizeof(*out));
 	if ((st = build_emitters(s, tris, shade, extra, ntris, mats, out)) != AJAR_OK ||
-	    (st = build_portals(portals, nportal_tris, out)) != AJAR_OK) {
+	    (st = build_portals(portals, nportal_tris, out)) != AJAR_OK ||
+	    (st = build_punctual(s, portals, nportal_tris, scene_radius, out)) != AJAR_OK) {
 		lights_free(out);
 		return st;
 	}
@@ -258,10 +341,10 @@ ajar_status lights_build(const Scene *s, Tri *tris, const TriShade *shade, const
 
 	if (s->env_type == ENV_NONE || !(out->env_power > 0.0f))
 		out->env_pdf_select = 0.0f;
-	else if (!(out->emitter_power > 0.0f))
+	else if (!(out->emitter_power + out->light_power > 0.0f))
 		out->env_pdf_select = 1.0f;
 	else
-		out->env_pdf_select = out->env_power / (out->env_power + out->emitter_power);
+		out->env_pdf_select = out->env_power / (out->env_power + out->emitter_power + out->light_power);
 	return AJAR_OK;
 }
 
@@ -271,5 +354,6 @@ void lights_free(LightTables *t)
 	free(t->emitter_cdf);
 	free(t->env);
 	free(t->portal_cdf);
+	free(t->lights);
 	memset(t, 0, sizeof(*t));
 }

@@ -30,6 +30,11 @@ typedef struct {
 	float *portal_cdf;     /* nportals + 1 (one float if none) */
 	uint32_t nportals;
 	float env_pdf_select;  /* probability that light sampling picks the environment */
+	/* Punctual lights, chosen in emitter_cdf after the emitters (which then
+	 * has nemitters + nlights + 1 entries). */
+	PunctualLight *lights; /* nlights (one if none) */
+	uint32_t nlights;
+	float light_power;     /* W: their power estimates, summed (src/lights.c) */
 } LightTables;
 
 /* `tris` is the array as uploaded (BVH order): each triangle's `emitter`

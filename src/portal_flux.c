@@ -2,9 +2,10 @@
  * triangle from each of its sides, estimated at load time with the
  * kernels' own code run on the host: from uniform points on the triangle,
  * cosine-distributed rays toward the side find the environment where they
- * escape, and next-event samples of the emitters (with shadow rays) find
- * the emitters behind that side. Per side, the flux is
- *     Phi = A (pi E[L_env escaping] + E[L_e cos cos' / (d^2 p_A)]).
+ * escape, and next-event samples of the emitters and punctual lights (with
+ * shadow rays) find those behind that side. Per side, the flux is
+ *     Phi = A (pi E[L_env escaping] + E[L_e cos cos' / (d^2 p_A)]),
+ * a punctual light's term E_perp cos / p_select.
  * From it:
  *   - env_side: the side the environment is seen through (next-event
  *     estimation through portals, kernels/env_portal.h), 0 if neither;
@@ -45,11 +46,31 @@ static void side_flux(const SceneView *sc, const PortalTri *pt, uint32_t index, 
 		V3 d = v3_from_local(sample_cosine_hemisphere(u1, u2), t, b, n);
 		if (!bvh_occluded(sc, p, d, AJAR_INF))
 			se += v3_lum(env_radiance(sc, d));
-		/* The emitters: a point by power, seen from this side. */
-		float pdf_a;
+		/* The emitters: a point by power, seen from this side; or a
+		 * punctual light, chosen in the same table. */
+		/* Drawn in the order gcc evaluated the three arguments of the
+		 * emitter_sample call this replaced (right to left), so the
+		 * tables of scenes without punctual lights stay as they were. */
+		float pdf_a, ub = rng_f(&rng), ua = rng_f(&rng), u_sel = rng_f(&rng);
 		V3 q, nq;
-		int tri = emitter_sample(sc, rng_f(&rng), rng_f(&rng), rng_f(&rng), &q, &nq, &pdf_a);
-		if (tri < 0 || !(pdf_a > 0.0f))
+		int k = light_pick(sc, u_sel);
+		if (k < 0)
+			continue;
+		if (k >= sc->params->num_emitters) {
+			GLOBAL const PunctualLight *l = &sc->punctual[k - sc->params->num_emitters];
+			V3 wi;
+			float dist;
+			V3 E = punctual_arrive(l, p, &wi, &dist);
+			float cos_p = v3_dot(wi, n);
+			if (!(cos_p > 0.0f) || !(l->pdf_select > 0.0f) || v3_is_zero(E))
+				continue;
+			int clear = dist < AJAR_INF ? segment_clear(sc, p, n, l->pos, v3_neg(wi)) : !bvh_occluded(sc, p, wi, AJAR_INF);
+			if (clear)
+				sl += v3_lum(E) * cos_p / l->pdf_select;
+			continue;
+		}
+		int tri = emitter_point(sc, k, ua, ub, &q, &nq, &pdf_a);
+		if (!(pdf_a > 0.0f))
 			continue;
 		V3 to = v3_sub(q, p);
 		float d2 = v3_len2(to);

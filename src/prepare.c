@@ -110,7 +110,9 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	d->emitters = d->lights.emitters;
 	d->n_emitters = d->lights.nemitters;
 	d->emitter_cdf = d->lights.emitter_cdf;
-	d->n_emitter_cdf = d->lights.nemitters + 1; /* sample_cdf reads cdf[n] even for n = 0 */
+	d->n_emitter_cdf = d->lights.nemitters + d->lights.nlights + 1; /* sample_cdf reads cdf[n] even for n = 0 */
+	d->punctual = d->lights.lights;
+	d->n_punctual = d->lights.nlights ? d->lights.nlights : 1;
 	d->env = d->lights.env;
 	d->n_env = d->lights.nenv;
 	d->portal_cdf = d->lights.portal_cdf;
@@ -124,6 +126,8 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	}
 	p->num_tris = (int)n;
 	p->num_emitters = (int)d->lights.nemitters;
+	p->num_lights = (int)d->lights.nlights;
+	p->light_power = d->lights.light_power;
 	p->num_portals = (int)s->nportal_tris;
 	p->num_textures = (int)s->ntextures;
 	p->env_type = s->env_type;
@@ -147,7 +151,7 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	 * scene and rarely find the way in through an opening; where the sky
 	 * is the only light, the intermediate subpaths (which start on the
 	 * portals) do their work, and the portal integrator leaves them out. */
-	p->light_paths = p->integrator != INTEGRATOR_PORTAL || p->num_emitters > 0;
+	p->light_paths = p->integrator != INTEGRATOR_PORTAL || p->num_emitters > 0 || p->num_lights > 0;
 	/* The intermediate strategies in use (kernels/portal.h), chosen by
 	 * measurement (kernels/README.md, "portal"). Where the sky is the only
 	 * light, next-event estimation through the portals takes the direct
@@ -196,8 +200,8 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 		prepare_free(d);
 		return st;
 	}
-	if (p->num_emitters == 0 && p->env_type == ENV_NONE)
-		log_msg(AJAR_LOG_WARNING, "%s: no emissive triangles and no environment: the image is black",
+	if (p->num_emitters == 0 && p->num_lights == 0 && p->env_type == ENV_NONE)
+		log_msg(AJAR_LOG_WARNING, "%s: no emissive triangles, no lights and no environment: the image is black",
 			s->source);
 	return AJAR_OK;
 }

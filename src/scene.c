@@ -75,6 +75,7 @@ void scene_free(Scene *s)
 	free(s->portals);
 	free(s->env_rgb);
 	free(s->extra);
+	free(s->lights);
 	free(s);
 }
 
@@ -386,6 +387,51 @@ ajar_status scene_add_portal(Scene *s, const char *what, const float *pos, uint3
 }
 
 static int v3_finite(V3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
+
+ajar_status scene_add_light(Scene *s, const char *what, const ajar_light *l)
+{
+	const float *num[] = {l->position, l->direction, l->color};
+	for (int k = 0; k < 3; k++)
+		for (int j = 0; j < 3; j++)
+			if (!isfinite(num[k][j]))
+				return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: position, direction or colour is not finite",
+					       s->source, what);
+	if (l->type != AJAR_LIGHT_DIRECTIONAL && l->type != AJAR_LIGHT_POINT && l->type != AJAR_LIGHT_SPOT)
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: unknown light type %d", s->source, what, (int)l->type);
+	if (!(l->color[0] >= 0.0f && l->color[1] >= 0.0f && l->color[2] >= 0.0f))
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: colour (%g, %g, %g) must be >= 0", s->source, what,
+			       l->color[0], l->color[1], l->color[2]);
+	if (!(l->intensity >= 0.0f) || !isfinite(l->intensity))
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: intensity %g must be finite and >= 0", s->source, what,
+			       l->intensity);
+	if (!(l->range >= 0.0f) || !isfinite(l->range))
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: range %g must be finite and > 0 (0: infinite)", s->source,
+			       what, l->range);
+	V3 d = v3(l->direction[0], l->direction[1], l->direction[2]);
+	if (l->type != AJAR_LIGHT_POINT && !(v3_len2(d) > 1e-20f))
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: zero direction", s->source, what);
+	if (l->type == AJAR_LIGHT_SPOT &&
+	    !(l->inner_cone >= 0.0f && l->inner_cone <= l->outer_cone && l->outer_cone > 0.0f &&
+	      l->outer_cone <= 0.5f * AJAR_PI + 1e-6f))
+		/* inner = outer (a hard edge) is what Blender exports for a spot without blend. */
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: spot cone angles %g, %g must be 0 <= inner <= outer <= pi/2, outer > 0",
+			       s->source, what, l->inner_cone, l->outer_cone);
+	ajar_status st = grow32((void **)&s->lights, &s->cap_lights, (size_t)s->nlights + 1, sizeof *s->lights);
+	if (st)
+		return st;
+	ajar_light *o = &s->lights[s->nlights++];
+	*o = *l;
+	if (v3_len2(d) > 1e-20f) {
+		d = v3_norm(d);
+		o->direction[0] = d.x + 0.0f; /* no -0, which would print as -0.000 */
+		o->direction[1] = d.y + 0.0f;
+		o->direction[2] = d.z + 0.0f;
+	} else {
+		o->direction[0] = o->direction[1] = 0.0f;
+		o->direction[2] = -1.0f;
+	}
+	return AJAR_OK;
+}
 
 ajar_status scene_set_camera(Scene *s, V3 pos, V3 forward, V3 up, float yfov, float aspect)
 {

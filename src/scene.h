@@ -51,6 +51,8 @@ typedef struct ajar_scene {
 	uint32_t nimages;        /* textures made by scene_add_texture (the others are uses of them) */
 	TriExtra *extra;         /* NULL, or one per triangle once any has TEXCOORD_1 or COLOR_0 */
 	size_t cap_extra;
+	ajar_light *lights;      /* punctual lights, glTF units, direction unit */
+	uint32_t nlights, cap_lights;
 } Scene;
 
 ajar_status scene_new(const char *source, Scene **out);
@@ -83,6 +85,10 @@ ajar_status scene_set_camera(Scene *s, V3 pos, V3 forward, V3 up, float yfov, fl
 void scene_set_env_color(Scene *s, V3 rgb);
 /* Takes ownership of rgb (malloc'ed, w * h * 3 floats). */
 ajar_status scene_set_env_image(Scene *s, uint32_t w, uint32_t h, float *rgb, float strength);
+
+/* Validates and appends a punctual light (`what` names it for messages);
+ * the direction is normalised. */
+ajar_status scene_add_light(Scene *s, const char *what, const ajar_light *l);
 
 /* Bounds of all renderable triangles (portals included). */
 void scene_bounds(const Scene *s, V3 *bmin, V3 *bmax);

@@ -6,6 +6,7 @@
  * structs to device ones and applies mesh transforms; scene.c does the
  * geometry checks every source of triangles shares. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -222,6 +223,39 @@ ajar_status ajar_scene_add_portal(ajar_scene *s, const ajar_mesh *mesh)
 	return st == AJAR_ERROR_BAD_INPUT ? AJAR_ERROR_INVALID_ARGUMENT : st;
 }
 
+void ajar_light_default(ajar_light *l)
+{
+	if (!l)
+		return;
+	memset(l, 0, sizeof *l);
+	l->type = AJAR_LIGHT_POINT;
+	l->direction[2] = -1.0f;
+	l->color[0] = l->color[1] = l->color[2] = 1.0f;
+	l->intensity = 1.0f;
+	l->outer_cone = 0.25f * AJAR_PI;
+}
+
+ajar_status ajar_scene_add_light(ajar_scene *s, const ajar_light *l)
+{
+	if (!s || !l)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_scene_add_light: NULL scene or light");
+	char what[48];
+	snprintf(what, sizeof what, "ajar_scene_add_light (light %u)", s->nlights);
+	ajar_status st = scene_add_light(s, what, l);
+	return st == AJAR_ERROR_BAD_INPUT ? AJAR_ERROR_INVALID_ARGUMENT : st;
+}
+
+ajar_status ajar_scene_light_get(const ajar_scene *s, uint32_t index, ajar_light *out)
+{
+	if (!s || !out)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_scene_light_get: NULL argument");
+	if (index >= s->nlights)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_scene_light_get: light %u does not exist (%u lights)",
+			       index, s->nlights);
+	*out = s->lights[index];
+	return AJAR_OK;
+}
+
 ajar_status ajar_scene_set_camera(ajar_scene *s, const ajar_camera *c)
 {
 	if (!s || !c)
@@ -333,5 +367,6 @@ ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info)
 	info->has_camera = s->has_camera;
 	info->width = s->width;
 	info->height = s->height;
+	info->lights = s->nlights;
 	return AJAR_OK;
 }

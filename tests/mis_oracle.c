@@ -6,9 +6,48 @@
 #include <math.h>
 
 
+static int at_infinity(const PathVertex *v) { return v->type == VERTEX_ENV || v->type == VERTEX_SUN; }
+static int punctual(const PathVertex *v) { return v->type == VERTEX_PUNCTUAL || v->type == VERTEX_SUN; }
+
+static int crosses(const double *o, const double *d, double tmax, V3 a, V3 b, V3 c, double *th);
+
+/* pf_1 of a punctual light x0 toward x1, from the light's definition:
+ * directions uniform on the sphere or in the spot's outer cone; lines of a
+ * directional light uniform on the disk of the scene's radius, or through
+ * a point of a portal triangle (p_A over the cosine, summed over the
+ * triangles the line crosses). */
+static double punctual_pf1(const SceneView *sc, const PathVertex *x0, const PathVertex *x1)
+{
+	GLOBAL const PunctualLight *l = &sc->punctual[x0->tri];
+	double dir[3] = {l->dir.x, l->dir.y, l->dir.z};
+	if (x0->type == VERTEX_SUN) {
+		double c1 = fabs(x1->ng.x * dir[0] + x1->ng.y * dir[1] + x1->ng.z * dir[2]);
+		/* Scene points lie within the disk. */
+		double disk = 1 / (M_PI * (double)l->disk_radius * l->disk_radius);
+		if (sc->params->num_portals == 0)
+			return c1 * disk;
+		double o[3] = {x1->p.x - 1e3 * dir[0], x1->p.y - 1e3 * dir[1], x1->p.z - 1e3 * dir[2]}, p = 0, th;
+		for (int i = 0; i < sc->params->num_portals; i++) {
+			GLOBAL const PortalTri *t = &sc->portals[i];
+			double c = fabs(t->n.x * dir[0] + t->n.y * dir[1] + t->n.z * dir[2]);
+			if (crosses(o, dir, 2e3, t->p0, t->p1, t->p2, &th))
+				p += t->pdf_select / (t->area * c);
+		}
+		return (SUN_DISK_SHARE * disk + (1 - SUN_DISK_SHARE) * p) * c1;
+	}
+	double d[3] = {x1->p.x - x0->p.x, x1->p.y - x0->p.y, x1->p.z - x0->p.z};
+	double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+	double pw = 1 / (4 * M_PI);
+	if (l->type == LIGHT_SPOT) {
+		double c = (d[0] * dir[0] + d[1] * dir[1] + d[2] * dir[2]) / len;
+		pw = c >= l->cos_outer ? 1 / (2 * M_PI * (1 - (double)l->cos_outer)) : 0;
+	}
+	return oracle_convert(x0, x1, (float)pw);
+}
+
 float oracle_convert(const PathVertex *from, const PathVertex *to, float pdf_w)
 {
-	if (to->type == VERTEX_ENV)
+	if (at_infinity(to))
 		return pdf_w;
 	double dx = to->p.x - from->p.x, dy = to->p.y - from->p.y, dz = to->p.z - from->p.z;
 	double d2 = dx * dx + dy * dy + dz * dz, d = sqrt(d2);
@@ -18,7 +57,7 @@ float oracle_convert(const PathVertex *from, const PathVertex *to, float pdf_w)
 
 V3 oracle_dir(const PathVertex *from, const PathVertex *to)
 {
-	return to->type == VERTEX_ENV ? to->p : v3_norm(v3_sub(to->p, from->p));
+	return at_infinity(to) ? to->p : v3_norm(v3_sub(to->p, from->p));
 }
 
 /* Solid-angle density that v's BSDF samples toward `to` given `from`. */
@@ -38,11 +77,15 @@ void oracle(const SceneView *sc, const PathVertex *x, const int *delta, int k, M
 	GLOBAL const Params *prm = sc->params;
 	float ps = prm->env_pdf_select;
 	for (int i = 0; i < k; i++) {
-		mv[i].delta = delta[i];
-		mv[i].infinite = x[i].type == VERTEX_ENV;
+		mv[i].delta = delta[i] || (i == 0 && punctual(&x[0]));
+		mv[i].infinite = at_infinity(&x[i]);
 		/* pf */
 		if (i == k - 1)
 			mv[i].pf = 0;
+		else if (i == 0 && punctual(&x[0]))
+			mv[i].pf = (1 - ps) * sc->punctual[x[0].tri].pdf_select;
+		else if (i == 1 && punctual(&x[0]))
+			mv[i].pf = (float)punctual_pf1(sc, &x[0], &x[1]);
 		else if (i == 0)
 			mv[i].pf = x[0].type == VERTEX_ENV ? ps * env_pdf_w(sc, x[0].p)
 							   : (1 - ps) * emitter_pdf_a(sc, x[0].tri, x[0].p);
@@ -57,7 +100,7 @@ void oracle(const SceneView *sc, const PathVertex *x, const int *delta, int k, M
 			mv[i].pf = delta[i - 1] ? 0 : oracle_convert(&x[i - 1], &x[i], oracle_bsdf(sc, &x[i - 1], &x[i - 2], &x[i]));
 		/* pn: x_0 as a next-event sample from x_1 */
 		if (i == 0)
-			mv[0].pn = k < 3 ? mv[0].pf
+			mv[0].pn = k < 3 || punctual(&x[0]) ? mv[0].pf
 					 : x[0].type == VERTEX_ENV ? ps * env_nee_pdf_w(sc, x[1].p, vertex_nee_normal(&x[1], &x[2]), x[0].p)
 								    : (1 - ps) * emitter_pdf_a(sc, x[0].tri, x[0].p);
 		/* pr */
@@ -78,7 +121,7 @@ void oracle(const SceneView *sc, const PathVertex *x, const int *delta, int k, M
 int near_contact(const PathVertex *x, int k, int i, float radius)
 {
 	for (int j = i - 2; j < i + 2; j++) {
-		if (j < 0 || j + 1 >= k || x[j].type == VERTEX_ENV || x[j + 1].type == VERTEX_ENV)
+		if (j < 0 || j + 1 >= k || at_infinity(&x[j]) || at_infinity(&x[j + 1]))
 			continue;
 		if (v3_len(v3_sub(x[j + 1].p, x[j].p)) < 1e-2f * radius)
 			return 1;
@@ -88,11 +131,13 @@ int near_contact(const PathVertex *x, int k, int i, float radius)
 
 int strategy_valid(const MisVertex *v, int k, int s)
 {
+	/* x_0's delta flag: a punctual light, which no ray hits and the camera
+	 * does not see; next-event estimation (s = 1) reaches it. */
 	if (s == 0)
-		return 1;
-	if (v[s - 1].delta || v[s].delta)
+		return !v[0].delta;
+	if ((s >= 2 && v[s - 1].delta) || v[s].delta)
 		return 0;
-	return !(v[s - 1].infinite && s == k - 1);
+	return !((v[s - 1].infinite || (s == 1 && v[0].delta)) && s == k - 1);
 }
 
 /* Relative difference of two densities. The walk converts the density of
@@ -158,7 +203,9 @@ static double direction_psa(const SceneView *sc, GLOBAL const PortalTri *pt, con
 {
 	double to[3], guided = 0, n[3] = {pt->n.x, pt->n.y, pt->n.z};
 	double ps = sc->params->env_pdf_select;
-	if (a->type == VERTEX_ENV) {
+	if (a->type == VERTEX_SUN) { /* the guided half never aims at a punctual light */
+		to[0] = a->p.x, to[1] = a->p.y, to[2] = a->p.z;
+	} else if (a->type == VERTEX_ENV) {
 		to[0] = a->p.x, to[1] = a->p.y, to[2] = a->p.z;
 		double pe = env_pdf_w(sc, a->p);
 		if (pt->env_side != 0) {
@@ -172,7 +219,7 @@ static double direction_psa(const SceneView *sc, GLOBAL const PortalTri *pt, con
 		double dist = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
 		for (int c = 0; c < 3; c++)
 			to[c] = d[c] / dist;
-		int tri = emitter_at(sc, a->p);
+		int tri = a->type == VERTEX_PUNCTUAL ? -1 : emitter_at(sc, a->p);
 		if (tri >= 0) {
 			V3 fn = v3_norm(tri_normal(&sc->tris[tri]));
 			double cos_l = -(fn.x * to[0] + fn.y * to[1] + fn.z * to[2]);
@@ -189,9 +236,9 @@ int oracle_pair_logs(const SceneView *sc, const PathVertex *a, const PathVertex 
 		     int max)
 {
 	double o[3], d[3], tmax = 1;
-	const PathVertex *p = a->type == VERTEX_ENV ? b : a;
-	if (a->type == VERTEX_ENV || b->type == VERTEX_ENV) {
-		const PathVertex *env = a->type == VERTEX_ENV ? a : b;
+	const PathVertex *p = at_infinity(a) ? b : a;
+	if (at_infinity(a) || at_infinity(b)) {
+		const PathVertex *env = at_infinity(a) ? a : b;
 		o[0] = p->p.x, o[1] = p->p.y, o[2] = p->p.z;
 		d[0] = env->p.x, d[1] = env->p.y, d[2] = env->p.z;
 		tmax = 1e30;
@@ -200,7 +247,7 @@ int oracle_pair_logs(const SceneView *sc, const PathVertex *a, const PathVertex 
 		d[0] = b->p.x - a->p.x, d[1] = b->p.y - a->p.y, d[2] = b->p.z - a->p.z;
 	}
 	double g;
-	if (a->type == VERTEX_ENV) {
+	if (at_infinity(a)) {
 		g = fabs(v3_dot(b->ng, a->p));
 	} else {
 		double d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];

@@ -49,7 +49,7 @@ static int check_mis(HostScene *h, int nsamples)
 					if (v3_is_zero(bdpt_emitted(sc, z, z->wo)))
 						continue;
 				} else {
-					if (l[s - 1].type == VERTEX_ENV && t == 1)
+					if ((vertex_infinite(&l[s - 1]) || (s == 1 && vertex_delta_light(&l[0]))) && t == 1)
 						continue;
 					if (e[t - 1].type == VERTEX_ENV)
 						continue;
@@ -199,6 +199,101 @@ static void test_mis_living_room(void **state)
 	host_scene_close(&h);
 }
 
+/* ---- Punctual lights ---------------------------------------------------- */
+
+/* Adds a point light, a spot and a directional light (colours, a range)
+ * to scene `s`, placed for a room of about `size` with its floor at 0
+ * around (cx, cz); `emitters` 0 removes the emission of every material. */
+static Scene *with_punctual(Scene *s, float cx, float cz, float size, int emitters)
+{
+	ajar_light l;
+	ajar_light_default(&l);
+	l.position[0] = cx - 0.2f * size;
+	l.position[1] = 0.6f * size;
+	l.position[2] = cz;
+	l.color[1] = 0.7f;
+	l.intensity = 683.0f * 0.3f * size * size;
+	l.range = 2.0f * size;
+	assert_int_equal(ajar_scene_add_light(s, &l), AJAR_OK);
+	ajar_light_default(&l);
+	l.type = AJAR_LIGHT_SPOT;
+	l.position[0] = cx + 0.2f * size;
+	l.position[1] = 0.8f * size;
+	l.position[2] = cz;
+	l.direction[0] = -0.3f;
+	l.direction[1] = -1.0f;
+	l.direction[2] = 0.2f;
+	l.inner_cone = 0.3f;
+	l.outer_cone = 0.7f;
+	l.intensity = 683.0f * 0.5f * size * size;
+	assert_int_equal(ajar_scene_add_light(s, &l), AJAR_OK);
+	ajar_light_default(&l);
+	l.type = AJAR_LIGHT_DIRECTIONAL;
+	l.direction[0] = 0.3f;
+	l.direction[1] = -0.5f;
+	l.direction[2] = 0.8f;
+	l.color[2] = 0.6f;
+	l.intensity = 683.0f * 2.0f;
+	assert_int_equal(ajar_scene_add_light(s, &l), AJAR_OK);
+	if (!emitters)
+		for (uint32_t i = 0; i < s->nmaterials; i++)
+			s->materials[i].emission = v3(0, 0, 0);
+	return s;
+}
+
+static Scene *load_with_punctual(const char *path, float cx, float cz, float size, int emitters)
+{
+	ajar_scene *s;
+	if (ajar_scene_load(path, &s) != AJAR_OK)
+		fail_msg("%s", ajar_last_error());
+	return with_punctual(s, cx, cz, size, emitters);
+}
+
+/* Cornell box (no portals: the directional light's lines cross the disk
+ * of the scene's radius) and the glossy scene (delta lobes next to the
+ * lights) with all three light types, beside their emitters and sky. */
+static void test_mis_punctual(void **state)
+{
+	HostScene h;
+	host_scene_open(&h, NULL, load_with_punctual(SCENE("cornell/cornell.gltf"), 0.278f, 0.28f, 0.55f, 1), 32, 32, INTEGRATOR_BDPT, 8);
+	assert_true(check_mis(&h, 300) > 1000);
+	host_scene_close(&h);
+	host_scene_open(&h, NULL, with_punctual(glossy_scene(), 0, -0.5f, 2, 1), 32, 32, INTEGRATOR_BDPT, 8);
+	assert_true(check_mis(&h, 600) > 1000);
+	host_scene_close(&h);
+}
+
+/* The window room with the sun shining in through its window, and its
+ * sky if `sky`. */
+static Scene *sun_window_room(int sky)
+{
+	ajar_scene *s;
+	if (ajar_scene_load(SCENE("window-room/window-room.gltf"), &s) != AJAR_OK)
+		fail_msg("%s", ajar_last_error());
+	ajar_light l;
+	ajar_light_default(&l);
+	l.type = AJAR_LIGHT_DIRECTIONAL;
+	l.direction[0] = 0.3f;
+	l.direction[1] = -0.5f;
+	l.direction[2] = 0.8f;
+	l.intensity = 683.0f * 5.0f;
+	assert_int_equal(ajar_scene_add_light(s, &l), AJAR_OK);
+	if (!sky)
+		s->env_type = ENV_NONE;
+	return s;
+}
+
+/* Its light subpaths start on the portal, and paths whose first vertex no
+ * such line reaches (outside walls) are left to next-event estimation. */
+static void test_mis_sun_portal(void **state)
+{
+	HostScene h;
+	host_scene_open(&h, NULL, sun_window_room(1), 32, 32, INTEGRATOR_BDPT, 8);
+	assert_true(h.data.params->num_portals > 0);
+	assert_true(check_mis(&h, 400) > 300);
+	host_scene_close(&h);
+}
+
 /* ---- Convergence ------------------------------------------------------- */
 
 #define BATCHES 32
@@ -250,6 +345,35 @@ static void test_strategies_unbiased(void **state)
 	host_scene_close(&hp);
 }
 
+/* The same with punctual lights alone (the Cornell box's emission taken
+ * away): s = 0 cannot reach them and the camera does not see them, so
+ * layer (s = 0) and (s = 1, t = 1) stay black, while every other strategy,
+ * light subpaths from the lights included, must give the path tracer's
+ * image. */
+static void test_strategies_unbiased_punctual(void **state)
+{
+	HostScene hb, hp;
+	const int len = 3;
+	host_scene_open(&hb, NULL, load_with_punctual(SCENE("cornell/cornell.gltf"), 0.278f, 0.28f, 0.55f, 0), 12, 12, INTEGRATOR_BDPT, len);
+	host_scene_open(&hp, NULL, load_with_punctual(SCENE("cornell/cornell.gltf"), 0.278f, 0.28f, 0.55f, 0), 12, 12, INTEGRATOR_PT, len);
+	hb.data.params->strategy_len = len;
+	hb.data.params->strategy_unweighted = 1;
+	for (int n = 1; n <= len; n++) {
+		Estimate pt, zero = {{0, 0, 0}, {0, 0, 0}};
+		char what[64];
+		hp.data.params->min_depth = hp.data.params->max_depth = n;
+		batch_estimate(&hp, 16, -1, &pt);
+		for (int s = 0; s <= n; s++) {
+			Estimate st;
+			batch_estimate(&hb, 16, (n - 1) * (n + 2) / 2 + s, &st);
+			snprintf(what, sizeof what, "punctual, length %d, strategy (s=%d, t=%d)", n, s, n + 1 - s);
+			assert_agree(what, &st, s == 0 || (s == 1 && n == 1) ? &zero : &pt, 5.0);
+		}
+	}
+	host_scene_close(&hb);
+	host_scene_close(&hp);
+}
+
 /* The weighted layers add up to the image, exactly (fixed-point sums). */
 static void test_layers_sum_to_image(void **state)
 {
@@ -284,6 +408,42 @@ static void test_bdpt_matches_pt_glossy(void **state)
 	host_scene_close(&hp);
 }
 
+/* bdpt against pt with punctual lights: the Cornell box with all three
+ * types beside its emitter. Not the glossy scene: a punctual light seen
+ * in a mirror or through smooth glass (paths light - delta lobe - ... -
+ * camera with no other vertex to connect at) is out of pt's reach, as its
+ * rays never hit the light, while bdpt's light subpaths find those
+ * caustics. */
+static void test_bdpt_matches_pt_punctual(void **state)
+{
+	HostScene hb, hp;
+	Estimate b, p;
+	host_scene_open(&hb, NULL, load_with_punctual(SCENE("cornell/cornell.gltf"), 0.278f, 0.28f, 0.55f, 1), 12, 12,
+			INTEGRATOR_BDPT, 6);
+	host_scene_open(&hp, NULL, load_with_punctual(SCENE("cornell/cornell.gltf"), 0.278f, 0.28f, 0.55f, 1), 12, 12,
+			INTEGRATOR_PT, 6);
+	batch_estimate(&hb, 8, -1, &b);
+	batch_estimate(&hp, 16, -1, &p);
+	assert_agree("Cornell box with punctual lights, bdpt vs pt", &b, &p, 5.0);
+	host_scene_close(&hb);
+	host_scene_close(&hp);
+}
+
+/* And bdpt against pt there: the light subpaths that start on the portal
+ * carry the sun's indirect light into the room. */
+static void test_bdpt_matches_pt_sun_portal(void **state)
+{
+	HostScene hb, hp;
+	Estimate b, p;
+	host_scene_open(&hb, NULL, sun_window_room(0), 12, 12, INTEGRATOR_BDPT, 6);
+	host_scene_open(&hp, NULL, sun_window_room(0), 12, 12, INTEGRATOR_PT, 6);
+	batch_estimate(&hb, 8, -1, &b);
+	batch_estimate(&hp, 16, -1, &p);
+	assert_agree("window room lit by the sun, bdpt vs pt", &b, &p, 5.0);
+	host_scene_close(&hb);
+	host_scene_close(&hp);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -294,6 +454,11 @@ int main(void)
 		cmocka_unit_test(test_layers_sum_to_image),
 		cmocka_unit_test(test_strategies_unbiased),
 		cmocka_unit_test(test_bdpt_matches_pt_glossy),
+		cmocka_unit_test(test_mis_punctual),
+		cmocka_unit_test(test_mis_sun_portal),
+		cmocka_unit_test(test_strategies_unbiased_punctual),
+		cmocka_unit_test(test_bdpt_matches_pt_punctual),
+		cmocka_unit_test(test_bdpt_matches_pt_sun_portal),
 	};
 	return cmocka_run_group_tests_name("bdpt", tests, NULL, NULL);
 }

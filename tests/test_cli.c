@@ -250,6 +250,42 @@ static void test_info(void **state)
 	result_free(&r);
 }
 
+/* A glTF with KHR_lights_punctual (required): info lists each light in
+ * glTF's units. */
+static void test_info_lights(void **state)
+{
+	char *gltf = path_in("lights.gltf");
+	FILE *f = fopen(gltf, "w");
+	assert_non_null(f);
+	fputs("{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_lights_punctual\"],"
+	      "\"extensionsRequired\":[\"KHR_lights_punctual\"],"
+	      "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[{\"type\":\"directional\",\"intensity\":3},"
+	      "{\"type\":\"spot\",\"color\":[1,0.5,0.25],\"intensity\":100,\"range\":7,"
+	      "\"spot\":{\"innerConeAngle\":0.25,\"outerConeAngle\":0.5}}]}},"
+	      "\"scene\":0,\"scenes\":[{\"nodes\":[0,1,2]}],\"nodes\":[{\"mesh\":0},"
+	      "{\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}},"
+	      "{\"translation\":[1,2,3],\"extensions\":{\"KHR_lights_punctual\":{\"light\":1}}}],"
+	      "\"buffers\":[{\"byteLength\":36,\"uri\":\"data:application/octet-stream;base64,"
+	      "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"}],"
+	      "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+	      "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\","
+	      "\"min\":[0,0,0],\"max\":[1,1,0]}],"
+	      "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}]}",
+	      f);
+	assert_int_equal(fclose(f), 0);
+	Result r = run((const char *[]){"info", gltf, NULL});
+	if (r.code != 0)
+		print_error("%s", r.err);
+	assert_int_equal(r.code, 0);
+	assert_non_null(strstr(r.out, "lights:       2 (KHR_lights_punctual)"));
+	assert_non_null(strstr(r.out, "[0] directional toward (0.000, 0.000, -1.000), colour (1, 1, 1), 3 lx"));
+	assert_non_null(strstr(r.out, "[1] spot        at (1, 2, 3) toward (0.000, 0.000, -1.000), colour (1, 0.5, 0.25), "
+				      "100 cd, cone 14.3..28.6 deg, range 7"));
+	result_free(&r);
+	unlink(gltf);
+	free(gltf);
+}
+
 static void test_tiny_render(void **state)
 {
 	char *exr = path_in("tiny.exr"), *png = path_in("tiny.png");
@@ -389,6 +425,7 @@ int main(void)
 		cmocka_unit_test(test_usage_errors),
 		cmocka_unit_test(test_bad_scenes),
 		cmocka_unit_test(test_info),
+		cmocka_unit_test(test_info_lights),
 		cmocka_unit_test(test_tiny_render),
 		cmocka_unit_test(test_cl_options),
 		cmocka_unit_test(test_sigint),

@@ -75,14 +75,11 @@ static void agree(const char *what, const Estimate *a, const Estimate *b)
 	}
 }
 
-static void compare(const char *path, uint32_t w, uint32_t h, uint32_t spp_pt, uint32_t spp_bdpt)
+static void compare_scene(ajar_scene *s, const char *path, uint32_t w, uint32_t h, uint32_t spp_pt, uint32_t spp_bdpt)
 {
-	ajar_scene *s;
 	Estimate pt, bdpt, portal;
 	char what[256];
 	const uint32_t depth = 12;
-	if (ajar_scene_load(path, &s) != AJAR_OK)
-		fail_msg("%s", ajar_last_error());
 	estimate(s, AJAR_INTEGRATOR_PT, w, h, spp_pt, depth, &pt);
 	estimate(s, AJAR_INTEGRATOR_BDPT, w, h, spp_bdpt, depth, &bdpt);
 	snprintf(what, sizeof what, "%s bdpt vs pt", path);
@@ -95,11 +92,75 @@ static void compare(const char *path, uint32_t w, uint32_t h, uint32_t spp_pt, u
 	ajar_scene_destroy(&s);
 }
 
+static void compare(const char *path, uint32_t w, uint32_t h, uint32_t spp_pt, uint32_t spp_bdpt)
+{
+	ajar_scene *s;
+	if (ajar_scene_load(path, &s) != AJAR_OK)
+		fail_msg("%s", ajar_last_error());
+	compare_scene(s, path, w, h, spp_pt, spp_bdpt);
+}
+
+/* `path` with a directional light along `dir` (intensity in lux), and a
+ * point light at p and a spot at q pointing down (candela), all in
+ * glTF's units (KHR_lights_punctual). */
+static void compare_punctual(const char *path, const char *what, const float dir[3], float lux, const float p[3],
+			     const float q[3], float cd, uint32_t w, uint32_t h, uint32_t spp_pt, uint32_t spp_bdpt)
+{
+	ajar_scene *s;
+	if (ajar_scene_load(path, &s) != AJAR_OK)
+		fail_msg("%s", ajar_last_error());
+	ajar_light l;
+	ajar_light_default(&l);
+	l.type = AJAR_LIGHT_DIRECTIONAL;
+	for (int k = 0; k < 3; k++)
+		l.direction[k] = dir[k];
+	l.intensity = lux;
+	assert_int_equal(ajar_scene_add_light(s, &l), AJAR_OK);
+	ajar_light_default(&l);
+	for (int k = 0; k < 3; k++)
+		l.position[k] = p[k];
+	l.color[2] = 0.5f;
+	l.intensity = cd;
+	assert_int_equal(ajar_scene_add_light(s, &l), AJAR_OK);
+	ajar_light_default(&l);
+	l.type = AJAR_LIGHT_SPOT;
+	for (int k = 0; k < 3; k++)
+		l.position[k] = q[k];
+	l.direction[0] = 0.1f;
+	l.direction[1] = -1.0f;
+	l.direction[2] = 0.2f;
+	l.inner_cone = 0.3f;
+	l.outer_cone = 0.6f;
+	l.intensity = 2 * cd;
+	l.range = 4.0f;
+	assert_int_equal(ajar_scene_add_light(s, &l), AJAR_OK);
+	compare_scene(s, what, w, h, spp_pt, spp_bdpt);
+}
+
 static void test_cornell(void **state) { compare(SCENE("cornell/cornell.gltf"), 32, 32, 32, 8); }
 static void test_window_room(void **state) { compare(SCENE("window-room/window-room.gltf"), 32, 32, 64, 16); }
 static void test_living_room(void **state) { compare(SCENE("living-room/living-room.gltf"), 32, 18, 64, 16); }
 static void test_bathroom(void **state) { compare(SCENE("bathroom/bathroom.gltf"), 24, 24, 32, 8); }
 static void test_door_ajar(void **state) { compare(SCENE("door-ajar/door-ajar.gltf"), 24, 24, 512, 128); }
+
+/* The Cornell box lit by its emitter, the sun through its open side, a
+ * point light and a spot (no portals: the sun's light subpaths start on
+ * the scene's disk). */
+static void test_cornell_punctual(void **state)
+{
+	const float sun[3] = {0.2f, -0.5f, 0.8f}, p[3] = {0.15f, 0.45f, 0.3f}, q[3] = {0.4f, 0.5f, 0.25f};
+	compare_punctual(SCENE("cornell/cornell.gltf"), "cornell + punctual lights", sun, 683.0f, p, q, 0.1f * 683.0f,
+			 32, 32, 32, 8);
+}
+
+/* The window room lit by the sun through its window (light subpaths start
+ * on the portal), a point light and a spot, besides its sky. */
+static void test_window_room_punctual(void **state)
+{
+	const float sun[3] = {0.3f, -0.5f, 0.8f}, p[3] = {1.0f, 2.2f, 2.0f}, q[3] = {3.0f, 2.5f, 1.5f};
+	compare_punctual(SCENE("window-room/window-room.gltf"), "window-room + sun + punctual lights", sun,
+			 683.0f * 10.0f, p, q, 683.0f, 32, 32, 64, 16);
+}
 
 int main(void)
 {
@@ -109,6 +170,8 @@ int main(void)
 		cmocka_unit_test(test_living_room),
 		cmocka_unit_test(test_bathroom),
 		cmocka_unit_test(test_door_ajar),
+		cmocka_unit_test(test_cornell_punctual),
+		cmocka_unit_test(test_window_room_punctual),
 	};
 	return cmocka_run_group_tests_name("integrators", tests, NULL, NULL);
 }

@@ -145,7 +145,9 @@ static void check_path(const SceneView *sc, const PathRef *P, MisStats *st)
 					if (s > set.s_max || m - s + 1 > set.sp_max || tp > set.tp_max ||
 					    k - m - tp - 1 > set.t_max)
 						continue; /* not in use */
-					if (s > 0 && (orc[s - 1].delta || orc[s].delta))
+					/* orc[0].delta: a punctual light, which the <- half cannot
+					 * reach (s = 0) but next-event estimation can (s = 1) */
+					if ((s == 0 && orc[0].delta) || (s >= 2 && orc[s - 1].delta) || (s > 0 && orc[s].delta))
 						continue;
 					if (orc[m + tp].delta || orc[m + tp + 1].delta)
 						continue;
@@ -300,7 +302,7 @@ static MisStats check_scene_mis(HostScene *h, int nsamples)
 		 * stands for x_0 here, not a next-event sample */
 		for (int s = 1; s <= nl && s <= depth; s++) {
 			V3 w = v3_sub(e[0].p, l[s - 1].p);
-			if (l[s - 1].type == VERTEX_ENV ||
+			if (vertex_infinite(&l[s - 1]) || (s == 1 && vertex_delta_light(&l[0])) ||
 			    (s >= 2 && v3_is_zero(bdpt_scatter(&l[s - 1], v3_norm(w), BSDF_IMPORTANCE))))
 				continue;
 			path_ref(&P, l, s, 0, 0, 0, 0, e, 1);
@@ -391,6 +393,94 @@ static void test_mis_door_ajar(void **state)
 	use_all_portal_strategies(&h);
 	assert_true(check_scene_mis(&h, 300).portal_paths > 50);
 	host_scene_close(&h);
+}
+
+/* ---- Punctual lights --------------------------------------------------- */
+
+/* `path` with a directional light at `dir` and, if `inside`, a point light
+ * at p and a spot at q pointing down; `sky` 0 removes the environment. */
+static Scene *punctual_scene(const char *path, const float dir[3], int inside, const float p[3], const float q[3],
+			     int sky)
+{
+	ajar_scene *s;
+	if (ajar_scene_load(path, &s) != AJAR_OK)
+		fail_msg("%s", ajar_last_error());
+	ajar_light l;
+	ajar_light_default(&l);
+	l.type = AJAR_LIGHT_DIRECTIONAL;
+	memcpy(l.direction, dir, sizeof l.direction);
+	l.color[2] = 0.8f;
+	l.intensity = 683.0f * 4.0f;
+	assert_int_equal(ajar_scene_add_light(s, &l), AJAR_OK);
+	if (inside) {
+		ajar_light_default(&l);
+		memcpy(l.position, p, sizeof l.position);
+		l.intensity = 683.0f * 0.5f;
+		l.range = 6.0f;
+		assert_int_equal(ajar_scene_add_light(s, &l), AJAR_OK);
+		ajar_light_default(&l);
+		l.type = AJAR_LIGHT_SPOT;
+		memcpy(l.position, q, sizeof l.position);
+		l.direction[0] = 0.2f;
+		l.direction[1] = -1.0f;
+		l.direction[2] = 0.1f;
+		l.inner_cone = 0.2f;
+		l.outer_cone = 0.6f;
+		l.intensity = 683.0f;
+		assert_int_equal(ajar_scene_add_light(s, &l), AJAR_OK);
+	}
+	if (!sky)
+		s->env_type = ENV_NONE;
+	return s;
+}
+
+static const float sun_in[3] = {0.3f, -0.5f, 0.8f}; /* through window-room's window */
+static const float wr_p[3] = {1.0f, 2.2f, 2.0f}, wr_q[3] = {3.0f, 2.5f, 1.5f};
+
+static Scene *sun_window_room(int inside, int sky)
+{
+	return punctual_scene(SCENE("window-room/window-room.gltf"), sun_in, inside, wr_p, wr_q, sky);
+}
+
+/* The window room with the sun through its window (light subpaths start
+ * on the portal), a point light and a spot, and its sky; door-ajar with a
+ * sun outside its house and the lights beside its emitter. */
+static void test_mis_punctual(void **state)
+{
+	HostScene h;
+	host_scene_open(&h, NULL, sun_window_room(1, 1), 24, 24, INTEGRATOR_PORTAL, 8);
+	assert_true(h.data.params->light_paths);
+	assert_true(check_scene_mis(&h, 200).portal_paths > 100);
+	use_all_portal_strategies(&h);
+	assert_true(check_scene_mis(&h, 300).portal_paths > 100);
+	host_scene_close(&h);
+	const float sun[3] = {-0.4f, -0.6f, 0.5f}, p[3] = {2.0f, 2.0f, 6.0f}, q[3] = {1.0f, 2.4f, 2.0f};
+	host_scene_open(&h, NULL, punctual_scene(SCENE("door-ajar/door-ajar.gltf"), sun, 1, p, q, 0), 24, 24,
+			INTEGRATOR_PORTAL, 8);
+	assert_true(check_scene_mis(&h, 300).portal_paths > 50);
+	assert_true(check_join_weights(&h, 100) > 500);
+	host_scene_close(&h);
+}
+
+/* portal against pt in the window room lit by the sun, a point light and
+ * a spot (no sky, so they carry all the light). */
+static void test_portal_matches_pt_punctual(void **state)
+{
+	HostScene hq, hp;
+	Estimate q, p;
+	host_scene_open(&hq, NULL, sun_window_room(1, 0), 12, 12, INTEGRATOR_PORTAL, 6);
+	host_scene_open(&hp, NULL, sun_window_room(1, 0), 12, 12, INTEGRATOR_PT, 6);
+	host_batch_estimate(&hq, 4, -1, 32, 2000, &q);
+	host_batch_estimate(&hp, 16, -1, 32, 2000, &p);
+	for (int c = 0; c < 3; c++) {
+		double se = sqrt(q.se[c] * q.se[c] + p.se[c] * p.se[c]), z = (q.mean[c] - p.mean[c]) / se;
+		print_message("window room with punctual lights, portal vs pt, channel %d: %.5f +- %.5f vs %.5f +- %.5f "
+			      "(%.1f se)\n", c, q.mean[c], q.se[c], p.mean[c], p.se[c], z);
+		if (fabs(z) > 5)
+			fail_msg("channel %d: portal and pt differ by %.1f standard errors", c, z);
+	}
+	host_scene_close(&hq);
+	host_scene_close(&hp);
 }
 
 /* A room lit by a ceiling light, with a window portal and, outside, a
@@ -769,6 +859,8 @@ int main(void)
 		cmocka_unit_test(test_wasted_fewer),
 		cmocka_unit_test(test_portal_set),
 		cmocka_unit_test(test_portal_rate),
+		cmocka_unit_test(test_mis_punctual),
+		cmocka_unit_test(test_portal_matches_pt_punctual),
 	};
 	return cmocka_run_group_tests_name("portal", tests, NULL, NULL);
 }

@@ -1082,6 +1082,123 @@ static void test_broken_files(void **state)
 	load_fails("nonexistent.gltf", AJAR_ERROR_IO, "cannot open");
 }
 
+/* ---- KHR_lights_punctual ------------------------------------------------ */
+
+/* The one-triangle scene with `nodes` after the mesh node (nodes[0]) and
+ * root lights `lights`, the extension required. */
+static void write_lights_gltf(const char *name, const char *scene_nodes, const char *nodes, const char *lights)
+{
+	write_tri_bin();
+	char json[4096];
+	snprintf(json, sizeof json,
+		 "{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_lights_punctual\"],"
+		 "\"extensionsRequired\":[\"KHR_lights_punctual\"],"
+		 "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[%s]}},"
+		 "\"scene\":0,\"scenes\":[{\"nodes\":[0,%s]}],\"nodes\":[{\"mesh\":0},%s]," TRI_BUFFERS(
+			 "tri.bin") "," TRI_ACCESSORS(3) "}",
+		 lights, scene_nodes, nodes);
+	write_text(name, json);
+}
+
+#define LIGHT_NODE(i) "{\"extensions\":{\"KHR_lights_punctual\":{\"light\":" #i "}}"
+
+static void test_lights_punctual(void **state)
+{
+	/* nodes[1]: the directional light turned -90 degrees about X (-Z to
+	 * -Y); nodes[2]: the point light at (1, 2, 3); nodes[3] (scaled, child
+	 * of nodes[4] at (0, 1, 0)): the spot, pointing down -Z. */
+	write_lights_gltf("lights.gltf", "1,2,4",
+			  LIGHT_NODE(0) ",\"rotation\":[-0.70710678,0,0,0.70710678]}," LIGHT_NODE(
+				  1) ",\"translation\":[1,2,3]}," LIGHT_NODE(2) ",\"scale\":[2,2,2]},"
+				     "{\"translation\":[0,1,0],\"children\":[3]}",
+			  "{\"type\":\"directional\",\"color\":[1,0.5,0.25],\"intensity\":3},"
+			  "{\"type\":\"point\",\"range\":5},"
+			  "{\"type\":\"spot\",\"intensity\":683,\"spot\":{\"innerConeAngle\":0.1,\"outerConeAngle\":0.3}}");
+	Scene *s = load_ok("lights.gltf");
+	ajar_scene_info in;
+	assert_int_equal(ajar_scene_info_get(s, &in), AJAR_OK);
+	assert_int_equal(in.lights, 3);
+	ajar_light l;
+	assert_int_equal(ajar_scene_light_get(s, 0, &l), AJAR_OK);
+	assert_int_equal(l.type, AJAR_LIGHT_DIRECTIONAL);
+	assert_float_equal(l.direction[0], 0.0f, 1e-6f);
+	assert_float_equal(l.direction[1], -1.0f, 1e-6f);
+	assert_float_equal(l.direction[2], 0.0f, 1e-6f);
+	assert_float_equal(l.color[1], 0.5f, 0.0f);
+	assert_float_equal(l.intensity, 3.0f, 0.0f);
+	assert_int_equal(ajar_scene_light_get(s, 1, &l), AJAR_OK);
+	assert_int_equal(l.type, AJAR_LIGHT_POINT);
+	assert_float_equal(l.position[0], 1.0f, 0.0f);
+	assert_float_equal(l.position[1], 2.0f, 0.0f);
+	assert_float_equal(l.position[2], 3.0f, 0.0f);
+	assert_float_equal(l.color[0], 1.0f, 0.0f); /* the spec's defaults */
+	assert_float_equal(l.intensity, 1.0f, 0.0f);
+	assert_float_equal(l.range, 5.0f, 0.0f);
+	/* The scene walks the root nodes in order: the spot (child of
+	 * nodes[4]) comes last. */
+	assert_int_equal(ajar_scene_light_get(s, 2, &l), AJAR_OK);
+	assert_int_equal(l.type, AJAR_LIGHT_SPOT);
+	assert_float_equal(l.position[1], 1.0f, 0.0f);
+	assert_float_equal(l.direction[2], -1.0f, 1e-6f); /* scale leaves it unit */
+	assert_float_equal(l.inner_cone, 0.1f, 1e-7f);
+	assert_float_equal(l.outer_cone, 0.3f, 1e-7f);
+	assert_float_equal(l.range, 0.0f, 0.0f); /* infinite */
+	assert_int_equal(ajar_scene_light_get(s, 3, &l), AJAR_ERROR_INVALID_ARGUMENT);
+	ajar_scene_destroy(&s);
+
+	/* A spot without blend, as Blender exports it: inner = outer. */
+	write_lights_gltf("hard.gltf", "1", LIGHT_NODE(0) "}",
+			  "{\"type\":\"spot\",\"spot\":{\"innerConeAngle\":0.5,\"outerConeAngle\":0.5}}");
+	s = load_ok("hard.gltf");
+	ajar_scene_destroy(&s);
+
+	write_lights_gltf("nolight.gltf", "1", LIGHT_NODE(7) "}", "{\"type\":\"point\"}");
+	load_fails("nolight.gltf", AJAR_ERROR_BAD_INPUT, "nodes[1]: KHR_lights_punctual light 7 does not exist (1 lights)");
+	write_lights_gltf("area.gltf", "1", LIGHT_NODE(0) "}", "{\"type\":\"area\"}");
+	load_fails("area.gltf", AJAR_ERROR_BAD_INPUT, "KHR_lights_punctual.lights[0]: unknown type 'area'");
+	write_lights_gltf("colour.gltf", "1", LIGHT_NODE(0) "}", "{\"type\":\"point\",\"color\":[1,1]}");
+	load_fails("colour.gltf", AJAR_ERROR_BAD_INPUT, "color has 2 numbers, expected 3");
+	write_lights_gltf("negative.gltf", "1", LIGHT_NODE(0) "}", "{\"type\":\"point\",\"intensity\":-1}");
+	load_fails("negative.gltf", AJAR_ERROR_BAD_INPUT, "nodes[1]: KHR_lights_punctual.lights[0]: intensity -1");
+	write_lights_gltf("range.gltf", "1", LIGHT_NODE(0) "}", "{\"type\":\"point\",\"range\":-2}");
+	load_fails("range.gltf", AJAR_ERROR_BAD_INPUT, "range -2 must be finite and > 0");
+	write_lights_gltf("cone.gltf", "1", LIGHT_NODE(0) "}",
+			  "{\"type\":\"spot\",\"spot\":{\"innerConeAngle\":0.6,\"outerConeAngle\":0.5}}");
+	load_fails("cone.gltf", AJAR_ERROR_BAD_INPUT, "spot cone angles 0.6, 0.5");
+}
+
+/* The API's lights: defaults, validation, what comes back. */
+static void test_api_lights(void **state)
+{
+	ajar_scene *s;
+	assert_int_equal(ajar_scene_create(&s), AJAR_OK);
+	ajar_light l, got;
+	ajar_light_default(&l);
+	assert_int_equal(l.type, AJAR_LIGHT_POINT);
+	assert_float_equal(l.outer_cone, (float)(M_PI / 4), 1e-7f);
+	l.type = AJAR_LIGHT_SPOT;
+	l.direction[0] = 3.0f;
+	l.direction[2] = 0.0f;
+	assert_int_equal(ajar_scene_add_light(s, &l), AJAR_OK);
+	assert_int_equal(ajar_scene_light_get(s, 0, &got), AJAR_OK);
+	assert_float_equal(got.direction[0], 1.0f, 0.0f); /* normalised */
+	l.direction[0] = 0.0f;
+	assert_int_equal(ajar_scene_add_light(s, &l), AJAR_ERROR_INVALID_ARGUMENT);
+	assert_non_null(strstr(ajar_last_error(), "zero direction"));
+	l.type = AJAR_LIGHT_POINT; /* a point light needs none */
+	assert_int_equal(ajar_scene_add_light(s, &l), AJAR_OK);
+	l.color[1] = NAN;
+	assert_int_equal(ajar_scene_add_light(s, &l), AJAR_ERROR_INVALID_ARGUMENT);
+	l.color[1] = 1.0f;
+	l.type = (ajar_light_type)5;
+	assert_int_equal(ajar_scene_add_light(s, &l), AJAR_ERROR_INVALID_ARGUMENT);
+	assert_int_equal(ajar_scene_add_light(s, NULL), AJAR_ERROR_INVALID_ARGUMENT);
+	ajar_scene_info in;
+	assert_int_equal(ajar_scene_info_get(s, &in), AJAR_OK);
+	assert_int_equal(in.lights, 2);
+	ajar_scene_destroy(&s);
+}
+
 static int setup(void **state)
 {
 	tmpdir = test_tmpdir();
@@ -1128,6 +1245,8 @@ int main(void)
 		cmocka_unit_test(test_generated_tangents),
 		cmocka_unit_test(test_normal_map),
 		cmocka_unit_test(test_broken_files),
+		cmocka_unit_test(test_lights_punctual),
+		cmocka_unit_test(test_api_lights),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
 }

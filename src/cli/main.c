@@ -544,6 +544,25 @@ static int cmd_info(int argc, char **argv)
 	printf("materials:    %u\n", in.materials);
 	printf("emissive:     %u triangles\n", in.emissive_triangles);
 	printf("portals:      %u objects, %u triangles\n", in.portals, in.portal_triangles);
+	printf("lights:       %u (KHR_lights_punctual)\n", in.lights);
+	for (uint32_t i = 0; i < in.lights; i++) {
+		ajar_light l;
+		if (ajar_scene_light_get(scene, i, &l) != AJAR_OK)
+			break;
+		static const char *const kind[] = {"directional", "point", "spot"};
+		printf("  [%u] %-11s", i, kind[l.type]);
+		if (l.type != AJAR_LIGHT_DIRECTIONAL)
+			printf(" at (%g, %g, %g)", l.position[0], l.position[1], l.position[2]);
+		if (l.type != AJAR_LIGHT_POINT)
+			printf(" toward (%.3f, %.3f, %.3f)", l.direction[0], l.direction[1], l.direction[2]);
+		printf(", colour (%g, %g, %g), %g %s", l.color[0], l.color[1], l.color[2], l.intensity,
+		       l.type == AJAR_LIGHT_DIRECTIONAL ? "lx" : "cd");
+		if (l.type == AJAR_LIGHT_SPOT)
+			printf(", cone %.1f..%.1f deg", l.inner_cone * 180.0 / M_PI, l.outer_cone * 180.0 / M_PI);
+		if (l.type != AJAR_LIGHT_DIRECTIONAL && l.range > 0.0f)
+			printf(", range %g", l.range);
+		printf("\n");
+	}
 	printf("textures:     %u (%u base colour, %u metallic-roughness, %u emissive, %u normal; %.1f MiB)\n",
 	       in.textures, in.base_color_textures, in.metallic_roughness_textures, in.emissive_textures,
 	       in.normal_textures,

@@ -43,7 +43,8 @@ def main():
 		p.error("give exactly one of --seconds and --spp")
 	a.width, a.height = (int(x) for x in a.size.split("x"))
 	s = Scene(a.scene)
-	s.check_lambertian()
+	if a.integrator != "principled":  # cycles-principled: glTF's materials (energy.py)
+		s.check_lambertian()
 	mod = importlib.import_module("backend_" + a.renderer)
 	rgb, info = mod.render(s, a, t0)
 	import numpy as np

@@ -8,7 +8,11 @@ strength is multiplied by (1 - Backfacing), and the material's emission
 sampling is FRONT. The world is the uniform environment (black if none).
 With --integrator noportal the scene has no portal; otherwise every Ajar
 portal quad becomes a Cycles portal: an area light with is_portal set, of
-the quad's size, emitting into the room.
+the quad's size, emitting into the room. With --integrator principled
+(tests/peers/energy.py) a material that is not Lambertian gets a Principled
+BSDF with its base colour, metallic, roughness, IOR and Specular IOR Level
+0.5 x specularFactor (0.5 leaves the IOR's Fresnel as it is), as Blender's
+glTF importer builds it; portals stay.
 
 Matching (see tests/peers/README.md): max_bounces = D - 2 for Ajar's and
 Mitsuba's max depth D (Cycles counts bounces after the first hit, and the
@@ -41,17 +45,29 @@ def make_mesh(bpy, name, v, f):
 	return me
 
 
-def make_material(bpy, name, base, emission):
+def make_material(bpy, name, base, emission, pbr=None):
 	mat = bpy.data.materials.new(name)
 	mat.use_nodes = True
 	nt = mat.node_tree
 	for n in list(nt.nodes):
 		nt.nodes.remove(n)
 	out = nt.nodes.new("ShaderNodeOutputMaterial")
-	dif = nt.nodes.new("ShaderNodeBsdfDiffuse")
-	dif.inputs["Color"].default_value = (*[float(x) for x in base], 1.0)
-	dif.inputs["Roughness"].default_value = 0.0
-	shader = dif.outputs["BSDF"]
+	if pbr is None:
+		dif = nt.nodes.new("ShaderNodeBsdfDiffuse")
+		dif.inputs["Color"].default_value = (*[float(x) for x in base], 1.0)
+		dif.inputs["Roughness"].default_value = 0.0
+		shader = dif.outputs["BSDF"]
+	else:
+		pr = nt.nodes.new("ShaderNodeBsdfPrincipled")
+		pr.inputs["Base Color"].default_value = (*[float(x) for x in base], 1.0)
+		pr.inputs["Metallic"].default_value = float(pbr["metallic"])
+		pr.inputs["Roughness"].default_value = float(pbr["roughness"])
+		pr.inputs["IOR"].default_value = float(pbr["ior"])
+		pr.inputs["Specular IOR Level"].default_value = 0.5 * float(pbr["specular"])
+		pr.inputs["Emission Strength"].default_value = 0.0
+		if "Diffuse Roughness" in pr.inputs:  # 0: Lambertian, like Ajar's base
+			pr.inputs["Diffuse Roughness"].default_value = 0.0
+		shader = pr.outputs["BSDF"]
 	s = float(max(emission))
 	if s > 0:
 		em = nt.nodes.new("ShaderNodeEmission")
@@ -87,7 +103,8 @@ def build(bpy, mathutils, scene, a):
 	for mi_index, (v, f) in scene.by_material().items():
 		m = scene.materials[mi_index]
 		me = make_mesh(bpy, f"mesh{mi_index}", v, f)
-		me.materials.append(make_material(bpy, m["name"], m["base"], m["emission"]))
+		pbr = m if a.integrator == "principled" and not m["lambertian"] else None
+		me.materials.append(make_material(bpy, m["name"], m["base"], m["emission"], pbr))
 		sc.collection.objects.link(bpy.data.objects.new(f"mesh{mi_index}", me))
 	world = bpy.data.worlds.new("world")
 	world.use_nodes = True

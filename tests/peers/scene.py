@@ -131,10 +131,12 @@ class Scene:
 		metallic = pbr.get("metallicFactor", 1.0)
 		transmission = ext.get("KHR_materials_transmission", {}).get("transmissionFactor", 0.0)
 		specular = ext.get("KHR_materials_specular", {}).get("specularFactor", 1.0)
+		roughness = pbr.get("roughnessFactor", 1.0)
+		ior = ext.get("KHR_materials_ior", {}).get("ior", 1.5)
 		return {
 			"name": m.get("name", f"material{i}"), "base": base, "texture": tex["index"] if tex else None,
 			"emission": emission, "metallic": metallic, "transmission": transmission,
-			"specular": specular, "double_sided": m.get("doubleSided", False),
+			"specular": specular, "roughness": roughness, "ior": ior, "double_sided": m.get("doubleSided", False),
 			"lambertian": metallic == 0 and transmission == 0 and specular == 0 and tex is None,
 			"portal_material": bool(m.get("extras", {}).get("portal_material", False)),
 		}
@@ -144,7 +146,7 @@ class Scene:
 		if self.default_material is None:
 			self.materials.append({
 				"name": "default", "base": np.ones(3), "texture": None, "emission": np.zeros(3),
-				"metallic": 1.0, "transmission": 0.0, "specular": 1.0, "double_sided": False,
+				"metallic": 1.0, "transmission": 0.0, "specular": 1.0, "roughness": 1.0, "ior": 1.5, "double_sided": False,
 				"lambertian": False, "portal_material": False})
 			self.default_material = len(self.materials) - 1
 		return self.default_material
@@ -249,9 +251,12 @@ class Scene:
 		return rects
 
 
-def write_lambert_variant(scene, out_path):
+def write_lambert_variant(scene, out_path, pbr=False):
 	"""The matched variant of `scene` (see the module comment) as glTF at
-	out_path (+ .bin beside it). Returns a list of lines saying what changed."""
+	out_path (+ .bin beside it). Returns a list of lines saying what changed.
+	With pbr, materials keep their metallic, roughness, specular and ior
+	(glTF's specular layers stay on: the energy comparison, energy.py); only
+	textures become their mean and transmissive meshes are removed."""
 	notes = []
 	mats, remap = [], {}
 	used = sorted({mi for mi, _, _ in scene.meshes})
@@ -266,16 +271,22 @@ def write_lambert_variant(scene, out_path):
 			mean = scene.texture_mean(m["texture"])
 			base = base * mean
 			was.append(f"texture (mean linear colour {np.round(mean, 4).tolist()})")
-		if m["metallic"] > 0:
+		if m["metallic"] > 0 and not pbr:
 			was.append(f"metallic {m['metallic']:g}")
-		if m["metallic"] < 1 and m["specular"] > 0:
+		if m["metallic"] < 1 and m["specular"] > 0 and not pbr:
 			was.append(f"dielectric layer (specular {m['specular']:g})")
 		if was:
-			notes.append(f"material {m['name']}: " + ", ".join(was) + f" -> Lambertian {np.round(base, 4).tolist()}")
+			notes.append(f"material {m['name']}: " + ", ".join(was) + " -> " + ("base colour" if pbr else "Lambertian") +
+				     f" {np.round(base, 4).tolist()}")
 		remap[mi] = len(mats)
 		mat = {"name": m["name"], "pbrMetallicRoughness": {"baseColorFactor": [float(x) for x in base] + [1.0],
 								   "metallicFactor": 0.0, "roughnessFactor": 1.0},
 		       "doubleSided": True, "extensions": {"KHR_materials_specular": {"specularFactor": 0.0}}}
+		if pbr:
+			mat["pbrMetallicRoughness"]["metallicFactor"] = float(m["metallic"])
+			mat["pbrMetallicRoughness"]["roughnessFactor"] = float(m["roughness"])
+			mat["extensions"] = {"KHR_materials_specular": {"specularFactor": float(m["specular"])},
+					     "KHR_materials_ior": {"ior": float(m["ior"])}}
 		if m["emission"].max() > 0:
 			s = float(m["emission"].max())
 			mat["emissiveFactor"] = [float(x) / s for x in m["emission"]]
@@ -327,7 +338,7 @@ def write_lambert_variant(scene, out_path):
 		scene_extras["environment"] = {"color": scene.environment}
 	base = os.path.splitext(os.path.basename(out_path))[0]
 	g = {"asset": {"version": "2.0", "generator": "Ajar tests/peers/scene.py (Lambertian variant)"},
-	     "extensionsUsed": ["KHR_materials_specular", "KHR_materials_emissive_strength"],
+	     "extensionsUsed": ["KHR_materials_specular", "KHR_materials_emissive_strength"] + (["KHR_materials_ior"] if pbr else []),
 	     "scene": 0, "scenes": [{"nodes": list(range(len(nodes))), "extras": scene_extras}],
 	     "nodes": nodes, "meshes": meshes, "materials": mats, "cameras": [cam],
 	     "accessors": accessors, "bufferViews": views,
