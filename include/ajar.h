@@ -148,6 +148,12 @@ typedef struct {
 	ajar_camera camera;
 	int has_camera;          /* 0: a default view framing the bounds is used */
 	uint32_t width, height;  /* suggested resolution (glTF extras), or 0 */
+	/* Images used as each kind of texture (an image used as two kinds
+	 * counts in both). */
+	uint32_t base_color_textures, metallic_roughness_textures, emissive_textures;
+	uint64_t texture_bytes;  /* texel memory on a device */
+	uint64_t alpha_triangles; /* triangles whose alpha (MASK, BLEND) rays test */
+	uint32_t normal_textures; /* images used as normal maps */
 	uint32_t lights;         /* KHR_lights_punctual lights (ajar_scene_light_get) */
 } ajar_scene_info;
 ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info);

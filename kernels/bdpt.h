@@ -251,7 +251,7 @@ CALLED int bdpt_light_subpath(const SceneView *sc, PathVertex *l, int max_verts,
 	if (!(lc.z > 0.0f))
 		return 1;
 	V3 dir = v3_from_local(lc, t, b, n);
-	V3 Le = emitter_radiance(sc, tri, dir);
+	V3 Le = emitter_radiance(sc, tri, p, dir);
 	/* Le cos / (pf_0 cos / pi) */
 	V3 beta = v3_scale(Le, AJAR_PI / y->pf);
 	return vertex_walk(sc, l, 1, max_verts, ray_offset(p, n, dir), dir, beta, lc.z * AJAR_INV_PI, 0, 1, 0,

@@ -159,7 +159,9 @@ INLINE float bsdf_w_glass(const Bsdf *bs) { return (1.0f - bs->metallic) * bs->t
 INLINE int bsdf_smooth(const Bsdf *bs) { return bs->alpha < BSDF_DELTA_ALPHA; }
 INLINE float bsdf_coat_alpha(const Bsdf *bs) { return fmax(bs->alpha, BSDF_MIN_ALPHA); }
 
-INLINE void bsdf_setup(Bsdf *bs, GLOBAL const Material *m, V3 base_color, V3 ns, V3 ng)
+/* The BSDF of material m with metallic and roughness given (textured, surface.h). */
+INLINE void bsdf_setup_mr(Bsdf *bs, GLOBAL const Material *m, V3 base_color, float metallic, float roughness, V3 ns,
+			  V3 ng)
 {
 	float lg = v3_len(ng);
 	bs->ng = lg > 0.0f ? v3_scale(ng, 1.0f / lg) : v3(0.0f, 0.0f, 1.0f);
@@ -172,8 +174,8 @@ INLINE void bsdf_setup(Bsdf *bs, GLOBAL const Material *m, V3 base_color, V3 ns,
 	bs->n = n;
 	v3_basis(n, &bs->t, &bs->b);
 	bs->base_color = v3(bsdf_clamp01(base_color.x), bsdf_clamp01(base_color.y), bsdf_clamp01(base_color.z));
-	bs->metallic = bsdf_clamp01(m->metallic);
-	float r = bsdf_clamp01(m->roughness);
+	bs->metallic = bsdf_clamp01(metallic);
+	float r = bsdf_clamp01(roughness);
 	bs->alpha = r * r;
 	bs->transmission = bsdf_clamp01(m->transmission);
 	bs->ior = fmin(fmax(m->ior, BSDF_MIN_IOR), BSDF_MAX_IOR);
@@ -225,6 +227,12 @@ INLINE void bsdf_setup(Bsdf *bs, GLOBAL const Material *m, V3 base_color, V3 ns,
 		bs->metal_fms = v3(fa.x * fa.x * e / (1.0f - fa.x * (1.0f - e)), fa.y * fa.y * e / (1.0f - fa.y * (1.0f - e)),
 				   fa.z * fa.z * e / (1.0f - fa.z * (1.0f - e)));
 	}
+}
+
+/* The BSDF of material m, its metallic and roughness untextured. */
+INLINE void bsdf_setup(Bsdf *bs, GLOBAL const Material *m, V3 base_color, V3 ns, V3 ng)
+{
+	bsdf_setup_mr(bs, m, base_color, m->metallic, m->roughness, ns, ng);
 }
 
 /* Contains some delta lobe (smooth metal or glass with a non-zero weight). */

@@ -10,6 +10,7 @@
  * "Robust BVH ray traversal"). */
 #ifndef AJAR_KERNEL_BVH_H
 #define AJAR_KERNEL_BVH_H
+#include "texture.h"
 #include "types.h"
 
 #define BVH_STACK_SIZE 224
@@ -248,7 +249,9 @@ INLINE int bvh_traverse(const SceneView *sc, V3 o, V3 d, float tmax, int any_hit
 			int first = BVH_LEAF_FIRST(entry), last = first + BVH_LEAF_COUNT(entry);
 			for (int i = first; i < last; i++) {
 				float t, u, v;
-				if (tri_intersect(&r, &sc->tris[i], tmax, &t, &u, &v)) {
+				/* Alpha-tested triangles (TRI_ALPHA) may let the ray pass. */
+				if (tri_intersect(&r, &sc->tris[i], tmax, &t, &u, &v) &&
+				    (!(sc->tris[i].flags & TRI_ALPHA) || alpha_hit(sc, i, u, v, o, d))) {
 					found = 1;
 					tmax = t;
 					hit->t = t;

@@ -16,7 +16,7 @@ INLINE V3 bdpt_emitted(const SceneView *sc, const PathVertex *l, V3 w)
 		return v3(0.0f, 0.0f, 0.0f);
 	if (l->type == VERTEX_ENV)
 		return env_radiance(sc, l->p);
-	return emitter_radiance(sc, l->tri, w);
+	return emitter_radiance(sc, l->tri, l->p, w);
 }
 
 /* Density of the light vertex as a light subpath's origin (pf_0). */
@@ -27,7 +27,7 @@ INLINE float bdpt_origin_pdf(const SceneView *sc, const PathVertex *l)
 		return ps * env_pdf_w(sc, l->p);
 	if (vertex_delta_light(l)) /* the probability of the choice; its delta cancels */
 		return (1.0f - ps) * sc->punctual[l->tri].pdf_select;
-	return (1.0f - ps) * emitter_pdf_a(sc, l->tri);
+	return (1.0f - ps) * emitter_pdf_a(sc, l->tri, l->p);
 }
 
 /* Density of the light vertex as a next-event sample from vertex x, seen
@@ -39,7 +39,7 @@ INLINE float bdpt_nee_pdf(const SceneView *sc, const PathVertex *l, const PathVe
 		return ps * env_nee_pdf_w(sc, x->p, vertex_nee_normal(x, from), l->p);
 	if (vertex_delta_light(l)) /* as the light subpath's origin: pn_0 = pf_0 */
 		return (1.0f - ps) * sc->punctual[l->tri].pdf_select;
-	return (1.0f - ps) * emitter_pdf_a(sc, l->tri);
+	return (1.0f - ps) * emitter_pdf_a(sc, l->tri, l->p);
 }
 
 /* x_0's two densities in a path's MIS records: as the light subpath's

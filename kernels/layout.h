@@ -6,7 +6,7 @@
 #include "types.h"
 
 #define AJAR_LAYOUT_TYPES(X) \
-	X(BvhNode, 256) X(Tri, 48) X(TriShade, 64) X(Material, 64) X(Texture, 16) \
+	X(BvhNode, 256) X(Tri, 48) X(TriShade, 64) X(TriExtra, 128) X(Material, 80) X(Texture, 48) \
 	X(Emitter, 16) X(PortalTri, 64) X(Camera, 64) X(Params, 224) \
 	X(PortalPlane, 80) X(PunctualLight, 64)
 
@@ -14,13 +14,17 @@
 	X(BvhNode, lo_x) X(BvhNode, lo_z) X(BvhNode, hi_x) X(BvhNode, hi_z) X(BvhNode, child)\
 	X(Tri, p0) X(Tri, p1) X(Tri, p2) X(Tri, material) X(Tri, emitter)              \
 	X(TriShade, n0) X(TriShade, n2) X(TriShade, u0) X(TriShade, v2)                \
-	X(TriShade, has_normals)                                                        \
+	X(TriShade, has_normals) X(TriExtra, u0) X(TriExtra, c0) X(TriExtra, c2)      \
+	X(TriExtra, t0) X(TriExtra, t2) X(Material, normal_tex) X(Material, normal_scale)\
+	X(Tri, flags)                                                                   \
 	X(Material, base_color) X(Material, base_tex) X(Material, emission)            \
 	X(Material, metallic) X(Material, roughness) X(Material, transmission)         \
 	X(Material, ior) X(Material, specular) X(Material, flags)                      \
-	X(Material, alpha_cutoff)                                                       \
-	X(Texture, offset) X(Texture, width) X(Texture, height)                        \
-	X(Emitter, tri) X(Emitter, area) X(Emitter, pdf_select)                        \
+	X(Material, alpha_cutoff) X(Material, mr_tex) X(Material, emissive_tex)         \
+	X(Material, base_alpha)                                                         \
+	X(Texture, offset) X(Texture, width) X(Texture, height) X(Texture, flags)      \
+	X(Texture, xf)                                                                  \
+	X(Emitter, tri) X(Emitter, area) X(Emitter, pdf_select) X(Emitter, cell)       \
 	X(PortalTri, p0) X(PortalTri, p2) X(PortalTri, n) X(PortalTri, area)          \
 	X(PortalTri, pdf_select) X(PortalTri, side_plus) X(PortalTri, env_side)       \
 	X(Camera, pos) X(Camera, tan_half_fov_y) X(Camera, right) X(Camera, aspect)    \

@@ -10,24 +10,91 @@
 #include "sampling.h"
 #include "bvh.h"
 #include "env_portal.h"
+#include "surface.h"
 #include "portal_geometry.h"
 
-/* Radiance leaving triangle `tri` in direction w (any length): the
- * material's emission on the front face, 0 behind it or if not emissive. */
-INLINE V3 emitter_radiance(const SceneView *sc, int tri, V3 w)
+/* Emitted radiance of emitter triangle `tri` at its point p, front face:
+ * the material's emission times its emissive texture (sRGB colour) and,
+ * on alpha-tested triangles, its coverage (texture.h). */
+INLINE V3 emitter_emission(const SceneView *sc, int tri, V3 p)
+{
+	GLOBAL const Tri *t = &sc->tris[tri];
+	GLOBAL const Material *m = &sc->materials[t->material];
+	if (!m->emissive_tex && !(t->flags & TRI_ALPHA))
+		return m->emission;
+	float b1, b2;
+	tri_barycentric(t, p, &b1, &b2);
+	V3 e = m->emission;
+	if (m->emissive_tex)
+		e = v3_mul(e, tri_texture(sc, tri, b1, b2, m->emissive_tex - 1, 1).rgb);
+	/* Where rays pass through it (alpha), it emits that much less. */
+	if (t->flags & TRI_ALPHA)
+		e = v3_scale(e, tri_coverage(sc, tri, b1, b2));
+	return e;
+}
+
+/* Radiance leaving triangle `tri` at its point p in direction w (any
+ * length): the emission on the front face, 0 behind it or if not an
+ * emitter. */
+INLINE V3 emitter_radiance(const SceneView *sc, int tri, V3 p, V3 w)
 {
 	GLOBAL const Tri *t = &sc->tris[tri];
 	if (t->emitter < 0 || !(v3_dot(tri_normal(t), w) > 0.0f))
 		return v3(0.0f, 0.0f, 0.0f);
-	return sc->materials[t->material].emission;
+	return emitter_emission(sc, tri, p);
 }
 
-/* Area density (selection included) of sampling a point on `tri`. */
-INLINE float emitter_pdf_a(const SceneView *sc, int tri)
+/* The cells of an emitter at level L (src/lights.c): the triangle's
+ * barycentric square (b1, b2) cut into an n x n grid, n = 2^L; square
+ * (i, j) with i + j < n holds a lower half (i, j), (i + 1, j), (i, j + 1)
+ * and, where i + j < n - 1, an upper half (i + 1, j), (i + 1, j + 1),
+ * (i, j + 1): n^2 triangles of equal area. Row i (b1 in [i, i + 1) / n)
+ * has 2 (n - i) - 1 cells and starts at cell i (2n - i); in a row, lower
+ * then upper half of each square in order of j. */
+INLINE int emitter_cell_of(int level, float b1, float b2)
+{
+	int n = 1 << level;
+	float x = b1 * (float)n, y = b2 * (float)n;
+	int i = min((int)x, n - 1);
+	int j = min((int)y, n - 1 - i);
+	int upper = i + j < n - 1 && (x - (float)i) + (y - (float)j) > 1.0f;
+	return i * (2 * n - i) + 2 * j + upper;
+}
+
+/* Corners of cell c at `level` in barycentric coordinates (b1, b2). */
+INLINE void emitter_cell_corners(int level, int c, float *b1, float *b2)
+{
+	int n = 1 << level;
+	int i = (int)((float)n - sqrt((float)n * (float)n - (float)c));
+	i = max(min(i, n - 1), 0);
+	while (i > 0 && i * (2 * n - i) > c)
+		i--;
+	while (i + 1 < n && (i + 1) * (2 * n - i - 1) <= c)
+		i++;
+	int r = c - i * (2 * n - i), j = r >> 1;
+	float s = 1.0f / (float)n;
+	if (r & 1) {
+		b1[0] = (float)(i + 1) * s, b2[0] = (float)j * s;
+		b1[1] = (float)(i + 1) * s, b2[1] = (float)(j + 1) * s;
+	} else {
+		b1[0] = (float)i * s, b2[0] = (float)j * s;
+		b1[1] = (float)(i + 1) * s, b2[1] = (float)j * s;
+	}
+	b1[2] = (float)i * s, b2[2] = (float)(j + 1) * s;
+}
+
+/* Area density (selection included) of sampling point p on `tri`. */
+INLINE float emitter_pdf_a(const SceneView *sc, int tri, V3 p)
 {
 	int e = sc->tris[tri].emitter;
 	if (e < 0)
 		return 0.0f;
+	int level = EMITTER_LEVEL(sc->emitters[e].cell);
+	if (level) {
+		float b1, b2;
+		tri_barycentric(&sc->tris[tri], p, &b1, &b2);
+		e += emitter_cell_of(level, b1, b2);
+	}
 	return sc->emitters[e].pdf_select / sc->emitters[e].area;
 }
 
@@ -39,12 +106,24 @@ INLINE int light_pick(const SceneView *sc, float u_sel)
 	return sample_cdf(sc->emitter_cdf, sc->params->num_emitters + sc->params->num_lights, u_sel, &p_sel, &u_rest);
 }
 
-/* A uniform point on emitter k (see emitter_sample); returns its triangle. */
+/* A uniform point on emitter (or emitter cell) k (see emitter_sample);
+ * returns its triangle. */
 INLINE int emitter_point(const SceneView *sc, int k, float u1, float u2, V3 *p, V3 *n, float *pdf_a)
 {
 	GLOBAL const Emitter *e = &sc->emitters[k];
 	GLOBAL const Tri *t = &sc->tris[e->tri];
-	sample_triangle_point(t->p0, t->p1, t->p2, u1, u2, p, n);
+	int level = EMITTER_LEVEL(e->cell);
+	if (!level) {
+		sample_triangle_point(t->p0, t->p1, t->p2, u1, u2, p, n);
+	} else {
+		float b1[3], b2[3];
+		emitter_cell_corners(level, EMITTER_INDEX(e->cell), b1, b2);
+		V3 c[3], e1 = v3_sub(t->p1, t->p0), e2 = v3_sub(t->p2, t->p0);
+		for (int i = 0; i < 3; i++)
+			c[i] = v3_add(t->p0, v3_add(v3_scale(e1, b1[i]), v3_scale(e2, b2[i])));
+		sample_triangle_point(c[0], c[1], c[2], u1, u2, p, n);
+		*n = v3_norm(tri_normal(t)); /* the cell's own cross product is less exact */
+	}
 	*pdf_a = e->pdf_select / e->area;
 	return e->tri;
 }
@@ -256,7 +335,7 @@ INLINE int light_sample_emitter(const SceneView *sc, V3 x, float u, float u1, fl
 	ls->wi = wi;
 	ls->dist = dist;
 	ls->tri = tri;
-	ls->Le = sc->materials[sc->tris[tri].material].emission;
+	ls->Le = emitter_emission(sc, tri, p);
 	ls->pdf_w = p_emitters * pdf_a * dist2 / cos_light;
 	return 1;
 }
@@ -304,7 +383,7 @@ INLINE float light_pdf_w(const SceneView *sc, V3 x, V3 n, V3 wi, int tri, float 
 	float ps = sc->params->env_pdf_select;
 	if (tri < 0)
 		return ps * env_nee_pdf_w(sc, x, n, wi);
-	float pdf_a = emitter_pdf_a(sc, tri);
+	float pdf_a = emitter_pdf_a(sc, tri, v3_add(x, v3_scale(wi, dist)));
 	if (!(pdf_a > 0.0f) || !(cos_light > 0.0f))
 		return 0.0f;
 	return (1.0f - ps) * pdf_a * dist * dist / cos_light;

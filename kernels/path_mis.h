@@ -123,7 +123,7 @@ INLINE float portal_direction_psa(const SceneView *sc, GLOBAL const PortalTri *p
 		to_m = v3_scale(d, 1.0f / dist);
 		if (xm->type != VERTEX_PUNCTUAL && xm->tri >= 0 && sc->tris[xm->tri].emitter >= 0) {
 			float cos_l = -v3_dot(xm->ng, to_m); /* ng is the front face */
-			guided = cos_l > 0.0f ? (1.0f - ps) * emitter_pdf_a(sc, xm->tri) * dist * dist / cos_l : 0.0f;
+			guided = cos_l > 0.0f ? (1.0f - ps) * emitter_pdf_a(sc, xm->tri, xm->p) * dist * dist / cos_l : 0.0f;
 		}
 	}
 	float cn = v3_dot(to_m, pt->n), c = fabs(cn);

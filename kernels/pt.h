@@ -72,7 +72,7 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 		surface_from_hit(sc, &h, &s);
 		V3 wo = v3_neg(d);
 		if (sc->tris[s.tri].emitter >= 0 && depth + 1 >= prm->min_depth) {
-			V3 Le = emitter_radiance(sc, s.tri, wo);
+			V3 Le = emitter_radiance(sc, s.tri, s.p, wo);
 			if (!v3_is_zero(Le)) {
 				float w = 1.0f;
 				if (!prev_delta) {
@@ -87,7 +87,7 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 		if (depth + 2 > prm->max_depth)
 			break;
 		Bsdf bs;
-		bsdf_setup(&bs, &sc->materials[s.material], surface_base_color(sc, &s), s.ns, s.ng);
+		surface_bsdf(sc, &s, surface_base_color(sc, &s), &bs);
 		/* The normal next-event samples are weighed by (env_portal.h): turned
 		 * toward wo here; pt's two densities at a vertex both read n_nee. */
 		V3 n_nee = v3_dot(s.ns, wo) < 0.0f ? v3_neg(s.ns) : s.ns;

@@ -1,5 +1,6 @@
 /* surface.h — what integrators know about a ray hit: position, geometric
- * and shading normals, material and its textured base colour.
+ * and shading normals, material, its textures (base colour, metallic-
+ * roughness, emission) and the BSDF they make.
  *
  * The geometric normal is the CCW front face's (glTF's front), not flipped
  * toward the ray: emitters emit from the front, and the BSDF decides sides
@@ -7,6 +8,7 @@
  * interpolated normals never point through the surface. */
 #ifndef AJAR_SURFACE_H
 #define AJAR_SURFACE_H
+#include "bsdf.h"
 #include "bvh.h"
 #include "types.h"
 
@@ -14,44 +16,43 @@ typedef struct {
 	V3 p;
 	V3 ng;        /* unit geometric normal, front face */
 	V3 ns;        /* unit shading normal, same side as ng */
-	float tu, tv; /* texture coordinates */
+	float tu, tv;   /* texture coordinates, TEXCOORD_0 */
+	float tu1, tv1; /* TEXCOORD_1 (0 where the mesh has none) */
+	V3 color;       /* COLOR_0 (1 where the mesh has none) */
+	float alpha;    /* COLOR_0's alpha */
 	int tri;
 	int material;
 } Surface;
 
-INLINE float srgb_to_linear(float c)
+/* Texture `tex` where surface s lies, in the coordinate set it reads. */
+INLINE Rgba surface_texture(const SceneView *sc, const Surface *s, int tex, int srgb)
 {
-	return c <= 0.04045f ? c * (1.0f / 12.92f) : pow((c + 0.055f) * (1.0f / 1.055f), 2.4f);
+	if (sc->textures[tex].flags & TEX_UV1)
+		return texture_rgba(sc, tex, s->tu1, s->tv1, srgb);
+	return texture_rgba(sc, tex, s->tu, s->tv, srgb);
 }
 
-INLINE V3 texel_rgb(uint t)
+/* A normal map's normal at s (glTF 3.9.3): the texel (linear) as a
+ * tangent-space vector, x and y times the scale, in the frame of the
+ * interpolated tangent (made orthogonal to n), sign x (n x t) and n. */
+INLINE V3 surface_normal_map(const SceneView *sc, const Surface *s, GLOBAL const TriExtra *e, float w, float b1,
+			     float b2, V3 n)
 {
-	return v3(srgb_to_linear((float)(t & 255u) * (1.0f / 255.0f)),
-		  srgb_to_linear((float)((t >> 8) & 255u) * (1.0f / 255.0f)),
-		  srgb_to_linear((float)((t >> 16) & 255u) * (1.0f / 255.0f)));
-}
-
-/* Bilinear lookup with repeat wrapping; (0, 0) is the image's first texel
- * corner, as glTF defines UVs. */
-INLINE V3 texture_rgb(const SceneView *sc, int tex, float u, float v)
-{
-	GLOBAL const Texture *t = &sc->textures[tex];
-	float x = (u - floor(u)) * (float)t->width - 0.5f;
-	float y = (v - floor(v)) * (float)t->height - 0.5f;
-	float fx = floor(x), fy = floor(y);
-	float ax = x - fx, ay = y - fy;
-	int x0 = (int)fx, y0 = (int)fy;
-	int x1 = x0 + 1, y1 = y0 + 1;
-	x0 = (x0 % t->width + t->width) % t->width;
-	x1 = x1 % t->width;
-	y0 = (y0 % t->height + t->height) % t->height;
-	y1 = y1 % t->height;
-	GLOBAL const uint *px = sc->texels + t->offset;
-	V3 c00 = texel_rgb(px[y0 * t->width + x0]), c10 = texel_rgb(px[y0 * t->width + x1]);
-	V3 c01 = texel_rgb(px[y1 * t->width + x0]), c11 = texel_rgb(px[y1 * t->width + x1]);
-	V3 top = v3_add(v3_scale(c00, 1.0f - ax), v3_scale(c10, ax));
-	V3 bot = v3_add(v3_scale(c01, 1.0f - ax), v3_scale(c11, ax));
-	return v3_add(v3_scale(top, 1.0f - ay), v3_scale(bot, ay));
+	GLOBAL const Material *m = &sc->materials[s->material];
+	V3 t = v3(w * e->t0[0] + b1 * e->t1[0] + b2 * e->t2[0], w * e->t0[1] + b1 * e->t1[1] + b2 * e->t2[1],
+		  w * e->t0[2] + b1 * e->t1[2] + b2 * e->t2[2]);
+	float sign = w * e->t0[3] + b1 * e->t1[3] + b2 * e->t2[3] < 0.0f ? -1.0f : 1.0f;
+	t = v3_madd(t, n, -v3_dot(t, n));
+	float lt = v3_len2(t);
+	if (!(lt > 1e-12f))
+		return n;
+	t = v3_scale(t, 1.0f / sqrt(lt));
+	V3 b = v3_scale(v3_cross(n, t), sign);
+	V3 c = surface_texture(sc, s, m->normal_tex - 1, 0).rgb;
+	V3 tn = v3((2.0f * c.x - 1.0f) * m->normal_scale, (2.0f * c.y - 1.0f) * m->normal_scale, 2.0f * c.z - 1.0f);
+	V3 r = v3_add(v3_add(v3_scale(t, tn.x), v3_scale(b, tn.y)), v3_scale(n, tn.z));
+	float lr = v3_len2(r);
+	return lr > 1e-12f ? v3_scale(r, 1.0f / sqrt(lr)) : n;
 }
 
 INLINE void surface_from_hit(const SceneView *sc, const Hit *h, Surface *s)
@@ -61,19 +62,33 @@ INLINE void surface_from_hit(const SceneView *sc, const Hit *h, Surface *s)
 	float w = 1.0f - h->u - h->v;
 	s->p = v3_add(v3_add(v3_scale(t->p0, w), v3_scale(t->p1, h->u)), v3_scale(t->p2, h->v));
 	s->ng = v3_norm(tri_normal(t));
-	s->ns = s->ng;
-	if (sh->has_normals) {
-		V3 n = v3_add(v3_add(v3_scale(sh->n0, w), v3_scale(sh->n1, h->u)), v3_scale(sh->n2, h->v));
-		float len2 = v3_len2(n);
-		if (len2 > 1e-12f) {
-			n = v3_scale(n, 1.0f / sqrt(len2));
-			s->ns = v3_dot(n, s->ng) < 0.0f ? v3_neg(n) : n;
-		}
-	}
 	s->tu = w * sh->u0 + h->u * sh->u1 + h->v * sh->u2;
 	s->tv = w * sh->v0 + h->u * sh->v1 + h->v * sh->v2;
+	s->tu1 = s->tv1 = 0.0f;
+	s->color = v3(1.0f, 1.0f, 1.0f);
+	s->alpha = 1.0f;
 	s->tri = h->tri;
 	s->material = t->material;
+	if (t->flags & TRI_EXTRA) {
+		GLOBAL const TriExtra *e = &sc->extra[h->tri];
+		s->tu1 = w * e->u0 + h->u * e->u1 + h->v * e->u2;
+		s->tv1 = w * e->v0 + h->u * e->v1 + h->v * e->v2;
+		float c[4];
+		for (int k = 0; k < 4; k++)
+			c[k] = w * e->c0[k] + h->u * e->c1[k] + h->v * e->c2[k];
+		s->color = v3(c[0], c[1], c[2]);
+		s->alpha = c[3];
+	}
+	V3 n = s->ng;
+	if (sh->has_normals) {
+		V3 ni = v3_add(v3_add(v3_scale(sh->n0, w), v3_scale(sh->n1, h->u)), v3_scale(sh->n2, h->v));
+		float len2 = v3_len2(ni);
+		if (len2 > 1e-12f)
+			n = v3_scale(ni, 1.0f / sqrt(len2));
+	}
+	if (t->flags & TRI_TANGENT)
+		n = surface_normal_map(sc, s, &sc->extra[h->tri], w, h->u, h->v, n);
+	s->ns = v3_dot(n, s->ng) < 0.0f ? v3_neg(n) : n;
 }
 
 /* Whether the segment between surface points a and b (geometric normals
@@ -93,11 +108,29 @@ INLINE int segment_clear(const SceneView *sc, V3 a, V3 na, V3 b, V3 nb)
 	return !bvh_occluded(sc, o, v3_scale(od, 1.0f / len), len * (1.0f - 1e-4f));
 }
 
+/* Factor x texture (sRGB) x COLOR_0 (glTF 3.9.2). */
 INLINE V3 surface_base_color(const SceneView *sc, const Surface *s)
 {
 	GLOBAL const Material *m = &sc->materials[s->material];
+	V3 c = v3_mul(m->base_color, s->color);
 	if (m->base_tex < 0)
-		return m->base_color;
-	return v3_mul(m->base_color, texture_rgb(sc, m->base_tex, s->tu, s->tv));
+		return c;
+	return v3_mul(c, surface_texture(sc, s, m->base_tex, 1).rgb);
 }
+
+/* The BSDF at s with base colour `base` (surface_base_color): metallic and
+ * roughness are the factors times the metallic-roughness texture's blue
+ * and green channels (glTF 3.9.2), read without sRGB decoding. */
+INLINE void surface_bsdf(const SceneView *sc, const Surface *s, V3 base, Bsdf *bs)
+{
+	GLOBAL const Material *m = &sc->materials[s->material];
+	float metallic = m->metallic, roughness = m->roughness;
+	if (m->mr_tex) {
+		Rgba t = surface_texture(sc, s, m->mr_tex - 1, 0);
+		metallic *= t.rgb.z;
+		roughness *= t.rgb.y;
+	}
+	bsdf_setup_mr(bs, m, base, metallic, roughness, s->ns, s->ng);
+}
+
 #endif

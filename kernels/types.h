@@ -24,11 +24,14 @@ typedef struct {
 } BvhNode; /* 256 */
 
 /* Triangle as traversal sees it. `emitter` indexes Emitter (or -1). */
+#define TRI_EXTRA 1 /* has TriExtra data (TEXCOORD_1, COLOR_0) */
+#define TRI_ALPHA 2 /* its material may be transparent here: rays test its alpha (bvh.h) */
+#define TRI_TANGENT 4 /* normal-mapped: TriExtra holds its tangents */
 typedef struct {
 	V3 p0, p1, p2;
 	int material;
 	int emitter;
-	int pad0;
+	int flags;  /* TRI_* */
 } Tri; /* 48 */
 
 /* Shading attributes of the triangle with the same index. */
@@ -38,8 +41,18 @@ typedef struct {
 	int has_normals; /* 0: use the geometric normal */
 } TriShade; /* 64 */
 
+/* The attributes few meshes have, for triangles with TRI_EXTRA: the
+ * array has one entry per triangle where any has them, else one. */
+typedef struct {
+	float u0, v0, u1, v1, u2, v2; /* TEXCOORD_1 */
+	float c0[4], c1[4], c2[4];    /* COLOR_0, linear RGBA */
+	float t0[4], t1[4], t2[4];    /* TRI_TANGENT: world-space tangent, w the bitangent's sign */
+	int pad0, pad1;
+} TriExtra; /* 128 */
+
 #define MATERIAL_DOUBLE_SIDED 1
-#define MATERIAL_ALPHA_MASK 2   /* alpha below alpha_cutoff is a hole (future) */
+#define MATERIAL_ALPHA_MASK 2   /* alpha below alpha_cutoff is a hole */
+#define MATERIAL_ALPHA_BLEND 4  /* stochastic transparency: rays meet the surface with probability alpha */
 
 /* glTF metallic-roughness, with KHR_materials_specular/transmission/ior. */
 typedef struct {
@@ -53,24 +66,48 @@ typedef struct {
 	float specular;     /* KHR_materials_specular factor; 0 = pure diffuse */
 	int flags;          /* MATERIAL_* */
 	float alpha_cutoff;
-	float pad0, pad1;
-} Material; /* 64 */
+	int mr_tex;         /* Texture index + 1 (0: none): B metallic, G roughness, times the factors */
+	int emissive_tex;   /* Texture index + 1 (0: none): multiplies emission */
+	float base_alpha;   /* baseColorFactor's alpha (MASK, BLEND) */
+	int normal_tex;     /* Texture index + 1 (0: none): tangent-space normal map */
+	float normal_scale; /* its x and y scale */
+	int pad0;
+} Material; /* 80 */
 
-/* RGBA8 texture (sRGB colour, linear alpha) in the shared texel array. */
+/* A texture as a material uses it: an RGBA8 image in the shared texel
+ * array (decoded from sRGB only where it holds colour, surface.h), the
+ * glTF sampler's wrap modes and filter, the texture coordinate set and
+ * KHR_texture_transform as an affine map of (u, v). */
+#define TEX_WRAP_REPEAT 0
+#define TEX_WRAP_CLAMP 1
+#define TEX_WRAP_MIRROR 2
+#define TEX_WRAP_S(flags) ((flags) & 3)
+#define TEX_WRAP_T(flags) (((flags) >> 2) & 3)
+#define TEX_NEAREST 16 /* else bilinear */
+#define TEX_UV1 32     /* reads TEXCOORD_1 (TriExtra) instead of TEXCOORD_0 */
 typedef struct {
 	int offset; /* first texel in `texels` */
 	int width;
 	int height;
-	int pad0;
-} Texture; /* 16 */
+	int flags;  /* TEX_* */
+	float xf[6]; /* u' = xf[0] u + xf[1] v + xf[2], v' = xf[3] u + xf[4] v + xf[5] */
+	int pad0, pad1;
+} Texture; /* 48 */
 
-/* Emissive triangle; chosen with probability proportional to its power. */
+/* Emissive triangle, or one cell of a triangle with an emissive texture;
+ * chosen with probability proportional to its (textured) power. The cells
+ * of one triangle are consecutive, Tri.emitter the first. */
 typedef struct {
 	int tri;
 	float area;
 	float pdf_select; /* probability of choosing this emitter */
-	int pad0;
+	int cell;         /* EMITTER_LEVEL(cell): the triangle is split into 4^level cells,
+			   * this entry is cell EMITTER_INDEX(cell) of them (lights.h) */
 } Emitter; /* 16 */
+
+#define EMITTER_CELL(level, index) ((level) << 24 | (index))
+#define EMITTER_LEVEL(cell) ((cell) >> 24)
+#define EMITTER_INDEX(cell) ((cell) & 0xffffff)
 
 /* Portal triangle: invisible to every ray. The host measures the direct
  * light arriving through it from each side (src/portal_flux.c): that picks
@@ -219,6 +256,7 @@ typedef struct {
 	X(float, env)             \
 	X(PortalTri, portals)     \
 	X(float, portal_cdf)      \
+	X(TriExtra, extra)        \
 	X(PunctualLight, punctual) \
 	X(PortalPlane, portal_planes) \
 	X(float, portal_sky)      \

@@ -134,7 +134,7 @@ CALLED int vertex_trace(const SceneView *sc, PathVertex *path, int n, V3 o, V3 d
 	v->base = surface_base_color(sc, &s);
 	v->material = s.material;
 	v->tri = s.tri;
-	bsdf_setup(&v->bs, &sc->materials[s.material], v->base, v->ns, v->ng);
+	surface_bsdf(sc, &s, v->base, &v->bs);
 	float pa = parallel ? pdf_w * fabs(v3_dot(s.ng, d)) : vertex_density_a(prev, v, pdf_w);
 	if (light_side)
 		v->pf = pa;

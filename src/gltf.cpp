@@ -39,7 +39,7 @@ namespace tg = tinygltf;
  * other cannot be shown correctly and is refused. */
 const char *const supported_extensions[] = {
 	"KHR_materials_emissive_strength", "KHR_materials_ior", "KHR_materials_specular",
-	"KHR_materials_transmission", "KHR_mesh_quantization", "KHR_lights_punctual",
+	"KHR_materials_transmission", "KHR_mesh_quantization", "KHR_lights_punctual", "KHR_texture_transform",
 };
 
 struct Loader {
@@ -50,7 +50,6 @@ struct Loader {
 	std::vector<uint32_t> material_ids; /* glTF material -> scene material */
 	int default_material = -1;
 	std::vector<int> image_textures;    /* glTF image -> scene texture or -1 */
-	bool warned_textures = false;
 	bool allow_outside = false; /* files outside the scene's folder may be read */
 	std::string root;           /* the scene's folder, symbolic links resolved */
 	std::string refused;        /* the first message about a file outside root */
@@ -584,6 +583,106 @@ ajar_status image_texture(Loader &L, int i, int *id)
 	return AJAR_OK;
 }
 
+/* A number, or a JSON array of n numbers, of a KHR_texture_transform. */
+bool transform_numbers(const tg::Value &ext, const char *key, int n, double *out)
+{
+	const tg::Value *v = value_member(ext, key);
+	if (!v)
+		return true;
+	if (n == 1) {
+		if (!v->IsNumber() || !std::isfinite(v->GetNumberAsDouble()))
+			return false;
+		out[0] = v->GetNumberAsDouble();
+		return true;
+	}
+	if (!v->IsArray() || v->ArrayLen() != (size_t)n)
+		return false;
+	for (int i = 0; i < n; i++) {
+		if (!v->Get(i).IsNumber() || !std::isfinite(v->Get(i).GetNumberAsDouble()))
+			return false;
+		out[i] = v->Get(i).GetNumberAsDouble();
+	}
+	return true;
+}
+
+int wrap_mode(int gl)
+{
+	return gl == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE     ? TEX_WRAP_CLAMP
+	       : gl == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT ? TEX_WRAP_MIRROR
+							     : TEX_WRAP_REPEAT;
+}
+
+/* materials[mi]'s texture `slot` (textures[index], coordinate set
+ * texcoord, the textureInfo's extensions) as a scene texture: the image's
+ * texels, the sampler's wrap modes and magnification filter (there are no
+ * mipmaps: pixel sampling filters), the coordinate set and
+ * KHR_texture_transform (T R S, its texCoord replacing the set). *id is -1
+ * where there is no texture. */
+ajar_status texture_use(Loader &L, int mi, const char *slot, int index, int texcoord, const tg::ExtensionMap &exts,
+			int *id)
+{
+	*id = -1;
+	if (index < 0)
+		return AJAR_OK;
+	const tg::Model &m = L.model;
+	if ((size_t)index >= m.textures.size())
+		return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d].%s: textures[%d] does not exist (%zu textures)", mi, slot,
+			    index, m.textures.size());
+	const tg::Texture &tex = m.textures[(size_t)index];
+	if (tex.source < 0 || (size_t)tex.source >= m.images.size())
+		return fail(L, AJAR_ERROR_BAD_INPUT, "textures[%d]: images[%d] does not exist (%zu images)", index,
+			    tex.source, m.images.size());
+	int flags = 0;
+	if (tex.sampler >= 0) {
+		if ((size_t)tex.sampler >= m.samplers.size())
+			return fail(L, AJAR_ERROR_BAD_INPUT, "textures[%d]: samplers[%d] does not exist (%zu samplers)", index,
+				    tex.sampler, m.samplers.size());
+		const tg::Sampler &sm = m.samplers[(size_t)tex.sampler];
+		flags |= wrap_mode(sm.wrapS) | wrap_mode(sm.wrapT) << 2;
+		if (sm.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST)
+			flags |= TEX_NEAREST;
+	}
+	float xf[6] = {1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f};
+	auto it = exts.find("KHR_texture_transform");
+	if (it != exts.end()) {
+		double off[2] = {0.0, 0.0}, rot = 0.0, sc[2] = {1.0, 1.0}, tc = texcoord;
+		if (!transform_numbers(it->second, "offset", 2, off) || !transform_numbers(it->second, "rotation", 1, &rot) ||
+		    !transform_numbers(it->second, "scale", 2, sc) || !transform_numbers(it->second, "texCoord", 1, &tc) ||
+		    !(tc >= 0.0 && tc == std::floor(tc)))
+			return fail(L, AJAR_ERROR_BAD_INPUT,
+				    "materials[%d].%s.extensions.KHR_texture_transform: offset and scale must be 2 numbers, "
+				    "rotation a number, texCoord an integer >= 0",
+				    mi, slot);
+		/* uv' = T(offset) R(rotation) S(scale) uv with R = [cos sin;
+		 * -sin cos] in (u, v): counter-clockwise as the image is seen
+		 * (v grows downwards), which TextureTransformTest's markers
+		 * confirm (the other sign hits its red "opposite" marker). */
+		double c = std::cos(rot), sn = std::sin(rot);
+		xf[0] = (float)(c * sc[0]);
+		xf[1] = (float)(sn * sc[1]);
+		xf[2] = (float)off[0];
+		xf[3] = (float)(-sn * sc[0]);
+		xf[4] = (float)(c * sc[1]);
+		xf[5] = (float)off[1];
+		texcoord = (int)std::fmin(tc, 1e6);
+	}
+	if (texcoord > 1) {
+		log_msg(AJAR_LOG_WARNING, "%s: materials[%d].%s uses TEXCOORD_%d; only TEXCOORD_0 and _1 are supported, texture ignored",
+			L.file, mi, slot, texcoord);
+		return AJAR_OK;
+	}
+	if (texcoord == 1)
+		flags |= TEX_UV1;
+	int img = -1;
+	ajar_status st = image_texture(L, tex.source, &img);
+	uint32_t tid;
+	if (!st)
+		st = scene_add_texture_use(L.s, (uint32_t)img, flags, xf, &tid);
+	if (!st)
+		*id = (int)tid;
+	return st;
+}
+
 ajar_status in_unit(const Loader &L, int mi, const char *name, double v)
 {
 	if (!(v >= 0.0 && v <= 1.0))
@@ -601,7 +700,7 @@ ajar_status load_material(Loader &L, int mi, uint32_t *id)
 	if (pbr.baseColorFactor.size() != 4)
 		return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d]: baseColorFactor has %zu numbers, expected 4", mi,
 			    pbr.baseColorFactor.size());
-	for (int c = 0; c < 3 && !st; c++)
+	for (int c = 0; c < 4 && !st; c++)
 		st = in_unit(L, mi, "baseColorFactor", pbr.baseColorFactor[(size_t)c]);
 	if (!st)
 		st = in_unit(L, mi, "metallicFactor", pbr.metallicFactor);
@@ -639,37 +738,32 @@ ajar_status load_material(Loader &L, int mi, uint32_t *id)
 	m.specular = (float)specular;
 	m.flags = gm.doubleSided ? MATERIAL_DOUBLE_SIDED : 0;
 	m.alpha_cutoff = (float)gm.alphaCutoff;
-	if (gm.alphaMode == "MASK") {
+	m.base_alpha = (float)pbr.baseColorFactor[3];
+	if (gm.alphaMode == "MASK")
 		m.flags |= MATERIAL_ALPHA_MASK;
-		log_msg(AJAR_LOG_WARNING, "%s: materials[%d]: alphaMode MASK is not applied yet: the surface is opaque",
-			L.file, mi);
-	}
+	else if (gm.alphaMode == "BLEND")
+		m.flags |= MATERIAL_ALPHA_BLEND;
+	else if (gm.alphaMode != "OPAQUE" && !gm.alphaMode.empty())
+		return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d]: alphaMode \"%s\" is not OPAQUE, MASK or BLEND", mi,
+			    gm.alphaMode.c_str());
 
-	const tg::TextureInfo &bt = pbr.baseColorTexture;
-	if (bt.index >= 0) {
-		if ((size_t)bt.index >= L.model.textures.size())
-			return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d]: textures[%d] does not exist (%zu textures)", mi,
-				    bt.index, L.model.textures.size());
-		int src = L.model.textures[(size_t)bt.index].source;
-		if (src < 0 || (size_t)src >= L.model.images.size())
-			return fail(L, AJAR_ERROR_BAD_INPUT, "textures[%d]: images[%d] does not exist (%zu images)", bt.index,
-				    src, L.model.images.size());
-		if (bt.texCoord != 0) {
-			log_msg(AJAR_LOG_WARNING, "%s: materials[%d]: baseColorTexture uses TEXCOORD_%d; only TEXCOORD_0 is supported, texture ignored",
-				L.file, mi, bt.texCoord);
-		} else {
-			int tid = -1;
-			if ((st = image_texture(L, src, &tid)))
-				return st;
-			m.base_tex = tid;
-		}
-	}
-	if (!L.warned_textures && (pbr.metallicRoughnessTexture.index >= 0 || gm.emissiveTexture.index >= 0 ||
-				   gm.normalTexture.index >= 0)) {
-		log_msg(AJAR_LOG_WARNING, "%s: materials[%d]: metallic-roughness, emissive and normal textures are ignored",
-			L.file, mi);
-		L.warned_textures = true;
-	}
+	int base = -1, mr = -1, em = -1;
+	const tg::TextureInfo &bt = pbr.baseColorTexture, &mt = pbr.metallicRoughnessTexture, &et = gm.emissiveTexture;
+	if ((st = texture_use(L, mi, "baseColorTexture", bt.index, bt.texCoord, bt.extensions, &base)) ||
+	    (st = texture_use(L, mi, "metallicRoughnessTexture", mt.index, mt.texCoord, mt.extensions, &mr)) ||
+	    (st = texture_use(L, mi, "emissiveTexture", et.index, et.texCoord, et.extensions, &em)))
+		return st;
+	m.base_tex = base;
+	m.mr_tex = mr + 1;
+	m.emissive_tex = em + 1;
+	const tg::NormalTextureInfo &nt = gm.normalTexture;
+	int nrm = -1;
+	if ((st = texture_use(L, mi, "normalTexture", nt.index, nt.texCoord, nt.extensions, &nrm)))
+		return st;
+	if (!std::isfinite(nt.scale))
+		return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d]: normalTexture.scale is not finite", mi);
+	m.normal_tex = nrm + 1;
+	m.normal_scale = (float)nt.scale;
 	return scene_add_material(L.s, &m, id);
 }
 
@@ -737,6 +831,124 @@ ajar_status triangle_list(const Loader &L, const std::string &what, int mode, co
 		out.push_back(c);
 	}
 	return AJAR_OK;
+}
+
+/* Tangents for a normal map where the mesh has none, as glTF asks (the
+ * MikkTSpace way, in its main points): each triangle's tangent is the
+ * direction of increasing u (from its positions and texture coordinates),
+ * its handedness w the sign that makes w (n x t) point along decreasing
+ * v (glTF's v runs down the image, the map's +y up it: the stored
+ * tangents of NormalTangentMirrorTest agree, test_scene); a vertex averages the tangents of the triangles around it of one
+ * handedness, weighted by their angles there and projected onto its
+ * normal's plane. A vertex shared by triangles of both handednesses (a
+ * mirrored UV seam without split vertices) is split in two. pos and nrm
+ * are world space (nrm may be empty: face normals); vertices may be
+ * appended to pos, nrm, uv and the other per-vertex arrays in `more`
+ * (each `width` floats a vertex), and tri renumbered. */
+struct VertexArray {
+	std::vector<float> *v;
+	size_t width;
+};
+
+void generate_tangents(std::vector<float> &pos, std::vector<float> &nrm, std::vector<float> &uvs,
+		       std::vector<VertexArray> more, std::vector<uint32_t> &tri, std::vector<float> &tan)
+{
+	size_t nv = pos.size() / 3;
+	std::vector<double> acc(2 * 3 * nv, 0.0);
+	std::vector<signed char> sign(tri.size() / 3, 1);
+	auto P = [&](uint32_t i, int c) { return (double)pos[3 * (size_t)i + (size_t)c]; };
+	for (size_t f = 0; f < tri.size() / 3; f++) {
+		uint32_t k[3] = {tri[3 * f], tri[3 * f + 1], tri[3 * f + 2]};
+		double e1[3], e2[3], fn[3];
+		for (int c = 0; c < 3; c++) {
+			e1[c] = P(k[1], c) - P(k[0], c);
+			e2[c] = P(k[2], c) - P(k[0], c);
+		}
+		fn[0] = e1[1] * e2[2] - e1[2] * e2[1];
+		fn[1] = e1[2] * e2[0] - e1[0] * e2[2];
+		fn[2] = e1[0] * e2[1] - e1[1] * e2[0];
+		if (!nrm.empty()) /* the side the vertex normals say */
+			for (int c = 0; c < 3; c++)
+				fn[c] = (double)nrm[3 * (size_t)k[0] + (size_t)c] + nrm[3 * (size_t)k[1] + (size_t)c] +
+					nrm[3 * (size_t)k[2] + (size_t)c];
+		double du1 = uvs[2 * (size_t)k[1]] - uvs[2 * (size_t)k[0]], dv1 = uvs[2 * (size_t)k[1] + 1] - uvs[2 * (size_t)k[0] + 1];
+		double du2 = uvs[2 * (size_t)k[2]] - uvs[2 * (size_t)k[0]], dv2 = uvs[2 * (size_t)k[2] + 1] - uvs[2 * (size_t)k[0] + 1];
+		double r = du1 * dv2 - du2 * dv1;
+		if (!(std::fabs(r) > 1e-20))
+			continue;
+		double t[3], b[3];
+		for (int c = 0; c < 3; c++) {
+			t[c] = (e1[c] * dv2 - e2[c] * dv1) / r;
+			b[c] = (e2[c] * du1 - e1[c] * du2) / r;
+		}
+		double nxt[3] = {fn[1] * t[2] - fn[2] * t[1], fn[2] * t[0] - fn[0] * t[2], fn[0] * t[1] - fn[1] * t[0]};
+		int s = nxt[0] * b[0] + nxt[1] * b[1] + nxt[2] * b[2] > 0.0 ? 0 : 1;
+		sign[f] = (signed char)(s ? 1 : -1);
+		for (int j = 0; j < 3; j++) {
+			uint32_t a = k[j], pb = k[(j + 1) % 3], pc = k[(j + 2) % 3];
+			double x[3], y[3], lx = 0, ly = 0, d = 0;
+			for (int c = 0; c < 3; c++) {
+				x[c] = P(pb, c) - P(a, c);
+				y[c] = P(pc, c) - P(a, c);
+				lx += x[c] * x[c];
+				ly += y[c] * y[c];
+				d += x[c] * y[c];
+			}
+			if (!(lx > 0.0 && ly > 0.0))
+				continue;
+			double angle = std::acos(std::fmin(std::fmax(d / std::sqrt(lx * ly), -1.0), 1.0));
+			double n[3] = {fn[0], fn[1], fn[2]};
+			if (!nrm.empty())
+				for (int c = 0; c < 3; c++)
+					n[c] = nrm[3 * (size_t)a + (size_t)c];
+			double ln = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+			double tn = ln > 0.0 ? (t[0] * n[0] + t[1] * n[1] + t[2] * n[2]) / (ln * ln) : 0.0;
+			double p[3] = {t[0] - tn * n[0], t[1] - tn * n[1], t[2] - tn * n[2]};
+			double lp = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+			if (!(lp > 0.0))
+				continue;
+			for (int c = 0; c < 3; c++)
+				acc[(size_t)s * 3 * nv + 3 * (size_t)a + (size_t)c] += angle * p[c] / lp;
+		}
+	}
+	/* Vertices used with both handednesses get a copy for the negative one. */
+	std::vector<uint32_t> twin(nv, UINT32_MAX);
+	std::vector<char> used(2 * nv, 0);
+	for (size_t f = 0; f < sign.size(); f++)
+		for (int j = 0; j < 3; j++)
+			used[(sign[f] > 0 ? nv : 0) + tri[3 * f + (size_t)j]] = 1;
+	more.push_back({&pos, 3});
+	if (!nrm.empty())
+		more.push_back({&nrm, 3});
+	more.push_back({&uvs, 2});
+	size_t total = nv;
+	for (size_t v = 0; v < nv; v++)
+		if (used[v] && used[nv + v])
+			twin[v] = (uint32_t)total++;
+	for (const VertexArray &a : more) {
+		a.v->resize(total * a.width);
+		for (size_t v = 0; v < nv; v++)
+			if (twin[v] != UINT32_MAX)
+				for (size_t c = 0; c < a.width; c++)
+					(*a.v)[twin[v] * a.width + c] = (*a.v)[v * a.width + c];
+	}
+	for (size_t f = 0; f < sign.size(); f++)
+		if (sign[f] < 0)
+			for (int j = 0; j < 3; j++)
+				if (twin[tri[3 * f + (size_t)j]] != UINT32_MAX)
+					tri[3 * f + (size_t)j] = twin[tri[3 * f + (size_t)j]];
+	tan.assign(4 * total, 0.0f);
+	for (size_t v = 0; v < nv; v++)
+		for (int s = 0; s < 2; s++) {
+			if (!used[(size_t)s * nv + v])
+				continue;
+			size_t out = s == 0 && twin[v] != UINT32_MAX ? twin[v] : v;
+			const double *a = &acc[(size_t)s * 3 * nv + 3 * v];
+			double l = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+			for (int c = 0; c < 3; c++)
+				tan[4 * out + (size_t)c] = l > 0.0 ? (float)(a[c] / l) : 0.0f;
+			tan[4 * out + 3] = s ? 1.0f : -1.0f;
+		}
 }
 
 ajar_status load_primitive(Loader &L, int mi, int pi, const double world[16], const double nm[3][3], bool flip,
@@ -820,15 +1032,41 @@ ajar_status load_primitive(Loader &L, int mi, int pi, const double world[16], co
 				nrm[3 * v + (size_t)r] = (float)(nm[r][0] * n[0] + nm[r][1] * n[1] + nm[r][2] * n[2]);
 		}
 	}
-	auto uit = pr.attributes.find("TEXCOORD_0");
-	if (uit != pr.attributes.end()) {
+	std::vector<float> uv1, col;
+	const char *sets[2] = {"TEXCOORD_0", "TEXCOORD_1"};
+	for (int k = 0; k < 2; k++) {
+		auto uit = pr.attributes.find(sets[k]);
+		if (uit == pr.attributes.end())
+			continue;
 		Packed pu;
-		if ((st = accessor_read(L, what, "TEXCOORD_0", uit->second, 2, pu)))
+		if ((st = accessor_read(L, what, sets[k], uit->second, 2, pu)))
 			return st;
 		if (pu.count != nv)
-			return fail(L, AJAR_ERROR_BAD_INPUT, "%s: TEXCOORD_0 has %zu elements, POSITION %zu", what.c_str(),
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s: %s has %zu elements, POSITION %zu", what.c_str(), sets[k],
 				    pu.count, nv);
-		uv = to_floats(pu);
+		(k ? uv1 : uv) = to_floats(pu);
+	}
+	/* COLOR_0: RGB or RGBA, float or normalized unsigned integers, linear. */
+	auto cit = pr.attributes.find("COLOR_0");
+	if (cit != pr.attributes.end()) {
+		int acc = cit->second;
+		int nc = acc >= 0 && (size_t)acc < L.model.accessors.size()
+				 ? type_components(L.model.accessors[(size_t)acc].type)
+				 : 4;
+		Packed pc;
+		if ((st = accessor_read(L, what, "COLOR_0", acc, nc == 3 ? 3 : 4, pc)))
+			return st;
+		if (pc.count != nv)
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s: COLOR_0 has %zu elements, POSITION %zu", what.c_str(),
+				    pc.count, nv);
+		if (pc.ctype != TINYGLTF_COMPONENT_TYPE_FLOAT && !pc.normalized)
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s: accessors[%d] (COLOR_0): integer components must be normalized",
+				    what.c_str(), acc);
+		std::vector<float> c = to_floats(pc);
+		col.assign(4 * nv, 1.0f);
+		for (size_t v = 0; v < nv; v++)
+			for (int j = 0; j < pc.ncomp; j++)
+				col[4 * v + (size_t)j] = std::fmin(std::fmax(c[(size_t)pc.ncomp * v + (size_t)j], 0.0f), 1.0f);
 	}
 	uint32_t mat = 0;
 	if (pr.material < 0) {
@@ -841,8 +1079,44 @@ ajar_status load_primitive(Loader &L, int mi, int pi, const double world[16], co
 	}
 	if (st)
 		return st;
-	return scene_add_triangles(L.s, what.c_str(), pos.data(), nrm.empty() ? nullptr : nrm.data(),
-				   uv.empty() ? nullptr : uv.data(), (uint32_t)nv, tri.data(), ntris, mat);
+	/* Tangents for a normal map: TANGENT (xyz by the node's matrix, w
+	 * turned over where it mirrors), else generated from the normal
+	 * map's coordinate set. */
+	std::vector<float> tan;
+	const ::Material &sm = L.s->materials[mat];
+	if (sm.normal_tex) {
+		auto tit = pr.attributes.find("TANGENT");
+		std::vector<float> &set = L.s->textures[sm.normal_tex - 1].flags & TEX_UV1 ? uv1 : uv;
+		if (tit != pr.attributes.end()) {
+			Packed pt;
+			if ((st = accessor_read(L, what, "TANGENT", tit->second, 4, pt)))
+				return st;
+			if (pt.count != nv)
+				return fail(L, AJAR_ERROR_BAD_INPUT, "%s: TANGENT has %zu elements, POSITION %zu", what.c_str(),
+					    pt.count, nv);
+			tan = to_floats(pt);
+			for (size_t v = 0; v < nv; v++) {
+				double t[3] = {tan[4 * v], tan[4 * v + 1], tan[4 * v + 2]};
+				for (int r = 0; r < 3; r++)
+					tan[4 * v + (size_t)r] = (float)(world[r] * t[0] + world[4 + r] * t[1] + world[8 + r] * t[2]);
+				if (flip)
+					tan[4 * v + 3] = -tan[4 * v + 3];
+			}
+		} else if (!set.empty()) {
+			std::vector<VertexArray> more;
+			std::vector<float> *other = &set == &uv ? &uv1 : &uv;
+			if (!other->empty())
+				more.push_back({other, 2});
+			if (!col.empty())
+				more.push_back({&col, 4});
+			generate_tangents(pos, nrm, set, more, tri, tan);
+			nv = pos.size() / 3;
+		}
+	}
+	return scene_add_triangles_ex(L.s, what.c_str(), pos.data(), nrm.empty() ? nullptr : nrm.data(),
+				      uv.empty() ? nullptr : uv.data(), uv1.empty() ? nullptr : uv1.data(),
+				      col.empty() ? nullptr : col.data(), tan.empty() ? nullptr : tan.data(), (uint32_t)nv,
+				      tri.data(), ntris, mat);
 }
 
 ajar_status load_mesh_node(Loader &L, int ni, const double world[16])

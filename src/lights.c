@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "error.h"
+#include "../kernels/lights.h"
 
 static float tri_area(V3 p0, V3 p1, V3 p2)
 {
@@ -36,37 +37,127 @@ double cdf_build(float *cdf, const double *w, uint32_t n, int uniform_if_empty)
 	return total;
 }
 
-static ajar_status build_emitters(Tri *tris, uint32_t ntris, const Material *mats, LightTables *out)
+/* Emissive textures: a triangle is split into 4^level cells of equal area
+ * (kernels/lights.h) so that a cell covers at most TEXELS_PER_CELL texels,
+ * and each cell is chosen by its own power; dark parts of a texture (and
+ * holes that alpha cuts) are then never sampled. Levels are capped per triangle and lowered for all
+ * where the scene would pass CELL_BUDGET cells. */
+#define TEXELS_PER_CELL 0.5
+#define MAX_LEVEL 7
+#define CELL_BUDGET (1u << 21)
+
+static int cell_level(const SceneView *v, uint32_t i, int tex, int cap)
 {
-	uint32_t n = 0;
+	double x[3], y[3];
+	scene_tri_texel_coords(v, i, tex, x, y);
+	double texels = 0.5 * fabs((x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]));
+	int level = 0;
+	while (level < cap && (double)(1u << (2 * level)) * TEXELS_PER_CELL < texels)
+		level++;
+	return level;
+}
+
+/* Mean emitted luminance over cell c of triangle i, from four points
+ * (the centroid and three toward the corners) of its bilinear texture. */
+static double cell_luminance(const SceneView *v, uint32_t i, int level, int c)
+{
+	static const float w[4][3] = {{1.0f / 3, 1.0f / 3, 1.0f / 3},
+				      {2.0f / 3, 1.0f / 6, 1.0f / 6},
+				      {1.0f / 6, 2.0f / 3, 1.0f / 6},
+				      {1.0f / 6, 1.0f / 6, 2.0f / 3}};
+	const Tri *t = &v->tris[i];
+	float b1[3] = {0.0f, 1.0f, 0.0f}, b2[3] = {0.0f, 0.0f, 1.0f};
+	if (level)
+		emitter_cell_corners(level, c, b1, b2);
+	double sum = 0.0;
+	for (int k = 0; k < 4; k++) {
+		float u = w[k][0] * b1[0] + w[k][1] * b1[1] + w[k][2] * b1[2];
+		float vv = w[k][0] * b2[0] + w[k][1] * b2[1] + w[k][2] * b2[2];
+		V3 p = v3_add(t->p0, v3_add(v3_scale(v3_sub(t->p1, t->p0), u), v3_scale(v3_sub(t->p2, t->p0), vv)));
+		sum += v3_lum(emitter_emission(v, (int)i, p));
+	}
+	return sum / 4.0;
+}
+
+static ajar_status build_emitters(const Scene *s, Tri *tris, const TriShade *shade, const TriExtra *extra,
+				  uint32_t ntris, const Material *mats, LightTables *out)
+{
+	SceneView v;
+	memset(&v, 0, sizeof v);
+	v.tris = tris;
+	v.shade = shade;
+	v.extra = extra;
+	v.materials = mats;
+	v.textures = s->textures;
+	v.texels = s->texels;
+	signed char *level = calloc(ntris ? ntris : 1, 1);
+	if (!level)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "lights: out of memory for %u triangles", ntris);
+	/* Which triangles emit, and each one's finest level. */
 	for (uint32_t i = 0; i < ntris; i++) {
 		Tri *t = &tris[i];
+		const Material *m = &mats[t->material];
 		t->emitter = -1;
-		if (v3_lum(mats[t->material].emission) > 0.0f && tri_area(t->p0, t->p1, t->p2) > 0.0f)
-			t->emitter = (int)n++;
+		level[i] = -1;
+		if (!(v3_lum(m->emission) > 0.0f) || !(tri_area(t->p0, t->p1, t->p2) > 0.0f))
+			continue;
+		if (m->emissive_tex && !scene_tri_can_emit(&v, i, m->emissive_tex - 1))
+			continue;
+		/* Cells as fine as the texture that varies the emission: the
+		 * emissive one, else, where alpha cuts holes, the base colour's. */
+		int tex = m->emissive_tex ? m->emissive_tex - 1 : (t->flags & TRI_ALPHA) ? m->base_tex : -1;
+		level[i] = (signed char)(tex >= 0 ? cell_level(&v, i, tex, MAX_LEVEL) : 0);
 	}
-	out->nemitters = n;
+	uint64_t n;
+	for (int cap = MAX_LEVEL;; cap--) {
+		n = 0;
+		for (uint32_t i = 0; i < ntris; i++)
+			if (level[i] >= 0) {
+				if (level[i] > cap)
+					level[i] = (signed char)cap;
+				n += 1u << (2 * level[i]);
+			}
+		if (n <= CELL_BUDGET || cap == 0)
+			break;
+	}
+	if (n > UINT32_MAX / 2) {
+		free(level);
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %llu emitters are too many", s->source, (unsigned long long)n);
+	}
+	out->nemitters = (uint32_t)n;
 	out->emitters = calloc(n ? n : 1, sizeof(Emitter));
 	out->emitter_cdf = calloc((size_t)n + 1, sizeof(float));
 	double *power = calloc(n ? n : 1, sizeof(double));
 	if (!out->emitters || !out->emitter_cdf || !power) {
 		free(power);
-		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "lights: out of memory for %u emitters", n);
+		free(level);
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "lights: out of memory for %llu emitters", (unsigned long long)n);
 	}
+	uint32_t k = 0;
 	for (uint32_t i = 0; i < ntris; i++) {
-		const Tri *t = &tris[i];
-		if (t->emitter < 0)
+		Tri *t = &tris[i];
+		if (level[i] < 0)
 			continue;
-		Emitter *e = &out->emitters[t->emitter];
-		e->tri = (int)i;
-		e->area = tri_area(t->p0, t->p1, t->p2);
-		/* One-sided Lambertian emitter: exitance pi L over the area. */
-		power[t->emitter] = (double)e->area * AJAR_PI * v3_lum(mats[t->material].emission);
+		const Material *m = &mats[t->material];
+		int cells = 1 << (2 * level[i]);
+		float area = tri_area(t->p0, t->p1, t->p2);
+		t->emitter = (int)k;
+		for (int c = 0; c < cells; c++, k++) {
+			Emitter *e = &out->emitters[k];
+			e->tri = (int)i;
+			e->area = area / (float)cells;
+			e->cell = EMITTER_CELL(level[i], c);
+			/* One-sided Lambertian emitter: exitance pi L over the area. */
+			double lum = m->emissive_tex || (t->flags & TRI_ALPHA) ? cell_luminance(&v, i, level[i], c)
+									       : v3_lum(m->emission);
+			power[k] = (double)e->area * AJAR_PI * lum;
+		}
 	}
-	out->emitter_power = (float)cdf_build(out->emitter_cdf, power, n, 0);
-	for (uint32_t k = 0; k < n; k++)
-		out->emitters[k].pdf_select = out->emitter_cdf[k + 1] - out->emitter_cdf[k];
+	out->emitter_power = (float)cdf_build(out->emitter_cdf, power, (uint32_t)n, 0);
+	for (uint32_t j = 0; j < n; j++)
+		out->emitters[j].pdf_select = out->emitter_cdf[j + 1] - out->emitter_cdf[j];
 	free(power);
+	free(level);
 	return AJAR_OK;
 }
 
@@ -161,8 +252,8 @@ static double punctual_power(const PunctualLight *l, const PortalTri *portals, u
 
 /* The punctual lights in device form, and emitter_cdf rebuilt over the
  * emitters and then the lights, by power. */
-static ajar_status build_punctual(const Scene *s, const Tri *tris, const Material *mats, const PortalTri *portals,
-				  uint32_t nportal_tris, float scene_radius, LightTables *out)
+static ajar_status build_punctual(const Scene *s, const PortalTri *portals, uint32_t nportal_tris, float scene_radius,
+				  LightTables *out)
 {
 	uint32_t ne = out->nemitters, nl = s->nlights;
 	out->nlights = nl;
@@ -178,10 +269,9 @@ static ajar_status build_punctual(const Scene *s, const Tri *tris, const Materia
 		free(power);
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "lights: out of memory for %u lights", nl);
 	}
-	for (uint32_t k = 0; k < ne; k++) {
-		const Emitter *e = &out->emitters[k];
-		power[k] = (double)e->area * AJAR_PI * v3_lum(mats[tris[e->tri].material].emission);
-	}
+	/* The emitters' (textured) powers, as build_emitters weighed them. */
+	for (uint32_t k = 0; k < ne; k++)
+		power[k] = (double)out->emitters[k].pdf_select * out->emitter_power;
 	double lp = 0.0;
 	for (uint32_t i = 0; i < nl; i++) {
 		const ajar_light *a = &s->lights[i];
@@ -217,15 +307,15 @@ static ajar_status build_punctual(const Scene *s, const Tri *tris, const Materia
 	return AJAR_OK;
 }
 
-ajar_status lights_build(const Scene *s, Tri *tris, uint32_t ntris, const Material *mats,
+ajar_status lights_build(const Scene *s, Tri *tris, const TriShade *shade, const TriExtra *extra, uint32_t ntris, const Material *mats,
 			 PortalTri *portals, uint32_t nportal_tris, V3 scene_center, float scene_radius,
 			 LightTables *out)
 {
 	ajar_status st;
 	memset(out, 0, sizeof(*out));
-	if ((st = build_emitters(tris, ntris, mats, out)) != AJAR_OK ||
+	if ((st = build_emitters(s, tris, shade, extra, ntris, mats, out)) != AJAR_OK ||
 	    (st = build_portals(portals, nportal_tris, out)) != AJAR_OK ||
-	    (st = build_punctual(s, tris, mats, portals, nportal_tris, scene_radius, out)) != AJAR_OK) {
+	    (st = build_punctual(s, portals, nportal_tris, scene_radius, out)) != AJAR_OK) {
 		lights_free(out);
 		return st;
 	}

@@ -38,14 +38,17 @@ typedef struct {
 } LightTables;
 
 /* `tris` is the array as uploaded (BVH order): each triangle's `emitter`
- * is set to its Emitter index or -1, and Emitter.tri indexes this array.
+ * is set to its (first) Emitter index or -1, and Emitter.tri indexes this
+ * array; `shade` and `extra` are in the same order (emissive textures
+ * read their UVs).
  * `mats` has the scene's materials; `portals` (nportal_tris) get their
  * area and pdf_select written. The environment comes from `s`. On failure
  * *out is left empty (safe to lights_free). */
-ajar_status lights_build(const Scene *s, Tri *tris, uint32_t ntris, const Material *mats,
+ajar_status lights_build(const Scene *s, Tri *tris, const TriShade *shade, const TriExtra *extra, uint32_t ntris, const Material *mats,
 			 PortalTri *portals, uint32_t nportal_tris, V3 scene_center, float scene_radius,
 			 LightTables *out);
 void lights_free(LightTables *t);
+
 
 /* cdf[0..n] from n non-negative weights (summed in double). With a zero
  * total the table is uniform if `uniform_if_empty`, else all zeros (which

@@ -80,7 +80,7 @@ static void side_flux(const SceneView *sc, const PortalTri *pt, uint32_t index, 
 		float cos_p = v3_dot(w, n), cos_q = -v3_dot(w, nq);
 		if (!(cos_p > 0.0f) || !(cos_q > 0.0f) || !segment_clear(sc, p, n, q, nq))
 			continue;
-		sl += v3_lum(sc->materials[sc->tris[tri].material].emission) * cos_p * cos_q / (d2 * pdf_a);
+		sl += v3_lum(emitter_emission(sc, tri, q)) * cos_p * cos_q / (d2 * pdf_a);
 	}
 	*env = pt->area * AJAR_PI * se / FLUX_SAMPLES;
 	*emit = pt->area * sl / FLUX_SAMPLES;

@@ -75,15 +75,19 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 
 	d->tris = malloc(sizeof *d->tris * n);
 	d->shade = malloc(sizeof *d->shade * n);
+	d->n_extra = s->extra ? n : 1; /* one unused entry, so a device buffer exists */
+	d->extra = calloc(d->n_extra, sizeof *d->extra);
 	d->params = calloc(1, sizeof *d->params);
 	d->portals = malloc(sizeof *d->portals * (s->nportal_tris ? s->nportal_tris : 1));
-	if (!d->tris || !d->shade || !d->params || !d->portals) {
+	if (!d->tris || !d->shade || !d->params || !d->portals || !d->extra) {
 		prepare_free(d);
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory preparing %u triangles", s->source, n);
 	}
 	for (uint32_t i = 0; i < n; i++) {
 		d->tris[i] = s->tris[d->bvh.order[i]];
 		d->shade[i] = s->shade[d->bvh.order[i]];
+		if (s->extra)
+			d->extra[i] = s->extra[d->bvh.order[i]];
 	}
 	d->n_tris = d->n_shade = n;
 	if (s->nportal_tris)
@@ -99,7 +103,7 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	scene_bounds(s, &d->bmin, &d->bmax);
 	V3 center = v3_scale(v3_add(d->bmin, d->bmax), 0.5f);
 	float radius = 0.5f * v3_len(v3_sub(d->bmax, d->bmin)) * 1.001f + 1e-4f;
-	if ((st = lights_build(s, d->tris, n, s->materials, d->portals, s->nportal_tris, center, radius,
+	if ((st = lights_build(s, d->tris, d->shade, d->extra, n, s->materials, d->portals, s->nportal_tris, center, radius,
 			       &d->lights)) != AJAR_OK) {
 		prepare_free(d);
 		return st;
@@ -225,6 +229,7 @@ void prepare_free(SceneData *d)
 	/* materials, textures and texels are borrowed from the Scene. */
 	free(d->tris);
 	free(d->shade);
+	free(d->extra);
 	free(d->params);
 	free(d->portals);
 	free(d->portal_planes);

@@ -14,6 +14,7 @@
 #include "error.h"
 #include "exr.h"
 #include "hdr.h"
+#include "../kernels/texture.h"
 
 /* Device code indexes with int, so no array may pass INT32_MAX entries. */
 #define SCENE_MAX_ITEMS ((size_t)INT32_MAX)
@@ -75,6 +76,7 @@ void scene_free(Scene *s)
 	free(s->texels);
 	free(s->portals);
 	free(s->env_rgb);
+	free(s->extra);
 	free(s->lights);
 	free(s);
 }
@@ -86,6 +88,10 @@ ajar_status scene_add_material(Scene *s, const Material *m, uint32_t *id)
 	if (m->base_tex >= (int)s->ntextures || m->base_tex < -1)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: material %u: texture %d does not exist (%u textures)",
 			       s->source, s->nmaterials, m->base_tex, s->ntextures);
+	if (m->mr_tex < 0 || m->mr_tex > (int)s->ntextures || m->emissive_tex < 0 ||
+	    m->emissive_tex > (int)s->ntextures || m->normal_tex < 0 || m->normal_tex > (int)s->ntextures)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: material %u: texture %d or %d does not exist (%u textures)",
+			       s->source, s->nmaterials, m->mr_tex - 1, m->emissive_tex - 1, s->ntextures);
 	ajar_status st = grow32((void **)&s->materials, &s->cap_materials, (size_t)s->nmaterials + 1,
 				sizeof *s->materials);
 	if (st)
@@ -122,7 +128,34 @@ ajar_status scene_add_texture(Scene *s, uint32_t width, uint32_t height, const u
 	t->offset = (int)s->ntexels;
 	t->width = (int)width;
 	t->height = (int)height;
+	t->xf[0] = t->xf[4] = 1.0f;
 	s->ntexels += n;
+	s->nimages++;
+	if (id)
+		*id = s->ntextures;
+	s->ntextures++;
+	return AJAR_OK;
+}
+
+ajar_status scene_add_texture_use(Scene *s, uint32_t image, int flags, const float xf[6], uint32_t *id)
+{
+	if (image >= s->ntextures)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: texture %u does not exist (%u textures)", s->source,
+			       image, s->ntextures);
+	for (int i = 0; i < 6; i++)
+		if (!isfinite(xf[i]))
+			return err_set(AJAR_ERROR_BAD_INPUT, "%s: texture %u: transform is not finite", s->source,
+				       s->ntextures);
+	if (s->ntextures >= SCENE_MAX_ITEMS)
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: too many textures", s->source);
+	ajar_status st = grow32((void **)&s->textures, &s->cap_textures, (size_t)s->ntextures + 1,
+				sizeof *s->textures);
+	if (st)
+		return st;
+	Texture *t = &s->textures[s->ntextures];
+	*t = s->textures[image];
+	t->flags = flags;
+	memcpy(t->xf, xf, sizeof t->xf);
 	if (id)
 		*id = s->ntextures;
 	s->ntextures++;
@@ -171,12 +204,59 @@ ajar_status scene_add_triangles(Scene *s, const char *what, const float *pos, co
 				const float *uvs, uint32_t nverts, const uint32_t *idx, uint32_t ntris,
 				uint32_t material)
 {
+	return scene_add_triangles_ex(s, what, pos, normals, uvs, NULL, NULL, NULL, nverts, idx, ntris, material);
+}
+
+static void extra_default(TriExtra *e)
+{
+	memset(e, 0, sizeof *e);
+	for (int c = 0; c < 4; c++)
+		e->c0[c] = e->c1[c] = e->c2[c] = 1.0f;
+}
+
+/* TriExtra entries for triangles [s->ntris, s->ntris + ntris), made when
+ * the first triangle with extra attributes arrives (earlier ones get the
+ * defaults: coordinates 0, colour 1). */
+static ajar_status extra_reserve(Scene *s, const char *what, uint32_t ntris)
+{
+	size_t have = s->extra ? s->ntris : 0, need = (size_t)s->ntris + ntris;
+	ajar_status st = grow((void **)&s->extra, &s->cap_extra, need, sizeof *s->extra);
+	if (st)
+		return err_set(st, "%s: %s: out of memory for vertex attributes", s->source, what);
+	for (size_t i = have; i < need; i++)
+		extra_default(&s->extra[i]);
+	return AJAR_OK;
+}
+
+ajar_status scene_add_triangles_ex(Scene *s, const char *what, const float *pos, const float *normals,
+				   const float *uvs, const float *uvs1, const float *colors, const float *tangents,
+				   uint32_t nverts,
+				   const uint32_t *idx, uint32_t ntris, uint32_t material)
+{
 	ajar_status st = check_geometry(s, what, pos, nverts, idx, ntris, s->ntris);
 	if (st)
+		return st;
+	if (uvs1 && !all_finite(uvs1, 2 * (size_t)nverts))
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: TEXCOORD_1 is not finite", s->source, what);
+	if (colors)
+		for (size_t i = 0; i < 4 * (size_t)nverts; i++)
+			if (!(colors[i] >= 0.0f && colors[i] <= 1.0f))
+				return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: vertex %zu: colour is not in [0, 1]",
+					       s->source, what, i / 4);
+	if (tangents && !all_finite(tangents, 4 * (size_t)nverts))
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: a tangent is not finite", s->source, what);
+	if (material < s->nmaterials && !s->materials[material].normal_tex)
+		tangents = NULL; /* only normal maps read them */
+	if ((uvs1 || colors || tangents || s->extra) && (st = extra_reserve(s, what, ntris)))
 		return st;
 	if (material >= s->nmaterials)
 		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: material %u does not exist (%u materials)", s->source,
 			       what, material, s->nmaterials);
+	/* Rays test the alpha only of triangles that can be transparent. */
+	const Material *mat = &s->materials[material];
+	int alpha = (mat->flags & (MATERIAL_ALPHA_MASK | MATERIAL_ALPHA_BLEND)) &&
+		    (mat->base_tex >= 0 || colors ||
+		     !(mat->base_alpha >= (mat->flags & MATERIAL_ALPHA_MASK ? mat->alpha_cutoff : 1.0f)));
 	if (normals)
 		for (uint32_t v = 0; v < nverts; v++)
 			if (!all_finite(normals + 3 * (size_t)v, 3))
@@ -218,6 +298,8 @@ ajar_status scene_add_triangles(Scene *s, const char *what, const float *pos, co
 		tri->p2 = load3(pos, k[2]);
 		tri->material = (int)material;
 		tri->emitter = -1;
+		if (alpha)
+			tri->flags |= TRI_ALPHA;
 		if (normals) {
 			V3 n[3];
 			sh->has_normals = 1;
@@ -236,6 +318,32 @@ ajar_status scene_add_triangles(Scene *s, const char *what, const float *pos, co
 				sh->n1 = n[1];
 				sh->n2 = n[2];
 			}
+		}
+		if (uvs1 || colors || tangents) {
+			TriExtra *e = &s->extra[s->ntris + t];
+			tri->flags |= TRI_EXTRA;
+			if (tangents) {
+				tri->flags |= TRI_TANGENT;
+				for (int c = 0; c < 4; c++) {
+					e->t0[c] = tangents[4 * (size_t)k[0] + c];
+					e->t1[c] = tangents[4 * (size_t)k[1] + c];
+					e->t2[c] = tangents[4 * (size_t)k[2] + c];
+				}
+			}
+			if (uvs1) {
+				e->u0 = uvs1[2 * (size_t)k[0]];
+				e->v0 = uvs1[2 * (size_t)k[0] + 1];
+				e->u1 = uvs1[2 * (size_t)k[1]];
+				e->v1 = uvs1[2 * (size_t)k[1] + 1];
+				e->u2 = uvs1[2 * (size_t)k[2]];
+				e->v2 = uvs1[2 * (size_t)k[2] + 1];
+			}
+			if (colors)
+				for (int c = 0; c < 4; c++) {
+					e->c0[c] = colors[4 * (size_t)k[0] + c];
+					e->c1[c] = colors[4 * (size_t)k[1] + c];
+					e->c2[c] = colors[4 * (size_t)k[2] + c];
+				}
 		}
 		if (uvs) {
 			sh->u0 = uvs[2 * (size_t)k[0]];
@@ -474,12 +582,85 @@ void scene_bounds(const Scene *s, V3 *bmin, V3 *bmax)
 	*bmax = hi;
 }
 
+#define SCAN_LIMIT (1u << 22) /* texels a "can it emit" test reads at most */
+
+/* Triangle i's texture coordinates under tex's transform, in texels. */
+void scene_tri_texel_coords(const SceneView *v, uint32_t i, int tex, double x[3], double y[3])
+{
+	const TriShade *sh = &v->shade[i];
+	const Texture *t = &v->textures[tex];
+	float u[3] = {sh->u0, sh->u1, sh->u2}, w[3] = {sh->v0, sh->v1, sh->v2};
+	if (t->flags & TEX_UV1) {
+		const TriExtra *e = v->tris[i].flags & TRI_EXTRA ? &v->extra[i] : NULL;
+		u[0] = e ? e->u0 : 0.0f, u[1] = e ? e->u1 : 0.0f, u[2] = e ? e->u2 : 0.0f;
+		w[0] = e ? e->v0 : 0.0f, w[1] = e ? e->v1 : 0.0f, w[2] = e ? e->v2 : 0.0f;
+	}
+	for (int k = 0; k < 3; k++) {
+		x[k] = ((double)t->xf[0] * u[k] + (double)t->xf[1] * w[k] + t->xf[2]) * t->width;
+		y[k] = ((double)t->xf[3] * u[k] + (double)t->xf[4] * w[k] + t->xf[5]) * t->height;
+	}
+}
+
+/* Texel indices lo..hi (of n) as a small range [*a, *b] that the wrap
+ * mode maps onto the same texels: clamped, or shifted by whole periods
+ * (two images wide, for mirrored repeat), or all of one period. */
+static void scan_range(double lo, double hi, int n, int mode, long *a, long *b)
+{
+	if (mode == TEX_WRAP_CLAMP) {
+		*a = (long)fmin(fmax(lo, 0.0), n - 1.0);
+		*b = (long)fmin(fmax(hi, 0.0), n - 1.0);
+	} else if (hi - lo >= 2.0 * n) {
+		*a = 0;
+		*b = 2L * n - 1;
+	} else {
+		double shift = 2.0 * n * floor(lo / (2.0 * n));
+		*a = (long)(lo - shift);
+		*b = (long)(hi - shift);
+	}
+}
+
+/* Whether triangle i can emit anywhere: some texel that a lookup inside
+ * its coordinates' bounding box reads (bilinear: the texels around
+ * x - 0.5, which include nearest's) is not black. Too large a box to read
+ * counts as emitting. */
+int scene_tri_can_emit(const SceneView *v, uint32_t i, int tex)
+{
+	const Texture *t = &v->textures[tex];
+	double x[3], y[3];
+	scene_tri_texel_coords(v, i, tex, x, y);
+	const double eps = 1e-3; /* float rounding in the kernel's lookup */
+	double x0 = floor(fmin(x[0], fmin(x[1], x[2])) - 0.5 - eps), x1 = floor(fmax(x[0], fmax(x[1], x[2])) - 0.5 + eps) + 1;
+	double y0 = floor(fmin(y[0], fmin(y[1], y[2])) - 0.5 - eps), y1 = floor(fmax(y[0], fmax(y[1], y[2])) - 0.5 + eps) + 1;
+	if ((x1 - x0 + 1) * (y1 - y0 + 1) > SCAN_LIMIT)
+		return 1;
+	long ax, bx, ay, by;
+	scan_range(x0, x1, t->width, TEX_WRAP_S(t->flags), &ax, &bx);
+	scan_range(y0, y1, t->height, TEX_WRAP_T(t->flags), &ay, &by);
+	for (long yy = ay; yy <= by; yy++) {
+		int ty = texture_wrap((int)yy, t->height, TEX_WRAP_T(t->flags));
+		for (long xx = ax; xx <= bx; xx++) {
+			int tx = texture_wrap((int)xx, t->width, TEX_WRAP_S(t->flags));
+			if (v->texels[t->offset + (size_t)ty * t->width + tx] & 0xffffffu)
+				return 1;
+		}
+	}
+	return 0;
+}
+
 uint32_t scene_count_emissive(const Scene *s)
 {
 	uint32_t n = 0;
+	SceneView v;
+	memset(&v, 0, sizeof v);
+	v.tris = s->tris;
+	v.shade = s->shade;
+	v.extra = s->extra;
+	v.textures = s->textures;
+	v.texels = s->texels;
 	for (uint32_t i = 0; i < s->ntris; i++) {
 		int m = s->tris[i].material;
-		if (m >= 0 && (uint32_t)m < s->nmaterials && !v3_is_zero(s->materials[m].emission))
+		if (m >= 0 && (uint32_t)m < s->nmaterials && !v3_is_zero(s->materials[m].emission) &&
+		    (!s->materials[m].emissive_tex || scene_tri_can_emit(&v, i, s->materials[m].emissive_tex - 1)))
 			n++;
 	}
 	return n;

@@ -49,6 +49,9 @@ typedef struct ajar_scene {
 	float *env_rgb;          /* env_width * env_height * 3, row 0 = top (+Y) */
 	float env_rotation;      /* radians about +Y, right-handed (kernels/env.h) */
 
+	uint32_t nimages;        /* textures made by scene_add_texture (the others are uses of them) */
+	TriExtra *extra;         /* NULL, or one per triangle once any has TEXCOORD_1 or COLOR_0 */
+	size_t cap_extra;
 	ajar_light *lights;      /* punctual lights, glTF units, direction unit */
 	uint32_t nlights, cap_lights;
 } Scene;
@@ -61,11 +64,22 @@ ajar_status scene_add_material(Scene *s, const Material *m, uint32_t *id);
 /* RGBA8 texels, row 0 first as stored in the image file. */
 ajar_status scene_add_texture(Scene *s, uint32_t width, uint32_t height, const uint8_t *rgba,
 			      uint32_t *id);
+/* Another use of texture `image`'s texels with its own sampler and
+ * coordinates: flags TEX_*, xf the affine map of (u, v) (kernels/types.h). */
+ajar_status scene_add_texture_use(Scene *s, uint32_t image, int flags, const float xf[6], uint32_t *id);
 /* Adds triangles already in world space. `normals` and `uvs` may be NULL.
  * `what` names the origin for messages (e.g. "meshes[2].primitives[0]"). */
 ajar_status scene_add_triangles(Scene *s, const char *what, const float *pos, const float *normals,
 				const float *uvs, uint32_t nverts, const uint32_t *idx, uint32_t ntris,
 				uint32_t material);
+/* scene_add_triangles with a second texture coordinate set (2 floats a
+ * vertex), vertex colours (linear RGBA, 4 floats a vertex) and tangents
+ * (world space xyz and the bitangent's sign w, 4 floats a vertex; used
+ * where the material has a normal map), each may be NULL. */
+ajar_status scene_add_triangles_ex(Scene *s, const char *what, const float *pos, const float *normals,
+				   const float *uvs, const float *uvs1, const float *colors, const float *tangents,
+				   uint32_t nverts,
+				   const uint32_t *idx, uint32_t ntris, uint32_t material);
 ajar_status scene_add_portal(Scene *s, const char *what, const float *pos, uint32_t nverts,
 			     const uint32_t *idx, uint32_t ntris);
 ajar_status scene_set_camera(Scene *s, V3 pos, V3 forward, V3 up, float yfov, float aspect);
@@ -89,6 +103,12 @@ ajar_status scene_add_light(Scene *s, const char *what, const ajar_light *l);
 /* Bounds of all renderable triangles (portals included). */
 void scene_bounds(const Scene *s, V3 *bmin, V3 *bmax);
 uint32_t scene_count_emissive(const Scene *s);
+/* Triangle i of v (tris, shade, extra and textures set): its texture
+ * coordinates for texture `tex` (its set and transform) in texels, and
+ * whether it can emit anywhere with emissive texture `tex` (some texel
+ * its lookups can read is not black; those that cannot are no emitters). */
+void scene_tri_texel_coords(const SceneView *v, uint32_t i, int tex, double x[3], double y[3]);
+int scene_tri_can_emit(const SceneView *v, uint32_t i, int tex);
 /* The camera to render with: the scene's, or, if it has none, a view along
  * -Z framing the bounding sphere (yfov 45 degrees). */
 void scene_camera(const Scene *s, V3 *pos, V3 *forward, V3 *up, float *yfov);

@@ -296,6 +296,27 @@ ajar_status ajar_scene_set_environment_rotation(ajar_scene *s, float degrees)
 	return scene_set_env_rotation(s, degrees);
 }
 
+static int texture_of(const Material *m, int which)
+{
+	return which == 0 ? m->base_tex : which == 1 ? m->mr_tex - 1 : which == 2 ? m->emissive_tex - 1 : m->normal_tex - 1;
+}
+
+/* Distinct images behind the textures of one kind: which = 0 base colour,
+ * 1 metallic-roughness, 2 emissive, 3 normal. */
+static uint32_t count_images(const ajar_scene *s, int which)
+{
+	uint32_t n = 0;
+	for (uint32_t i = 0; i < s->nmaterials; i++) {
+		int t = texture_of(&s->materials[i], which), seen = t < 0;
+		for (uint32_t j = 0; j < i && !seen; j++) {
+			int u = texture_of(&s->materials[j], which);
+			seen = u >= 0 && s->textures[u].offset == s->textures[t].offset;
+		}
+		n += !seen;
+	}
+	return n;
+}
+
 ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info)
 {
 	if (!s || !info)
@@ -306,7 +327,14 @@ ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info)
 	info->emissive_triangles = scene_count_emissive(s);
 	info->portal_triangles = s->nportal_tris;
 	info->portals = s->nportals;
-	info->textures = s->ntextures;
+	info->textures = s->nimages;
+	info->base_color_textures = count_images(s, 0);
+	info->metallic_roughness_textures = count_images(s, 1);
+	info->emissive_textures = count_images(s, 2);
+	info->normal_textures = count_images(s, 3);
+	info->texture_bytes = (uint64_t)s->ntexels * sizeof *s->texels;
+	for (uint32_t i = 0; i < s->ntris; i++)
+		info->alpha_triangles += (s->tris[i].flags & TRI_ALPHA) != 0;
 	info->environment = s->env_type == ENV_IMAGE ? 2 : s->env_type == ENV_COLOR ? 1 : 0;
 	V3 lo, hi;
 	scene_bounds(s, &lo, &hi);

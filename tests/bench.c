@@ -125,10 +125,12 @@ static void bench_scene(const char *path, uint32_t spp)
 	check(device_build(&d, ajar_kernel_source, KERNEL_OPTIONS "0"));
 	double mrays = traversal_mrays(&sd, &d);
 	double msps = pt_msamples(s, 256, spp);
+	/* Textures as the device holds them: RGBA8 texels (4 bytes each). */
 	printf("%-34s %9u tris  load %6.2f s  BVH build %6.3f s  %7.1f MiB  %5u nodes/k-tri  "
-	       "traversal %6.2f Mrays/s  pt %6.3f Msamples/s\n",
+	       "traversal %6.2f Mrays/s  pt %6.3f Msamples/s  textures %u, %.1f MiB\n",
 	       path, s->ntris, load, sd.bvh_seconds, bvh_memory(&sd.bvh) / 1048576.0,
-	       (unsigned)(1000.0 * sd.bvh.nnodes / s->ntris), mrays, msps);
+	       (unsigned)(1000.0 * sd.bvh.nnodes / s->ntris), mrays, msps, s->nimages,
+	       (double)(sd.n_texels * sizeof *sd.texels) / 1048576.0);
 	device_close(&d);
 	prepare_free(&sd);
 	ajar_scene_destroy(&s);

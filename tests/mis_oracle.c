@@ -88,7 +88,7 @@ void oracle(const SceneView *sc, const PathVertex *x, const int *delta, int k, M
 			mv[i].pf = (float)punctual_pf1(sc, &x[0], &x[1]);
 		else if (i == 0)
 			mv[i].pf = x[0].type == VERTEX_ENV ? ps * env_pdf_w(sc, x[0].p)
-							   : (1 - ps) * emitter_pdf_a(sc, x[0].tri);
+							   : (1 - ps) * emitter_pdf_a(sc, x[0].tri, x[0].p);
 		else if (i == 1 && x[0].type == VERTEX_ENV)
 			mv[i].pf = fabs(v3_dot(x[1].ng, x[0].p)) /
 				   (AJAR_PI * prm->scene_radius * prm->scene_radius);
@@ -102,7 +102,7 @@ void oracle(const SceneView *sc, const PathVertex *x, const int *delta, int k, M
 		if (i == 0)
 			mv[0].pn = k < 3 || punctual(&x[0]) ? mv[0].pf
 					 : x[0].type == VERTEX_ENV ? ps * env_nee_pdf_w(sc, x[1].p, vertex_nee_normal(&x[1], &x[2]), x[0].p)
-								    : (1 - ps) * emitter_pdf_a(sc, x[0].tri);
+								    : (1 - ps) * emitter_pdf_a(sc, x[0].tri, x[0].p);
 		/* pr */
 		if (i == k - 1)
 			mv[i].pr = 1;
@@ -224,7 +224,7 @@ static double direction_psa(const SceneView *sc, GLOBAL const PortalTri *pt, con
 			V3 fn = v3_norm(tri_normal(&sc->tris[tri]));
 			double cos_l = -(fn.x * to[0] + fn.y * to[1] + fn.z * to[2]);
 			if (cos_l > 0)
-				guided = (1 - ps) * emitter_pdf_a(sc, tri) * dist * dist / cos_l;
+				guided = (1 - ps) * emitter_pdf_a(sc, tri, a->p) * dist * dist / cos_l;
 		}
 	}
 	double cn = to[0] * n[0] + to[1] * n[1] + to[2] * n[2], c = fabs(cn);

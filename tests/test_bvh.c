@@ -536,6 +536,104 @@ static void test_scene_window_room(void **state) { check_scene(SCENE("window-roo
 static void test_scene_living_room(void **state) { check_scene(SCENE("living-room/living-room.gltf")); }
 static void test_scene_bathroom(void **state) { check_scene(SCENE("bathroom/bathroom.gltf")); }
 
+/* Alpha in ray queries: a unit quad at z = 0 (UVs = xy) with an 8 x 8
+ * checker whose alpha is 0 or 1 (MASK, cutoff 0.5, nearest) lets a ray
+ * through exactly where its texel is clear, for closest-hit and occlusion
+ * queries alike (half the rays over its inner 6 x 6 texels); a BLEND quad of alpha 0.3
+ * stops 30% of them (binomial, 4 sigma); an opaque quad's triangles get no
+ * alpha flag. */
+static void add_quad(Scene *s, float z, uint32_t mat)
+{
+	float pos[] = {0, 0, z, 1, 0, z, 1, 1, z, 0, 1, z};
+	float uv[] = {0, 0, 1, 0, 1, 1, 0, 1};
+	uint32_t idx[] = {0, 1, 2, 0, 2, 3};
+	assert_int_equal(scene_add_triangles(s, "quad", pos, NULL, uv, 4, idx, 2, mat), AJAR_OK);
+}
+
+static uint32_t add_alpha_material(Scene *s, int flags, float alpha, int tex)
+{
+	Material m;
+	memset(&m, 0, sizeof m);
+	m.base_color = v3(1, 1, 1);
+	m.base_alpha = alpha;
+	m.base_tex = tex;
+	m.alpha_cutoff = 0.5f;
+	m.roughness = 1.0f;
+	m.ior = 1.5f;
+	m.flags = flags;
+	uint32_t id;
+	assert_int_equal(scene_add_material(s, &m, &id), AJAR_OK);
+	return id;
+}
+
+static void test_alpha(void **state)
+{
+	(void)state;
+	rng_state = 23;
+	Scene *s;
+	assert_int_equal(scene_new("<test>", &s), AJAR_OK);
+	uint8_t rgba[8 * 8 * 4];
+	for (int i = 0; i < 64; i++) {
+		rgba[4 * i] = rgba[4 * i + 1] = rgba[4 * i + 2] = 200;
+		rgba[4 * i + 3] = ((i % 8) + (i / 8)) % 2 ? 255 : 0;
+	}
+	uint32_t img, tex;
+	assert_int_equal(scene_add_texture(s, 8, 8, rgba, &img), AJAR_OK);
+	const float xf[6] = {1, 0, 0, 0, 1, 0};
+	assert_int_equal(scene_add_texture_use(s, img, TEX_NEAREST, xf, &tex), AJAR_OK);
+	uint32_t mask = add_alpha_material(s, MATERIAL_ALPHA_MASK, 1.0f, (int)tex);
+	uint32_t blend = add_alpha_material(s, MATERIAL_ALPHA_BLEND, 0.3f, -1);
+	uint32_t opaque = add_alpha_material(s, MATERIAL_ALPHA_BLEND, 1.0f, -1);
+	add_quad(s, 0.0f, mask);
+	add_quad(s, 5.0f, blend);
+	add_quad(s, 9.0f, opaque);
+	assert_true(s->tris[0].flags & TRI_ALPHA);
+	assert_true(s->tris[2].flags & TRI_ALPHA);
+	assert_false(s->tris[4].flags & TRI_ALPHA);
+	Built b;
+	built_make(s->tris, s->ntris, &b);
+	TriShade shade[6];
+	for (int i = 0; i < 6; i++)
+		shade[i] = s->shade[b.bvh.order[i]];
+	b.sc.shade = shade;
+	b.sc.materials = s->materials;
+	b.sc.textures = s->textures;
+	b.sc.texels = s->texels;
+	enum { N = 20000 };
+	int through = 0, stopped_blend = 0;
+	for (int k = 0; k < N; k++) {
+		/* Rays up from below the mask, slightly tilted, crossing z = 0 at (x, y). */
+		float x = rnd_range(0.125f, 0.875f), y = rnd_range(0.125f, 0.875f); /* whole texels */
+		V3 d = v3_norm(v3(rnd_range(-0.01f, 0.01f), rnd_range(-0.01f, 0.01f), 1.0f));
+		V3 o = v3_madd(v3(x, y, 0.0f), d, -1.0f / d.z);
+		int ix = (int)fminf(x * 8, 7), iy = (int)fminf(y * 8, 7);
+		int clear = (ix + iy) % 2 == 0;
+		if (fabsf(x * 8 - roundf(x * 8)) < 1e-3f || fabsf(y * 8 - roundf(y * 8)) < 1e-3f) {
+			k--; /* on a texel edge: either side is right */
+			continue;
+		}
+		Hit h;
+		int hit = bvh_intersect(&b.sc, o, d, 4.0f, &h);
+		assert_int_equal(hit, !clear);
+		assert_int_equal(bvh_occluded(&b.sc, o, d, 4.0f), !clear);
+		if (hit)
+			assert_float_equal(h.t, 1.0f / d.z, 1e-5f);
+		through += clear;
+		/* On through the BLEND quad (z = 5), stopped by the opaque one. */
+		V3 o2 = v3_madd(v3(x, y, 4.0f), d, 0.0f);
+		int hb = bvh_intersect(&b.sc, o2, d, AJAR_INF, &h);
+		assert_true(hb);
+		int at_blend = fabsf(o2.z + h.t * d.z - 5.0f) < 1e-3f;
+		assert_int_equal(bvh_occluded(&b.sc, o2, d, 2.0f), at_blend);
+		stopped_blend += at_blend;
+	}
+	printf("  mask: %d of %d through; blend: %d of %d stopped\n", through, N, stopped_blend, N);
+	assert_true(fabs(through - 0.5 * N) < 4.0 * sqrt(0.25 * N));
+	assert_true(fabs(stopped_blend - 0.3 * N) < 4.0 * sqrt(0.21 * N));
+	built_free(&b);
+	scene_free(s);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -550,6 +648,7 @@ int main(void)
 		cmocka_unit_test(test_scene_window_room),
 		cmocka_unit_test(test_scene_living_room),
 		cmocka_unit_test(test_scene_bathroom),
+		cmocka_unit_test(test_alpha),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

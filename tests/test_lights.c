@@ -75,7 +75,7 @@ static void lit_build(Lit *l)
 	assert_non_null(l->tris);
 	if (s->ntris)
 		memcpy(l->tris, s->tris, sizeof(Tri) * s->ntris);
-	assert_int_equal(lights_build(s, l->tris, s->ntris, s->materials, s->portals, s->nportal_tris,
+	assert_int_equal(lights_build(s, l->tris, s->shade, s->extra, s->ntris, s->materials, s->portals, s->nportal_tris,
 				      v3(0, 0, 0), 10.0f, &l->lt),
 			 AJAR_OK);
 	memset(&l->prm, 0, sizeof(l->prm));
@@ -91,6 +91,9 @@ static void lit_build(Lit *l)
 	l->prm.env_pdf_select = l->lt.env_pdf_select;
 	memset(&l->sc, 0, sizeof(l->sc));
 	l->sc.tris = l->tris;
+	l->sc.shade = s->shade;
+	l->sc.textures = s->textures;
+	l->sc.texels = s->texels;
 	l->sc.materials = s->materials;
 	l->sc.emitters = l->lt.emitters;
 	l->sc.emitter_cdf = l->lt.emitter_cdf;
@@ -432,7 +435,7 @@ static void test_emitter_sampling(void **state)
 		assert_true(tri >= 0 && tri < 6 && l.tris[tri].emitter >= 0);
 		const Tri *t = &l.tris[tri];
 		obs[t->emitter] += 1.0;
-		assert_float_equal(pdf_a, emitter_pdf_a(&l.sc, tri), 0.0f);
+		assert_float_equal(pdf_a, emitter_pdf_a(&l.sc, tri, p), 0.0f);
 		assert_float_equal(pdf_a, power[t->emitter] / total / l.lt.emitters[t->emitter].area,
 				   1e-5 * pdf_a);
 		V3 ng = tri_normal(t);
@@ -471,10 +474,128 @@ static void test_emitter_sampling(void **state)
 
 	/* Radiance leaves the front face only; non-emitters give none. */
 	V3 front = tri_normal(&l.tris[1]);
-	assert_float_equal(emitter_radiance(&l.sc, 1, front).x, 1.0f, 0.0f);
-	assert_true(v3_is_zero(emitter_radiance(&l.sc, 1, v3_neg(front))));
-	assert_true(v3_is_zero(emitter_radiance(&l.sc, 0, tri_normal(&l.tris[0]))));
-	assert_float_equal(emitter_pdf_a(&l.sc, 0), 0.0f, 0.0f);
+	assert_float_equal(emitter_radiance(&l.sc, 1, l.tris[1].p0, front).x, 1.0f, 0.0f);
+	assert_true(v3_is_zero(emitter_radiance(&l.sc, 1, l.tris[1].p0, v3_neg(front))));
+	assert_true(v3_is_zero(emitter_radiance(&l.sc, 0, l.tris[0].p0, tri_normal(&l.tris[0]))));
+	assert_float_equal(emitter_pdf_a(&l.sc, 0, l.tris[0].p0), 0.0f, 0.0f);
+	lit_free(&l);
+}
+
+/* A unit quad in z = 0 (UVs = xy) with an 8 x 8 emissive texture whose
+ * left half (x < 0.5) is black, nearest filtering, and a triangle whose
+ * UVs lie in the black half: the quad emits half the power of an
+ * untextured one, its points are sampled only where it emits and
+ * uniformly there (chi-square over 8 x 8 cells of the lit half), and the
+ * black triangle is no emitter at all. */
+static void test_emissive_texture(void **state)
+{
+	(void)state;
+	rng_state = 17;
+	Lit l;
+	assert_int_equal(scene_new("<test>", &l.s), AJAR_OK);
+	uint8_t rgba[8 * 8 * 4];
+	for (int i = 0; i < 64; i++) {
+		uint8_t c = (i % 8) < 4 ? 0 : 255;
+		rgba[4 * i] = rgba[4 * i + 1] = rgba[4 * i + 2] = c;
+		rgba[4 * i + 3] = 255;
+	}
+	uint32_t img, tex;
+	assert_int_equal(scene_add_texture(l.s, 8, 8, rgba, &img), AJAR_OK);
+	const float xf[6] = {1, 0, 0, 0, 1, 0};
+	assert_int_equal(scene_add_texture_use(l.s, img, TEX_NEAREST, xf, &tex), AJAR_OK);
+	uint32_t m = add_material(l.s, v3(2, 2, 2));
+	l.s->materials[m].emissive_tex = (int)tex + 1;
+	float pos[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+	float uv[] = {0, 0, 1, 0, 1, 1, 0, 1};
+	uint32_t idx[] = {0, 1, 2, 0, 2, 3};
+	assert_int_equal(scene_add_triangles(l.s, "quad", pos, NULL, uv, 4, idx, 2, m), AJAR_OK);
+	float pos2[] = {3, 0, 0, 4, 0, 0, 3, 1, 0};
+	float uv2[] = {0.1f, 0, 0.4f, 0, 0.1f, 1};
+	assert_int_equal(scene_add_triangles(l.s, "dark", pos2, NULL, uv2, 3, NULL, 1, m), AJAR_OK);
+	lit_build(&l);
+	assert_true(l.tris[0].emitter >= 0 && l.tris[1].emitter >= 0);
+	assert_int_equal(l.tris[2].emitter, -1);
+	/* Area 1, half of it at radiance 2 (luminance 2): pi W. */
+	assert_float_equal(l.lt.emitter_power, AJAR_PI, 1e-5 * AJAR_PI);
+	enum { N = 64000, G = 8 };
+	double obs[G * G] = {0}, expct[G * G];
+	for (int k = 0; k < N; k++) {
+		V3 p, n;
+		float pdf_a;
+		int tri = emitter_sample(&l.sc, rnd(), rnd(), rnd(), &p, &n, &pdf_a);
+		assert_true(tri == 0 || tri == 1);
+		assert_true(p.x >= 0.5f - 1e-6f);
+		/* Uniform over the lit half: density 2 per unit area. */
+		assert_float_equal(pdf_a, 2.0f, 1e-4f);
+		assert_float_equal(emitter_pdf_a(&l.sc, tri, p), pdf_a, 1e-4f);
+		assert_float_equal(emitter_radiance(&l.sc, tri, p, v3(0, 0, 1)).x, 2.0f, 0.0f);
+		int i = (int)fminf((p.x - 0.5f) * 2 * G, G - 1), j = (int)fminf(p.y * G, G - 1);
+		obs[j * G + i] += 1.0;
+	}
+	for (int c = 0; c < G * G; c++)
+		expct[c] = (double)N / (G * G);
+	double p = chi2_test(obs, expct, G * G, 5.0);
+	printf("  points on the lit half: p = %.3f\n", p);
+	assert_true(p > ALPHA);
+	/* The black half: no emission and zero density. */
+	V3 dark = v3(0.25f, 0.6f, 0.0f);
+	int t = 1; /* (0,0) (1,1) (0,1) holds x < y */
+	assert_true(v3_is_zero(emitter_radiance(&l.sc, t, dark, v3(0, 0, 1))));
+	assert_float_equal(emitter_pdf_a(&l.sc, t, dark), 0.0f, 0.0f);
+
+	/* An alpha-masked emitter (checker of 4 x 4 texels, clear where
+	 * x + y is even): half the power, sampled only where it is. */
+	lit_free(&l);
+	assert_int_equal(scene_new("<test>", &l.s), AJAR_OK);
+	uint8_t chk[4 * 4 * 4];
+	for (int i = 0; i < 16; i++) {
+		chk[4 * i] = chk[4 * i + 1] = chk[4 * i + 2] = 255;
+		chk[4 * i + 3] = ((i % 4) + (i / 4)) % 2 ? 255 : 0;
+	}
+	assert_int_equal(scene_add_texture(l.s, 4, 4, chk, &img), AJAR_OK);
+	assert_int_equal(scene_add_texture_use(l.s, img, TEX_NEAREST, xf, &tex), AJAR_OK);
+	m = add_material(l.s, v3(2, 2, 2));
+	l.s->materials[m].base_tex = (int)tex;
+	l.s->materials[m].base_alpha = 1.0f;
+	l.s->materials[m].alpha_cutoff = 0.5f;
+	l.s->materials[m].flags = MATERIAL_ALPHA_MASK;
+	assert_int_equal(scene_add_triangles(l.s, "quad", pos, NULL, uv, 4, idx, 2, m), AJAR_OK);
+	lit_build(&l);
+	assert_float_equal(l.lt.emitter_power, AJAR_PI, 1e-5 * AJAR_PI);
+	for (int k = 0; k < 2000; k++) {
+		V3 p, n;
+		float pdf_a;
+		int tri = emitter_sample(&l.sc, rnd(), rnd(), rnd(), &p, &n, &pdf_a);
+		int ix = (int)fminf(p.x * 4, 3), iy = (int)fminf(p.y * 4, 3);
+		assert_true((ix + iy) % 2 == 1);
+		assert_float_equal(pdf_a, 2.0f, 1e-4f);
+		assert_float_equal(emitter_radiance(&l.sc, tri, p, v3(0, 0, 1)).x, 2.0f, 0.0f);
+	}
+
+	/* The metallic-roughness texture (linear, B metallic, G roughness)
+	 * times the factors, sRGB decoding only for colour. */
+	uint8_t mr[4] = {0, 128, 64, 255};
+	uint32_t mimg;
+	assert_int_equal(scene_add_texture(l.s, 1, 1, mr, &mimg), AJAR_OK);
+	l.sc.textures = l.s->textures;
+	l.sc.texels = l.s->texels;
+	Material *mm = &l.s->materials[m];
+	mm->metallic = 1.0f;
+	mm->roughness = 0.5f;
+	mm->mr_tex = (int)mimg + 1;
+	mm->base_tex = (int)mimg;
+	Surface s;
+	memset(&s, 0, sizeof s);
+	s.material = (int)m;
+	s.ng = s.ns = v3(0, 0, 1);
+	s.tu = s.tv = 0.3f;
+	s.color = v3(1, 1, 1);
+	s.alpha = 1.0f;
+	Bsdf bs;
+	surface_bsdf(&l.sc, &s, surface_base_color(&l.sc, &s), &bs);
+	assert_float_equal(bs.metallic, 64.0f / 255.0f, 1e-6f);
+	assert_float_equal(bs.alpha, powf(0.5f * 128.0f / 255.0f, 2.0f), 1e-6f);
+	assert_float_equal(bs.base_color.y, 0.5f * srgb_to_linear(128.0f / 255.0f), 1e-6f);
 	lit_free(&l);
 }
 
@@ -597,7 +718,7 @@ static void check_light_sample(Lit *l, V3 x, V3 n, const char *name)
 			assert_true(tri >= 0);
 			assert_float_equal(light_pdf_w(&l->sc, x, n, ls.wi, tri, ls.dist, cos_light), ls.pdf_w,
 					   1e-4f * ls.pdf_w);
-			V3 Le = emitter_radiance(&l->sc, tri, v3_neg(ls.wi));
+			V3 Le = emitter_radiance(&l->sc, tri, ls.p, v3_neg(ls.wi));
 			assert_true(Le.x == ls.Le.x && Le.y == ls.Le.y && Le.z == ls.Le.z);
 		}
 		float c = fminf(fmaxf(ls.wi.y, -1.0f), 1.0f);
@@ -963,6 +1084,7 @@ int main(void)
 		cmocka_unit_test(test_env_sample_chi2),
 		cmocka_unit_test(test_env_sample_chi2_turned),
 		cmocka_unit_test(test_env_rotation_sense),
+		cmocka_unit_test(test_emissive_texture),
 		cmocka_unit_test(test_env_black_and_color),
 		cmocka_unit_test(test_emitter_sampling),
 		cmocka_unit_test(test_portal_sampling),

@@ -563,7 +563,11 @@ static int cmd_info(int argc, char **argv)
 			printf(", range %g", l.range);
 		printf("\n");
 	}
-	printf("textures:     %u\n", in.textures);
+	printf("textures:     %u (%u base colour, %u metallic-roughness, %u emissive, %u normal; %.1f MiB)\n",
+	       in.textures, in.base_color_textures, in.metallic_roughness_textures, in.emissive_textures,
+	       in.normal_textures,
+	       (double)in.texture_bytes / (1024.0 * 1024.0));
+	printf("alpha-tested: %llu triangles\n", (unsigned long long)in.alpha_triangles);
 	printf("environment:  %s\n", in.environment >= 0 && in.environment <= 2 ? env[in.environment] : "?");
 	printf("bounds:       (%g, %g, %g) .. (%g, %g, %g)\n", in.bounds_min[0], in.bounds_min[1],
 	       in.bounds_min[2], in.bounds_max[0], in.bounds_max[1], in.bounds_max[2]);
