@@ -15,7 +15,16 @@ LINK = re.compile(r'!?\[(?:[^\]\\]|\\.)*\]\(([^()\s]+)(?:\s+"[^"]*")?\)')
 FENCE = re.compile(r'^\s*(```|~~~)')
 
 
+# Third-party assets copied unchanged, with their own READMEs and licences:
+# their links point into the repositories they came from.
+THIRD_PARTY = ('scenes/khronos/',)
+
+
 def markdown_files():
+    return [f for f in all_markdown_files() if not f.startswith(THIRD_PARTY)]
+
+
+def all_markdown_files():
     try:
         out = subprocess.run(['git', 'ls-files', '--cached', '--others', '--exclude-standard', '*.md'],
                              cwd=ROOT, capture_output=True, text=True, check=True).stdout
