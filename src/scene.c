@@ -647,16 +647,23 @@ int scene_tri_can_emit(const SceneView *v, uint32_t i, int tex)
 	return 0;
 }
 
-uint32_t scene_count_emissive(const Scene *s)
+SceneView scene_surface_view(const Scene *s)
 {
-	uint32_t n = 0;
 	SceneView v;
 	memset(&v, 0, sizeof v);
 	v.tris = s->tris;
 	v.shade = s->shade;
 	v.extra = s->extra;
+	v.materials = s->materials;
 	v.textures = s->textures;
 	v.texels = s->texels;
+	return v;
+}
+
+uint32_t scene_count_emissive(const Scene *s)
+{
+	uint32_t n = 0;
+	SceneView v = scene_surface_view(s);
 	for (uint32_t i = 0; i < s->ntris; i++) {
 		int m = s->tris[i].material;
 		if (m >= 0 && (uint32_t)m < s->nmaterials && !v3_is_zero(s->materials[m].emission) &&

@@ -102,6 +102,9 @@ ajar_status scene_add_light(Scene *s, const char *what, const ajar_light *l);
 
 /* Bounds of all renderable triangles (portals included). */
 void scene_bounds(const Scene *s, V3 *bmin, V3 *bmax);
+/* The host scene's surfaces (triangles, shading, materials, textures) as
+ * the kernels' surface code reads them; the other arrays are NULL. */
+SceneView scene_surface_view(const Scene *s);
 uint32_t scene_count_emissive(const Scene *s);
 /* Triangle i of v (tris, shade, extra and textures set): its texture
  * coordinates for texture `tex` (its set and transform) in texels, and

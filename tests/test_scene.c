@@ -1004,14 +1004,7 @@ static void test_texture_coordinates(void **state)
 	write_text("uv.gltf", uv_gltf);
 	Scene *s = load_ok("uv.gltf");
 	assert_int_equal(s->nimages, 1);
-	SceneView sc;
-	memset(&sc, 0, sizeof sc);
-	sc.tris = s->tris;
-	sc.shade = s->shade;
-	sc.extra = s->extra;
-	sc.materials = s->materials;
-	sc.textures = s->textures;
-	sc.texels = s->texels;
+	SceneView sc = scene_surface_view(s);
 	int t0 = s->materials[0].base_tex, t1 = s->materials[1].base_tex, t2 = s->materials[2].base_tex;
 	/* Wrap modes at and past the edges: clamp in s, mirrored repeat in t. */
 	assert_texel(texture_rgba(&sc, t0, 1.3f, 0.1f, 0), 3, 0);
@@ -1241,14 +1234,7 @@ static void test_normal_map(void **state)
 	uint32_t idx[] = {0, 1, 2, 0, 2, 3};
 	assert_int_equal(scene_add_triangles_ex(s, "quad", pos, nrm, uv, NULL, NULL, tan, 4, idx, 2, mid), AJAR_OK);
 	assert_true(s->tris[0].flags & TRI_TANGENT);
-	SceneView sc;
-	memset(&sc, 0, sizeof sc);
-	sc.tris = s->tris;
-	sc.shade = s->shade;
-	sc.extra = s->extra;
-	sc.materials = s->materials;
-	sc.textures = s->textures;
-	sc.texels = s->texels;
+	SceneView sc = scene_surface_view(s);
 	float x = (2.0f * 200 / 255 - 1) * 0.5f, y = (2.0f * 100 / 255 - 1) * 0.5f, z = 2.0f * 220 / 255 - 1;
 	/* b = w (n x t) = -(z x x) = -y */
 	V3 want = v3_norm(v3(x, -y, z));
