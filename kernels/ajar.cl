@@ -9,9 +9,12 @@
 #define AJAR_KERNEL_ARG(type, name) __global const type *name,
 #define AJAR_VIEW_INIT(type, name) sc.name = name;
 
-/* One work-item per pixel: samples [sample_first, sample_first + count) of
- * that pixel, added in fixed point to accum (3 longs per pixel; the pixel
- * is owned by this work-item, so no atomics). Light paths that reach the
+/* Work unit u = unit_first + global id is pixel u % npix, lane u / npix
+ * of `lanes`: it renders the samples sample_first + lane + i lanes of
+ * [sample_first, sample_first + count) of that pixel, added in fixed point
+ * to accum (3 longs per pixel; with one lane the pixel is owned by this
+ * work-item, so no atomics; with more, 64-bit atomic adds, which give the
+ * same integers in any order). Light paths that reach the
  * camera (t = 1) land in other pixels: they go to `splat` with 64-bit
  * atomic adds. The host divides both by the samples per pixel. When
  * Params.strategy_len > 0, bdpt's per-strategy layers follow the splat
@@ -19,21 +22,31 @@
  * first-hit outputs (AOV_CHANNELS longs per pixel, aov.h) to the AOV film
  * at splat + aov_at, after the layers; the pixel owns them, as in accum. */
 __kernel void render_pass(AJAR_SCENE_BUFFERS(AJAR_KERNEL_ARG) __global long *accum,
-			  __global long *splat, uint sample_first, uint sample_count, ulong aov_at)
+			  __global long *splat, uint sample_first, uint sample_count, ulong aov_at,
+			  __global uint *scratch, uint lanes, uint unit_first)
 {
 	SceneView sc;
 	AJAR_SCENE_BUFFERS(AJAR_VIEW_INIT)
 	GLOBAL const Camera *cam = &params->camera;
-	uint pixel = (uint)get_global_id(0);
-	if (pixel >= (uint)(cam->width * cam->height))
+	uint npix = (uint)(cam->width * cam->height);
+	uint unit = unit_first + (uint)get_global_id(0);
+	if (unit >= npix * lanes)
 		return;
+	uint pixel = unit % npix, lane = unit / npix;
 	float x = (float)(pixel % (uint)cam->width), y = (float)(pixel / (uint)cam->width);
 	long sum[3] = {0, 0, 0};
 	long aov_sum[AOV_CHANNELS];
 	for (int c = 0; c < AOV_CHANNELS; c++)
 		aov_sum[c] = 0;
+#ifdef AJAR_SUBPATH_SOA
+	/* This work-item's column of the scratch buffer (vertex.h): the eye
+	 * subpath has one slot more, for the next-event vertex (VNEE). */
+	VRef light = scratch + get_global_id(0), eye = VAT(light, SUBPATH_MAX), back = VAT(eye, SUBPATH_MAX + 1),
+	     fwd = VAT(back, SUBPATH_MAX);
+#else
 	PathVertex light[SUBPATH_MAX], eye[SUBPATH_MAX], back[SUBPATH_MAX], fwd[SUBPATH_MAX];
-	for (uint i = 0; i < sample_count; i++) {
+#endif
+	for (uint i = lane; i < sample_count; i += lanes) {
 		Rng rng = rng_init_pixel(params->seed, pixel, sample_first + i);
 		float jx, jy;
 		rng_pixel(&rng, &jx, &jy);
@@ -55,6 +68,14 @@ __kernel void render_pass(AJAR_SCENE_BUFFERS(AJAR_KERNEL_ARG) __global long *acc
 		if (aov_at)
 			aov_sample(&sc, cam->pos, camera_ray_dir(cam, x + jx, y + jy), L, pixel, sample_first + i,
 				   aov_sum);
+	}
+	if (lanes > 1) {
+		for (int c = 0; c < 3; c++)
+			atom_add(&accum[3 * pixel + c], sum[c]);
+		if (aov_at)
+			for (int c = 0; c < AOV_CHANNELS; c++)
+				atom_add(&splat[aov_at + AOV_CHANNELS * (ulong)pixel + c], aov_sum[c]);
+		return;
 	}
 	accum[3 * pixel + 0] += sum[0];
 	accum[3 * pixel + 1] += sum[1];

@@ -37,52 +37,57 @@
 /* The MIS records of the path made of light vertices l[0..s-1] and eye
  * vertices e[t-1..0], with the densities next to the connection
  * recomputed: pr of l[s-1] and l[s-2], pf of e[t-1] and e[t-2]. */
-INLINE int bdpt_mis_path(const SceneView *sc, const PathVertex *l, int s, const PathVertex *e, int t,
-			 MisVertex *mv)
+INLINE int bdpt_mis_path(const SceneView *sc, VCRef l, int s, VCRef e, int t, MisVertex *mv)
 {
 	GLOBAL const Camera *cam = &sc->params->camera;
 	int k = s + t;
 	for (int i = 0; i < s; i++) {
-		mv[i].pf = l[i].pf;
-		mv[i].pr = l[i].pr;
-		mv[i].delta = l[i].delta;
-		mv[i].infinite = vertex_infinite(&l[i]);
+		VCRef x = VAT(l, i);
+		mv[i].pf = VGETF(x, pf);
+		mv[i].pr = VGETF(x, pr);
+		mv[i].delta = VGETI(x, delta);
+		mv[i].infinite = VREF_INFINITE(x);
 	}
 	for (int j = 0; j < t; j++) {
 		MisVertex *m = &mv[k - 1 - j];
-		m->pf = e[j].pf;
-		m->pr = e[j].pr;
-		m->delta = e[j].delta;
-		m->infinite = vertex_infinite(&e[j]);
+		VCRef x = VAT(e, j);
+		m->pf = VGETF(x, pf);
+		m->pr = VGETF(x, pr);
+		m->delta = VGETI(x, delta);
+		m->infinite = VREF_INFINITE(x);
 	}
 	/* The connection's ends scatter through non-delta lobes on this path,
 	 * whatever their subpaths sampled next (pbrt does the same). */
 	if (s > 0)
 		mv[s - 1].delta = 0;
 	mv[s].delta = 0;
+	VTMP(t0);
+	VTMP(t1);
+	VTMP(t2);
+	VTMP(t3);
 	if (s > 0) /* a punctual light (mis.h) */
-		mv[0].delta = vertex_delta_light(&l[0]);
-	const PathVertex *x0 = s > 0 ? &l[0] : &e[t - 1];
+		mv[0].delta = VREF_DELTA_LIGHT(VAT(l, 0));
+	const PathVertex *x0 = VLOAD(s > 0 ? VAT(l, 0) : VAT(e, t - 1), t0);
 	/* x_1 and x_2 (k >= 3 for the second): light vertices, then eye vertices. */
-	const PathVertex *x1 = s >= 2 ? &l[1] : (s == 1 ? &e[t - 1] : &e[t - 2]);
-	const PathVertex *x2 = s >= 3 ? &l[2] : &e[max(t + s - 3, 0)];
+	const PathVertex *x1 = VLOAD(s >= 2 ? VAT(l, 1) : (s == 1 ? VAT(e, t - 1) : VAT(e, t - 2)), t1);
+	const PathVertex *x2 = VLOAD(s >= 3 ? VAT(l, 2) : VAT(e, max(t + s - 3, 0)), t2);
 	bdpt_light_records(sc, mv, x0, x1, x2, k);
 	if (s == 0) {
 		/* e[t-1] is the light: its emission density. */
-		const PathVertex *lt = &e[t - 1];
+		const PathVertex *lt = x0;
 		if (t >= 3)
-			mv[1].pf = bdpt_emission_pdf(sc, lt, &e[t - 2]);
+			mv[1].pf = bdpt_emission_pdf(sc, lt, x1);
 		return k;
 	}
-	const PathVertex *ls = &l[s - 1], *es = &e[t - 1];
+	const PathVertex *ls = VLOAD(VAT(l, s - 1), t0), *es = VLOAD(VAT(e, t - 1), t1);
 	/* Eye side of the connection: pf of e[t-1], then of e[t-2]. */
 	if (t >= 2) {
 		if (s == 1)
 			mv[s].pf = bdpt_emission_pdf(sc, ls, es);
 		else
-			mv[s].pf = bdpt_pdf_a(sc, ls, &l[s - 2], es, BSDF_IMPORTANCE);
+			mv[s].pf = bdpt_pdf_a(sc, ls, VLOAD(VAT(l, s - 2), t2), es, BSDF_IMPORTANCE);
 		if (t >= 3)
-			mv[s + 1].pf = bdpt_pdf_a(sc, es, ls, &e[t - 2], BSDF_RADIANCE);
+			mv[s + 1].pf = bdpt_pdf_a(sc, es, ls, VLOAD(VAT(e, t - 2), t3), BSDF_RADIANCE);
 	}
 	/* Light side: pr of l[s-1] (from the eye vertex or the camera), then of l[s-2]. */
 	if (t == 1) {
@@ -92,16 +97,16 @@ INLINE int bdpt_mis_path(const SceneView *sc, const PathVertex *l, int s, const 
 		camera_raster(cam, v3_scale(d, 1.0f / sqrt(d2)), &px, &py, &cos_c);
 		mv[s - 1].pr = vertex_density_a(es, ls, camera_pdf_w(cam, cos_c));
 	} else {
-		mv[s - 1].pr = bdpt_pdf_a(sc, es, &e[t - 2], ls, BSDF_RADIANCE);
+		mv[s - 1].pr = bdpt_pdf_a(sc, es, VLOAD(VAT(e, t - 2), t3), ls, BSDF_RADIANCE);
 	}
 	if (s >= 2)
-		mv[s - 2].pr = bdpt_pdf_a(sc, ls, es, &l[s - 2], BSDF_IMPORTANCE);
+		mv[s - 2].pr = bdpt_pdf_a(sc, ls, es, VLOAD(VAT(l, s - 2), t2), BSDF_IMPORTANCE);
 	return k;
 }
 
 /* The weight of bdpt strategy (s, t): over the bdpt strategies alone, or,
  * in the portal integrator, over both families (path_mis.h). */
-CALLED float bdpt_weight(const SceneView *sc, const PathVertex *l, int s, const PathVertex *e, int t)
+CALLED float bdpt_weight(const SceneView *sc, VCRef l, int s, VCRef e, int t)
 {
 	if (PARAMS_INTEGRATOR(sc->params) == INTEGRATOR_PORTAL) {
 		PathRef P;
@@ -154,11 +159,12 @@ INLINE V3 bdpt_scatter(const PathVertex *v, V3 wi, int mode)
  * u4), its intensity windowed by the first hit's distance; from a
  * directional light along a line by sun_line_sample (u1, u3, u4), parallel
  * rays whose density is per perpendicular area. */
-INLINE int bdpt_punctual_subpath(const SceneView *sc, PathVertex *l, int i, float pf, float u1, float u3, float u4,
+INLINE int bdpt_punctual_subpath(const SceneView *sc, VRef l, int i, float pf, float u1, float u3, float u4,
 				 int max_verts, Rng *rng)
 {
 	GLOBAL const PunctualLight *pl = &sc->punctual[i];
-	PathVertex *y = &l[0];
+	VTMP(yt);
+	PathVertex *y = VEDIT(VAT(l, 0), yt);
 	y->tri = i;
 	y->pf = pf;
 	if (!(pf > 0.0f))
@@ -170,6 +176,7 @@ INLINE int bdpt_punctual_subpath(const SceneView *sc, PathVertex *l, int i, floa
 		y->type = VERTEX_SUN;
 		y->p = v3_neg(pl->dir);
 		y->ng = y->ns = y->wo = pl->dir;
+		VCOMMIT(VAT(l, 0), y);
 		if (!sun_line_sample(sc, pl, u1, u3, u4, &o, &pdf_perp))
 			return 1;
 		V3 beta = v3_scale(pl->intensity, 1.0f / (pf * pdf_perp));
@@ -180,26 +187,30 @@ INLINE int bdpt_punctual_subpath(const SceneView *sc, PathVertex *l, int i, floa
 	V3 dir = punctual_dir_sample(pl, u3, u4);
 	float pdf_dir = punctual_dir_pdf(pl, dir);
 	y->ng = y->ns = y->wo = dir;
+	VCOMMIT(VAT(l, 0), y);
 	if (!(pdf_dir > 0.0f) || max_verts < 2 ||
 	    !vertex_trace(sc, l, 1, pl->pos, dir, v3(0.0f, 0.0f, 0.0f), pdf_dir, 0, 1, 0))
 		return 1;
 	/* I(w) window(d) cos / d^2 over (pf pdf_dir cos / d^2). */
-	l[1].beta = v3_scale(punctual_intensity(pl, dir, v3_len(v3_sub(l[1].p, pl->pos))), 1.0f / (pf * pdf_dir));
-	if (v3_is_zero(l[1].beta))
+	V3 beta1 = v3_scale(punctual_intensity(pl, dir, v3_len(v3_sub(VGET3(VAT(l, 1), p), pl->pos))),
+			    1.0f / (pf * pdf_dir));
+	VSET3(VAT(l, 1), beta, beta1);
+	if (v3_is_zero(beta1))
 		return 1;
-	return vertex_extend(sc, l, 2, max_verts, 1, 0, fmax(v3_maxc(l[1].beta), 1e-30f), rng);
+	return vertex_extend(sc, l, 2, max_verts, 1, 0, fmax(v3_maxc(beta1), 1e-30f), rng);
 }
 
 /* Traces the light subpath into l[]; returns its vertex count (0 if the
  * scene has nothing to start from). */
-CALLED int bdpt_light_subpath(const SceneView *sc, PathVertex *l, int max_verts, Rng *rng)
+CALLED int bdpt_light_subpath(const SceneView *sc, VRef l, int max_verts, Rng *rng)
 {
 	GLOBAL const Params *prm = sc->params;
 	float ps = prm->env_pdf_select;
 	float u_sel = rng_f(rng), u1 = rng_f(rng), u2 = rng_f(rng), u3 = rng_f(rng), u4 = rng_f(rng);
 	if (max_verts < 1)
 		return 0;
-	PathVertex *y = &l[0];
+	VTMP(yt);
+	PathVertex *y = VNEW(VAT(l, 0), yt);
 	y->delta = 0;
 	y->pr = 0.0f;
 	y->base = v3(0.0f, 0.0f, 0.0f);
@@ -224,6 +235,7 @@ CALLED int bdpt_light_subpath(const SceneView *sc, PathVertex *l, int max_verts,
 		float pdf_disk = 1.0f / (AJAR_PI * r * r);
 		y->beta = v3(1.0f / y->pf, 1.0f / y->pf, 1.0f / y->pf);
 		V3 beta = v3_scale(Le, 1.0f / (y->pf * pdf_disk));
+		VCOMMIT(VAT(l, 0), y);
 		return vertex_walk(sc, l, 1, max_verts, o, v3_neg(dir), beta, pdf_disk, 1, 1, 0, rng);
 	}
 	float u = fmin((u_sel - ps) / (1.0f - ps), 0.99999994f), pdf_a;
@@ -233,6 +245,7 @@ CALLED int bdpt_light_subpath(const SceneView *sc, PathVertex *l, int max_verts,
 		return 0;
 	if (k >= prm->num_emitters) {
 		int i = k - prm->num_emitters;
+		VCOMMIT(VAT(l, 0), y);
 		return bdpt_punctual_subpath(sc, l, i, (1.0f - ps) * sc->punctual[i].pdf_select, u1, u3, u4, max_verts,
 					     rng);
 	}
@@ -248,6 +261,7 @@ CALLED int bdpt_light_subpath(const SceneView *sc, PathVertex *l, int max_verts,
 	V3 t, b;
 	v3_basis(n, &t, &b);
 	V3 lc = sample_cosine_hemisphere(u3, u4);
+	VCOMMIT(VAT(l, 0), y);
 	if (!(lc.z > 0.0f))
 		return 1;
 	V3 dir = v3_from_local(lc, t, b, n);
@@ -348,21 +362,23 @@ INLINE V3 bdpt_to_camera(const SceneView *sc, const PathVertex *y, int origin, c
 }
 
 /* Light vertex s - 1 seen by the camera: splats its weighted contribution. */
-CALLED void bdpt_light_to_camera(const SceneView *sc, PathVertex *l, int s, PathVertex *cam_v, BdptFilm *out,
-				 Rng *rng)
+CALLED void bdpt_light_to_camera(const SceneView *sc, VCRef l, int s, VCRef cam_v, BdptFilm *out, Rng *rng)
 {
 	uint pixel;
-	V3 c = bdpt_to_camera(sc, &l[s - 1], s == 1, cam_v, &pixel);
+	VTMP(yt);
+	VTMP(ct);
+	V3 c = bdpt_to_camera(sc, VLOAD(VAT(l, s - 1), yt), s == 1, VLOAD(cam_v, ct), &pixel);
 	if (!v3_is_zero(c))
 		bdpt_add(sc, out, s, 1, c, bdpt_weight(sc, l, s, cam_v, 1), pixel, rng);
 }
 
 /* Traces the eye subpath through raster point (px, py) into e[]; e[0] is
  * the camera. Returns its vertex count. */
-CALLED int bdpt_eye_subpath(const SceneView *sc, float px, float py, PathVertex *e, int max_verts, Rng *rng)
+CALLED int bdpt_eye_subpath(const SceneView *sc, float px, float py, VRef e, int max_verts, Rng *rng)
 {
 	GLOBAL const Camera *cam = &sc->params->camera;
-	PathVertex *z0 = &e[0];
+	VTMP(zt);
+	PathVertex *z0 = VNEW(VAT(e, 0), zt);
 	z0->type = VERTEX_CAMERA;
 	z0->p = cam->pos;
 	z0->ng = z0->ns = z0->wo = cam->forward;
@@ -374,6 +390,7 @@ CALLED int bdpt_eye_subpath(const SceneView *sc, float px, float py, PathVertex 
 	z0->material = z0->tri = -1;
 	V3 dir = camera_ray_dir(cam, px, py);
 	float cos_c = v3_dot(dir, cam->forward);
+	VCOMMIT(VAT(e, 0), z0);
 	return vertex_walk(sc, e, 1, max_verts, cam->pos, dir, z0->beta, camera_pdf_w(cam, cos_c), 0, 0, 1, rng);
 }
 
@@ -428,18 +445,20 @@ CALLED V3 bdpt_nee(const SceneView *sc, const PathVertex *z, const PathVertex *f
 
 /* Every bdpt strategy of one light and one eye subpath: adds the eye
  * strategies to out->L and splats light tracing (t = 1). */
-CALLED void bdpt_strategies(const SceneView *sc, PathVertex *l, int nl, PathVertex *e, int ne, BdptFilm *out,
-			    Rng *rng)
+CALLED void bdpt_strategies(const SceneView *sc, VRef l, int nl, VRef e, int ne, BdptFilm *out, Rng *rng)
 {
 	int depth = sc->params->max_depth;
 
 	/* t = 1: every light vertex to the camera. */
 	for (int s = 1; s <= nl && s <= depth; s++)
-		if (s > 1 || !vertex_delta_light(&l[0])) /* a punctual light is not seen */
-			bdpt_light_to_camera(sc, l, s, &e[0], out, rng);
+		if (s > 1 || !VREF_DELTA_LIGHT(VAT(l, 0))) /* a punctual light is not seen */
+			bdpt_light_to_camera(sc, l, s, VAT(e, 0), out, rng);
 
 	for (int t = 2; t <= ne; t++) {
-		PathVertex *z = &e[t - 1];
+		VTMP(zt);
+		VTMP(ft);
+		VTMP(lt);
+		const PathVertex *z = VLOAD(VAT(e, t - 1), zt);
 		/* s = 0: the eye subpath found the light. */
 		if (z->type == VERTEX_ENV || sc->tris[z->tri].emitter >= 0) {
 			V3 Le = bdpt_emitted(sc, z, z->wo);
@@ -453,16 +472,17 @@ CALLED void bdpt_strategies(const SceneView *sc, PathVertex *l, int nl, PathVert
 		/* s = 1: next-event estimation with a fresh light sample. */
 		{
 			PathVertex y;
-			V3 c = bdpt_nee(sc, z, &e[t - 2], &y, rng);
+			V3 c = bdpt_nee(sc, z, VLOAD(VAT(e, t - 2), ft), &y, rng);
 			if (!v3_is_zero(c))
-				bdpt_add(sc, out, 1, t, c, bdpt_weight(sc, &y, 1, e, t), out->pixel, rng);
+				bdpt_add(sc, out, 1, t, c, bdpt_weight(sc, VNEE(e, y), 1, e, t), out->pixel, rng);
 		}
 		/* s >= 2: light vertex s-1 to eye vertex t-1. */
 		for (int s = 2; s <= nl && s + t - 1 <= depth; s++) {
-			V3 c = bdpt_connect(sc, &l[s - 1], z);
+			const PathVertex *ly = VLOAD(VAT(l, s - 1), lt);
+			V3 c = bdpt_connect(sc, ly, z);
 			if (v3_is_zero(c))
 				continue;
-			bdpt_add(sc, out, s, t, v3_mul(v3_mul(l[s - 1].beta, c), z->beta), bdpt_weight(sc, l, s, e, t),
+			bdpt_add(sc, out, s, t, v3_mul(v3_mul(ly->beta, c), z->beta), bdpt_weight(sc, l, s, e, t),
 				 out->pixel, rng);
 		}
 	}
@@ -470,8 +490,7 @@ CALLED void bdpt_strategies(const SceneView *sc, PathVertex *l, int nl, PathVert
 
 /* One bdpt pixel sample at raster (px, py) of pixel out->pixel. l and e
  * hold SUBPATH_MAX vertices each. */
-INLINE void bdpt_sample(const SceneView *sc, float px, float py, PathVertex *l, PathVertex *e, BdptFilm *out,
-			Rng *rng)
+INLINE void bdpt_sample(const SceneView *sc, float px, float py, VRef l, VRef e, BdptFilm *out, Rng *rng)
 {
 	int depth = sc->params->max_depth;
 	Rng lr = rng_fork(rng); /* the light subpath's own stream */

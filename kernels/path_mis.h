@@ -18,25 +18,24 @@
 /* A path assembled from up to four subpath segments, light first:
  * l[0..s-1], R[sp..1], F[1..tp], e[t-1..0]; sp = tp = 0 for bdpt paths. */
 typedef struct {
-	const PathVertex *x[4 * SUBPATH_MAX];
+	VCRef x[4 * SUBPATH_MAX];
 	int k, s, sp, tp, t;
 	int c1;   /* connection edge light side (x_{c1}, x_{c1+1}), or -1 */
 	int c2;   /* connection edge on the eye side, or -1 */
 	int pair; /* the portal pair's edge m, or -1 */
 } PathRef;
 
-INLINE void path_ref(PathRef *P, const PathVertex *l, int s, const PathVertex *R, int sp, const PathVertex *F, int tp,
-		     const PathVertex *e, int t)
+INLINE void path_ref(PathRef *P, VCRef l, int s, VCRef R, int sp, VCRef F, int tp, VCRef e, int t)
 {
 	int k = 0;
 	for (int i = 0; i < s; i++)
-		P->x[k++] = &l[i];
+		P->x[k++] = VAT(l, i);
 	for (int j = sp; j >= 1; j--)
-		P->x[k++] = &R[j];
+		P->x[k++] = VAT(R, j);
 	for (int j = 1; j <= tp; j++)
-		P->x[k++] = &F[j];
+		P->x[k++] = VAT(F, j);
 	for (int j = t - 1; j >= 0; j--)
-		P->x[k++] = &e[j];
+		P->x[k++] = VAT(e, j);
 	P->k = k;
 	P->s = s;
 	P->sp = sp;
@@ -58,30 +57,37 @@ INLINE void path_ref(PathRef *P, const PathVertex *l, int s, const PathVertex *R
  * scattering (mis.h's convention). */
 INLINE float path_pf(const SceneView *sc, const PathRef *P, const MisVertex *mv, int i)
 {
-	const PathVertex *const *x = P->x;
+	const VCRef *x = P->x;
+	VTMP(t0);
+	VTMP(t1);
+	VTMP(t2);
 	if (i == 0)
-		return bdpt_origin_pdf(sc, x[0]);
+		return bdpt_origin_pdf(sc, VLOAD(x[0], t0));
 	if (i == 1)
-		return bdpt_emission_pdf(sc, x[0], x[1]);
+		return bdpt_emission_pdf(sc, VLOAD(x[0], t0), VLOAD(x[1], t1));
 	if (i == P->k - 1 || mv[i - 1].delta)
 		return 0.0f;
-	return bdpt_pdf_a(sc, x[i - 1], x[i - 2], x[i], BSDF_IMPORTANCE);
+	return bdpt_pdf_a(sc, VLOAD(x[i - 1], t0), VLOAD(x[i - 2], t1), VLOAD(x[i], t2), BSDF_IMPORTANCE);
 }
 
 INLINE float path_pr(const SceneView *sc, const PathRef *P, const MisVertex *mv, int i)
 {
-	const PathVertex *const *x = P->x;
+	const VCRef *x = P->x;
 	int k = P->k;
+	VTMP(t0);
+	VTMP(t1);
+	VTMP(t2);
 	if (i == k - 1)
 		return 1.0f;
 	if (i == k - 2) {
 		GLOBAL const Camera *cam = &sc->params->camera;
-		V3 d = vertex_infinite(x[i]) ? v3_neg(x[i]->p) : v3_norm(v3_sub(x[i]->p, cam->pos));
-		return vertex_density_a(x[k - 1], x[i], camera_pdf_w(cam, v3_dot(d, cam->forward)));
+		const PathVertex *xi = VLOAD(x[i], t0);
+		V3 d = vertex_infinite(xi) ? v3_neg(xi->p) : v3_norm(v3_sub(xi->p, cam->pos));
+		return vertex_density_a(VLOAD(x[k - 1], t1), xi, camera_pdf_w(cam, v3_dot(d, cam->forward)));
 	}
 	if (mv[i + 1].delta)
 		return 0.0f;
-	return bdpt_pdf_a(sc, x[i + 1], x[i + 2], x[i], BSDF_RADIANCE);
+	return bdpt_pdf_a(sc, VLOAD(x[i + 1], t0), VLOAD(x[i + 2], t1), VLOAD(x[i], t2), BSDF_RADIANCE);
 }
 
 /* The portal direction density, per projected solid angle about the
@@ -159,7 +165,9 @@ INLINE float portal_pair_log(const SceneView *sc, GLOBAL const PortalTri *pt, co
 INLINE float path_pair_logsum(const SceneView *sc, const PathRef *P, int i, float beta, const V3 *w0, float *lcur,
 			      int *found)
 {
-	const PathVertex *a = P->x[i], *b = P->x[i + 1];
+	VTMP(at);
+	VTMP(bt);
+	const PathVertex *a = VLOAD(P->x[i], at), *b = VLOAD(P->x[i + 1], bt);
 	V3 o = vertex_infinite(a) ? b->p : a->p;
 	V3 d = vertex_infinite(a) ? a->p : v3_sub(b->p, a->p);
 	float tmax = vertex_infinite(a) ? AJAR_INF : 1.0f;
@@ -194,14 +202,14 @@ INLINE float path_pair_logsum(const SceneView *sc, const PathRef *P, int i, floa
 INLINE void path_records_part(const SceneView *sc, const PathRef *P, int heuristic, MisPortalSet set, int n,
 			      MisVertex *mv, int *cross, float *lpsum, float *lpair_cur, int part)
 {
-	const PathVertex *const *x = P->x;
+	const VCRef *x = P->x;
 	int k = P->k, need_pf = mis_needs_pf(set);
 	int nr = min(k, n + 1); /* x_n's delta flag is read too */
 	for (int i = 0; i < nr; i++) {
-		mv[i].pf = x[i]->pf;
-		mv[i].pr = x[i]->pr;
-		mv[i].delta = x[i]->delta;
-		mv[i].infinite = vertex_infinite(x[i]);
+		mv[i].pf = VGETF(x[i], pf);
+		mv[i].pr = VGETF(x[i], pr);
+		mv[i].delta = VGETI(x[i], delta);
+		mv[i].infinite = VREF_INFINITE(x[i]);
 	}
 	/* Connection ends, the light and the camera scatter through non-delta
 	 * lobes on this path whatever their subpaths did next. */
@@ -212,14 +220,18 @@ INLINE void path_records_part(const SceneView *sc, const PathRef *P, int heurist
 	for (int j = 0; j < 2; j++)
 		for (int i = conn[j]; conn[j] >= 0 && i <= conn[j] + 1 && i < nr; i++)
 			mv[i].delta = 0;
-	mv[0].delta = vertex_delta_light(x[0]); /* a punctual light (mis.h) */
+	mv[0].delta = VREF_DELTA_LIGHT(x[0]); /* a punctual light (mis.h) */
 	/* Densities the subpaths could not know. A next-event light vertex
 	 * (s = 1, t >= 2) carries its own sample density, which is pn, and
 	 * its pr when the caller stored it (bdpt_nee). */
 	int nee = P->s == 1 && k >= 3; /* else a light subpath's origin (t = 1) */
 	if (part != PATH_EYE_END) {
-		mv[0].pf = bdpt_origin_pdf(sc, x[0]);
-		mv[0].pn = k < 3 ? mv[0].pf : (nee ? x[0]->pf : bdpt_nee_pdf(sc, x[0], x[1], x[2]));
+		VTMP(t0);
+		VTMP(t1);
+		VTMP(t2);
+		const PathVertex *x0 = VLOAD(x[0], t0);
+		mv[0].pf = bdpt_origin_pdf(sc, x0);
+		mv[0].pn = k < 3 ? mv[0].pf : (nee ? x0->pf : bdpt_nee_pdf(sc, x0, VLOAD(x[1], t1), VLOAD(x[2], t2)));
 		if (need_pf && P->s == 0 && k > 2)
 			mv[1].pf = path_pf(sc, P, mv, 1);
 	}
@@ -227,7 +239,7 @@ INLINE void path_records_part(const SceneView *sc, const PathRef *P, int heurist
 		int c = conn[j];
 		if (c < 0 || (j == 0 && part == PATH_EYE_END) || (j == 1 && part == PATH_LIGHT_END))
 			continue;
-		if (c < n && !(c == 0 && nee && x[0]->pr > 0.0f))
+		if (c < n && !(c == 0 && nee && VGETF(x[0], pr) > 0.0f))
 			mv[c].pr = path_pr(sc, P, mv, c);
 		if (c >= 1 && c - 1 < n)
 			mv[c - 1].pr = path_pr(sc, P, mv, c - 1);
@@ -263,15 +275,16 @@ INLINE void path_records_part(const SceneView *sc, const PathRef *P, int heurist
 		else if (conn)
 			c = -1; /* below */
 		else if (i + 1 < s) /* light subpath: x_{i+1}'s predecessor is x_i */
-			c = x[i + 1]->cross;
+			c = VGETI(x[i + 1], cross);
 		else if (m >= 0 && i <= m) /* <- half (and the pair edge): x_i's predecessor is x_{i+1} */
-			c = x[i]->cross;
+			c = VGETI(x[i], cross);
 		else if (m >= 0 && i < m + tp) /* -> half */
-			c = x[i + 1]->cross;
+			c = VGETI(x[i + 1], cross);
 		else /* eye subpath */
-			c = x[i]->cross;
+			c = VGETI(x[i], cross);
 		if (c != 0 || i == m) {
-			lpsum[i] = path_pair_logsum(sc, P, i, beta, i == m ? &x[i]->w0 : 0, lpair_cur, &found);
+			V3 w0 = i == m ? VGET3(x[i], w0) : v3(0.0f, 0.0f, 0.0f);
+			lpsum[i] = path_pair_logsum(sc, P, i, beta, i == m ? &w0 : 0, lpair_cur, &found);
 			if (conn)
 				c = found;
 		}
@@ -409,18 +422,18 @@ INLINE void mis_record_keep(MisRecord *r, const MisVertex *v, const int *cross, 
  * in turn (lpf 0 unless need_pf): the eye-side ends of one intermediate
  * subpath share most of their records, and reuse the logs of those that
  * path_records left as stored. */
-INLINE void path_vertex_logs(const PathVertex *v, int n, int need_pf, float *out)
+INLINE void path_vertex_logs(VCRef v, int n, int need_pf, float *out)
 {
 	for (int i = 0; i < n; i++) {
-		out[2 * i] = need_pf ? fast_log(mis_remap0(v[i].pf)) : 0.0f;
-		out[2 * i + 1] = fast_log(mis_remap0(v[i].pr));
+		out[2 * i] = need_pf ? fast_log(mis_remap0(VGETF(VAT(v, i), pf))) : 0.0f;
+		out[2 * i + 1] = fast_log(mis_remap0(VGETF(VAT(v, i), pr)));
 	}
 }
 
 /* The light-side end l[0..s-1], R[a..1] (lp = l, or the next-event sample
  * when s = 1), taken from the path that joins it to F[1] and the camera. */
-CALLED void path_light_end(const SceneView *sc, MisPortalSet set, const PathVertex *lp, int s, const PathVertex *R,
-			   int a, const PathVertex *F, const PathVertex *e, MisLightEnd *L)
+CALLED void path_light_end(const SceneView *sc, MisPortalSet set, VCRef lp, int s, VCRef R, int a, VCRef F, VCRef e,
+			   MisLightEnd *L)
 {
 	PathRef P;
 	MisVertex mv[4 * SUBPATH_MAX];
@@ -466,8 +479,8 @@ CALLED void path_light_end(const SceneView *sc, MisPortalSet set, const PathVert
 /* The eye-side end F[1..b], e[t-1..0] into E and its records r[0..b+t-1],
  * taken from the path that joins it to A alone (s = 0, s' = 1); lF and lE
  * are path_vertex_logs of F[0..b] and e[0..t-1]. */
-CALLED void path_eye_end(const SceneView *sc, MisPortalSet set, const PathVertex *R, const PathVertex *F, int b,
-			 const PathVertex *e, int t, const float *lF, const float *lE, MisEyeEnd *E, MisRecord *r)
+CALLED void path_eye_end(const SceneView *sc, MisPortalSet set, VCRef R, VCRef F, int b, VCRef e, int t,
+			 const float *lF, const float *lE, MisEyeEnd *E, MisRecord *r)
 {
 	PathRef P;
 	MisVertex mv[4 * SUBPATH_MAX];
@@ -480,9 +493,9 @@ CALLED void path_eye_end(const SceneView *sc, MisPortalSet set, const PathVertex
 	int nr = P.k - 1;
 	for (int i = 1; i < P.k; i++) {
 		const float *lv = i <= b ? &lF[2 * i] : &lE[2 * (t + b - i)]; /* x_i is F[i] or e[t + b - i] */
-		const PathVertex *xv = P.x[i];
-		float lf = !need_pf ? 0.0f : mv[i].pf == xv->pf ? lv[0] : fast_log(mis_remap0(mv[i].pf));
-		float lr = mv[i].pr == xv->pr ? lv[1] : fast_log(mis_remap0(mv[i].pr));
+		VCRef xv = P.x[i];
+		float lf = !need_pf ? 0.0f : mv[i].pf == VGETF(xv, pf) ? lv[0] : fast_log(mis_remap0(mv[i].pf));
+		float lr = mv[i].pr == VGETF(xv, pr) ? lv[1] : fast_log(mis_remap0(mv[i].pr));
 		mis_record_set(&r[i - 1], lf, lr, mv, cross, lpsum, i, i + 1 < P.k);
 	}
 	E->nr = nr;
@@ -545,10 +558,15 @@ INLINE float path_join_whole(const SceneView *sc, MisPortalSet set, const MisLig
  * x2 is the path's x_2, read when L->pn_from_x2. set is
  * path_portal_set(sc->params), which the caller makes once. */
 CALLED float path_join_weight(const SceneView *sc, MisPortalSet set, const MisLightEnd *L, const MisEyeEnd *E,
-			      const MisRecord *r, const PathVertex *x2, const PathVertex *R, MisStrategy cur)
+			      const MisRecord *r, VCRef x2, VCRef R, MisStrategy cur)
 {
 	int m = L->m;
-	float lpn = L->pn_from_x2 ? fast_log(mis_remap0(bdpt_nee_pdf(sc, &R[1], &R[0], x2))) : L->lpn;
+	VTMP(t0);
+	VTMP(t1);
+	VTMP(t2);
+	float lpn = L->pn_from_x2 ? fast_log(mis_remap0(bdpt_nee_pdf(sc, VLOAD(VAT(R, 1), t0), VLOAD(VAT(R, 0), t1),
+								       VLOAD(x2, t2))))
+				  : L->lpn;
 	if (L->other || E->first_cross < min(E->nr - 1, set.s_max + set.sp_max - m - 1))
 		return path_join_whole(sc, set, L, E, r, lpn, cur);
 	float beta = mis_beta(sc->params->mis);

@@ -100,7 +100,7 @@ INLINE int portal_guided_reached(const SceneView *sc, const PathVertex *A, V3 w0
 /* Traces both halves; returns the vertex counts of R and F (each >= 2 when
  * the half has a first vertex, counting the copy at index 0), or 0 when
  * the sample is wasted. */
-CALLED void portal_intermediate(const SceneView *sc, PathVertex *R, int *nR, PathVertex *F, int *nF, Rng *rng)
+CALLED void portal_intermediate(const SceneView *sc, VRef R, int *nR, VRef F, int *nF, Rng *rng)
 {
 	GLOBAL const Params *prm = sc->params;
 	int depth = prm->max_depth;
@@ -126,14 +126,17 @@ CALLED void portal_intermediate(const SceneView *sc, PathVertex *R, int *nR, Pat
 	origin.type = VERTEX_SURFACE;
 	origin.p = w0;
 	origin.ng = origin.ns = n;
-	PathVertex tmp[2];
-	tmp[0] = origin;
-	if (!vertex_trace(sc, tmp, 1, w0, w, v3(1.0f, 1.0f, 1.0f), 0.0f, 0, 1, 0))
+	/* Each half's walk starts from the origin in its slot 0 (subpath storage, vertex.h). */
+	VSTORE(VAT(F, 0), &origin);
+	if (!vertex_trace(sc, F, 1, w0, w, v3(1.0f, 1.0f, 1.0f), 0.0f, 0, 1, 0))
 		return; /* -> escaped: nothing in the scene to connect to the eye */
-	PathVertex B = tmp[1];
-	if (!vertex_trace(sc, tmp, 1, w0, v3_neg(w), v3(1.0f, 1.0f, 1.0f), 0.0f, 0, 0, 1))
+	VTMP(bt);
+	VTMP(at);
+	PathVertex B = *VLOAD(VAT(F, 1), bt);
+	VSTORE(VAT(R, 0), &origin);
+	if (!vertex_trace(sc, R, 1, w0, v3_neg(w), v3(1.0f, 1.0f, 1.0f), 0.0f, 0, 0, 1))
 		return; /* <- escaped and there is no environment */
-	PathVertex A = tmp[1];
+	PathVertex A = *VLOAD(VAT(R, 1), at);
 	if (how == 2 && !portal_guided_reached(sc, &A, w0, guided_env, guided_dist))
 		return;
 	int cross_ab = A.type == VERTEX_ENV ? portal_crossings(sc, B.p, A.p, 1) : portal_crossings(sc, A.p, B.p, 0);
@@ -147,10 +150,10 @@ CALLED void portal_intermediate(const SceneView *sc, PathVertex *R, int *nR, Pat
 	float k = 1.0f / (pdf_a * q); /* f / p_pair = 1 / (p_A q): G cancels */
 	A.beta = v3(1.0f, 1.0f, 1.0f);
 	B.beta = v3(k, k, k);
-	R[0] = B;
-	R[1] = A;
-	F[0] = A;
-	F[1] = B;
+	VSTORE(VAT(R, 0), &B);
+	VSTORE(VAT(R, 1), &A);
+	VSTORE(VAT(F, 0), &A);
+	VSTORE(VAT(F, 1), &B);
 	/* Each half only as long as the strategies in use reach. */
 	int rmax = min(depth, prm->portal_sp_max) + 1, fmax_ = min(depth, prm->portal_tp_max) + 1;
 	*nR = A.type == VERTEX_ENV ? 2 : vertex_extend(sc, R, 2, rmax, 0, 1, 1.0f, rng);
@@ -173,28 +176,30 @@ INLINE void portal_add(const SceneView *sc, BdptFilm *out, int s, int sp, int tp
 /* The eye-side end of portal strategies: -> vertex F[b] (a surface) to
  * eye vertex e[t-1] (t >= 2) or to the camera (t = 1): the contribution
  * from F[b]'s throughput on, and the pixel it lands in. */
-CALLED V3 portal_right(const SceneView *sc, const PathVertex *F, int b, const PathVertex *e, int t, uint own_pixel,
-		       uint *pixel)
+CALLED V3 portal_right(const SceneView *sc, VCRef F, int b, VCRef e, int t, uint own_pixel, uint *pixel)
 {
-	const PathVertex *y = &F[b];
+	VTMP(yt);
+	VTMP(zt);
 	*pixel = own_pixel;
-	if (y->type != VERTEX_SURFACE)
+	if (VGETI(VAT(F, b), type) != VERTEX_SURFACE)
 		return v3(0.0f, 0.0f, 0.0f);
+	const PathVertex *y = VLOAD(VAT(F, b), yt);
 	if (t >= 2) {
-		if (e[t - 1].type != VERTEX_SURFACE)
+		if (VGETI(VAT(e, t - 1), type) != VERTEX_SURFACE)
 			return v3(0.0f, 0.0f, 0.0f);
-		V3 c = bdpt_connect(sc, y, &e[t - 1]);
-		return v3_mul(v3_mul(y->beta, c), e[t - 1].beta);
+		const PathVertex *z = VLOAD(VAT(e, t - 1), zt);
+		V3 c = bdpt_connect(sc, y, z);
+		return v3_mul(v3_mul(y->beta, c), z->beta);
 	}
-	return bdpt_to_camera(sc, y, 0, &e[0], pixel);
+	return bdpt_to_camera(sc, y, 0, VLOAD(VAT(e, 0), zt), pixel);
 }
 
 #define PORTAL_RIGHT_MAX 48
 #define PORTAL_RECORDS_MAX 512 /* the eye-side ends' MIS records in a chunk (>= 2 SUBPATH_MAX) */
 
 /* One pixel sample of the portal integrator. */
-INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVertex *l, PathVertex *e, PathVertex *R,
-				PathVertex *F, BdptFilm *out, Rng *rng)
+INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, VRef l, VRef e, VRef R, VRef F,
+				BdptFilm *out, Rng *rng)
 {
 	int depth = sc->params->max_depth;
 	/* The light and intermediate subpaths draw from streams of their
@@ -246,22 +251,26 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 		/* Light-side ends: <- vertex R[a] is the light (s = 0), gets a
 		 * light sample (s = 1), or meets light vertex l[s-1]. */
 		for (int a = 1; a < nR; a++) {
-			const PathVertex *z = &R[a];
+			VTMP(zt);
+			const PathVertex *z = VLOAD(VAT(R, a), zt);
 			for (int s = 0; s <= sc->params->portal_s_max && (s <= 1 || s <= nl); s++) {
 				V3 lcon = v3(0.0f, 0.0f, 0.0f);
 				PathVertex y; /* the light sample for s = 1 */
-				const PathVertex *lp = l;
+				VCRef lp = l;
+				VTMP(ft);
 				if (s == 0) {
 					if (z->type == VERTEX_ENV || sc->tris[z->tri].emitter >= 0)
 						lcon = v3_mul(z->beta, bdpt_emitted(sc, z, z->wo));
 				} else if (z->type != VERTEX_SURFACE) {
 					break;
 				} else if (s == 1) {
-					lcon = bdpt_nee(sc, z, &R[a - 1], &y, &ir);
-					lp = &y;
+					lcon = bdpt_nee(sc, z, VLOAD(VAT(R, a - 1), ft), &y, &ir);
+					if (!v3_is_zero(lcon))
+						lp = VNEE(e, y);
 				} else {
-					V3 c = bdpt_connect(sc, &l[s - 1], z);
-					lcon = v3_mul(v3_mul(l[s - 1].beta, c), z->beta);
+					const PathVertex *ly = VLOAD(VAT(l, s - 1), ft);
+					V3 c = bdpt_connect(sc, ly, z);
+					lcon = v3_mul(v3_mul(ly->beta, c), z->beta);
 				}
 				if (v3_is_zero(lcon))
 					continue;
@@ -284,7 +293,7 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, PathVer
 					MisStrategy cur = {2, s, s + a - 1, b};
 					float w;
 					if (join) {
-						w = path_join_weight(sc, set, &L, &rend[j], &rrec[r], b >= 2 ? &F[2] : &e[t - 1],
+						w = path_join_weight(sc, set, &L, &rend[j], &rrec[r], b >= 2 ? VAT(F, 2) : VAT(e, t - 1),
 								     R, cur);
 					} else {
 						PathRef P;

@@ -48,12 +48,111 @@ typedef struct {
 		       * vertex (rebuilding it was 17% of door-ajar's portal time) */
 } PathVertex;
 
+/* ---- Where subpaths live (kernels/README.md, "On GPUs: subpaths in global memory") ----
+ *
+ * By default the subpath arrays are private arrays of PathVertex (CPUs:
+ * they stay in the core's caches). Built with -DAJAR_SUBPATH_SOA=C, they live
+ * in a global scratch buffer for C work-items, structure of arrays by
+ * work-item: 32-bit word f of vertex slot i of work-item w at
+ * [(i * AJAR_SUBPATH_WORDS + f) * C + w], so neighbouring work-items read
+ * neighbouring addresses. Code that walks or reads subpaths holds VRef
+ * (VCRef: read only) and goes through these macros; in the private build
+ * they are the plain pointer code (the same instructions as before).
+ *   VAT(a, i)       vertex i of the subpath at a
+ *   VTMP(t)         a private copy's storage (nothing in the private build)
+ *   VLOAD(r, t)     a readable `const PathVertex *` of vertex r (a copy in t)
+ *   VEDIT(r, t)     a writable copy of r (loaded), VCOMMIT(r, v) writes it back
+ *   VNEW(r, t)      a writable vertex to fill whole, VCOMMIT(r, v) stores it
+ *   VSTORE(r, v)    stores private vertex *v into r; VCOPY(dst, src) between refs
+ *   VGETF/I/3(r, f), VSETF/I/3(r, f, x)  one float, int or V3 field
+ *   VNEE(e, y)      a ref to the private next-event vertex y, for the MIS
+ *                   weights (the SoA build keeps it in eye slot SUBPATH_MAX)
+ * A copy is a snapshot: write through VSET or VCOMMIT, then load again. */
+#define VERTEX_WORDS ((int)(sizeof(PathVertex) / 4))
+#ifdef AJAR_SUBPATH_SOA
+typedef GLOBAL uint *VRef;
+typedef GLOBAL const uint *VCRef;
+typedef union {
+	PathVertex v;
+	uint w[sizeof(PathVertex) / 4];
+} VertexWords;
+/* The host reserves AJAR_SUBPATH_WORDS words a vertex slot (src/device.h). */
+typedef char vertex_fits_slot[sizeof(PathVertex) <= 4 * (AJAR_SUBPATH_WORDS) ? 1 : -1];
+#define VSTRIDE ((size_t)(AJAR_SUBPATH_SOA))
+#define VOFF(f) ((size_t)(__builtin_offsetof(PathVertex, f) / 4) * VSTRIDE)
+#define VAT(a, i) ((a) + (size_t)(i) * ((AJAR_SUBPATH_WORDS) * VSTRIDE))
+#define VTMP(t) VertexWords t
+INLINE PathVertex *vertex_load(VCRef r, VertexWords *t)
+{
+	for (int f = 0; f < VERTEX_WORDS; f++)
+		t->w[f] = r[(size_t)f * VSTRIDE];
+	return &t->v;
+}
+INLINE VRef vertex_store(VRef r, const PathVertex *v)
+{
+	VertexWords t;
+	t.v = *v;
+	for (int f = 0; f < VERTEX_WORDS; f++)
+		r[(size_t)f * VSTRIDE] = t.w[f];
+	return r;
+}
+INLINE void vertex_copy(VRef d, VCRef s)
+{
+	for (int f = 0; f < VERTEX_WORDS; f++)
+		d[(size_t)f * VSTRIDE] = s[(size_t)f * VSTRIDE];
+}
+#define VLOAD(r, t) ((const PathVertex *)vertex_load((r), &(t)))
+#define VEDIT(r, t) vertex_load((r), &(t))
+#define VNEW(r, t) (&(t).v)
+#define VCOMMIT(r, v) ((void)vertex_store((r), (v)))
+#define VSTORE(r, v) ((void)vertex_store((r), (v)))
+#define VCOPY(d, s) vertex_copy((d), (s))
+#define VGETF(r, f) u2f((r)[VOFF(f)])
+#define VGETI(r, f) ((int)(r)[VOFF(f)])
+#define VGET3(r, f) v3(u2f((r)[VOFF(f.x)]), u2f((r)[VOFF(f.y)]), u2f((r)[VOFF(f.z)]))
+#define VSETF(r, f, x) ((r)[VOFF(f)] = f2u(x))
+#define VSETI(r, f, x) ((r)[VOFF(f)] = (uint)(x))
+#define VSET3(r, f, val)                                 \
+	do {                                             \
+		V3 vset3_ = (val);                       \
+		(r)[VOFF(f.x)] = f2u(vset3_.x);          \
+		(r)[VOFF(f.y)] = f2u(vset3_.y);          \
+		(r)[VOFF(f.z)] = f2u(vset3_.z);          \
+	} while (0)
+#define VNEE(e, y) ((VCRef)vertex_store(VAT((VRef)(e), SUBPATH_MAX), &(y)))
+#else
+typedef PathVertex *VRef;
+typedef const PathVertex *VCRef;
+#define VAT(a, i) (&(a)[i])
+#define VTMP(t)
+#define VLOAD(r, t) ((const PathVertex *)(r))
+#define VEDIT(r, t) (r)
+#define VNEW(r, t) (r)
+#define VCOMMIT(r, v) ((void)0)
+#define VSTORE(r, v) ((void)(*(r) = *(v)))
+#define VCOPY(d, s) ((void)(*(d) = *(s)))
+#define VGETF(r, f) ((r)->f)
+#define VGETI(r, f) ((r)->f)
+#define VGET3(r, f) ((r)->f)
+#define VSETF(r, f, x) ((r)->f = (x))
+#define VSETI(r, f, x) ((r)->f = (x))
+#define VSET3(r, f, x) ((r)->f = (x))
+#define VNEE(e, y) ((VCRef)&(y))
+#endif
+/* The slots of one work-item: light, eye (+ the next-event vertex), the
+ * two halves of an intermediate subpath. */
+#define SUBPATH_SLOTS (4 * SUBPATH_MAX + 1)
+
 /* A vertex at infinity (p a direction): the environment or a directional light. */
 INLINE int vertex_infinite(const PathVertex *v) { return v->type == VERTEX_ENV || v->type == VERTEX_SUN; }
 
 /* A punctual light: no ray hits it (s = 0 is impossible), and it is never
  * a connection end but as the fixed end of next-event estimation. */
 INLINE int vertex_delta_light(const PathVertex *v) { return v->type == VERTEX_PUNCTUAL || v->type == VERTEX_SUN; }
+
+/* The same two tests of a stored vertex, reading its type alone. */
+#define VREF_INFINITE(r) (VGETI(r, type) == VERTEX_ENV || VGETI(r, type) == VERTEX_SUN)
+#define VREF_DELTA_LIGHT(r) (VGETI(r, type) == VERTEX_PUNCTUAL || VGETI(r, type) == VERTEX_SUN)
 
 /* Area density at `to` of a direction sampled at `from` with solid-angle
  * density pdf_w; unchanged (solid angle) when `to` is at infinity. */
@@ -98,10 +197,13 @@ INLINE float vertex_shading_correction(const PathVertex *v, V3 wo, V3 wi)
  * light subpaths and the portal's -> half). A ray that escapes becomes an
  * environment vertex if `escape_env` and the scene has one. Returns 1 if
  * a vertex was appended. */
-CALLED int vertex_trace(const SceneView *sc, PathVertex *path, int n, V3 o, V3 d, V3 beta, float pdf_w,
-			int parallel, int light_side, int escape_env)
+CALLED int vertex_trace(const SceneView *sc, VRef path, int n, V3 o, V3 d, V3 beta, float pdf_w, int parallel,
+			int light_side, int escape_env)
 {
-	PathVertex *prev = &path[n - 1], *v = &path[n];
+	VTMP(pt);
+	VTMP(vt);
+	const PathVertex *prev = VLOAD(VAT(path, n - 1), pt);
+	PathVertex *v = VNEW(VAT(path, n), vt);
 	Hit h = {0.0f, 0.0f, 0.0f, -1}; /* gcc cannot see bvh_intersect set it */
 	int portals = PARAMS_INTEGRATOR(sc->params) == INTEGRATOR_PORTAL;
 	v->beta = beta;
@@ -123,6 +225,7 @@ CALLED int vertex_trace(const SceneView *sc, PathVertex *path, int n, V3 o, V3 d
 			v->pr = pdf_w;
 		if (portals)
 			v->cross = portal_crossings(sc, prev->p, d, 1);
+		VCOMMIT(VAT(path, n), v);
 		return 1;
 	}
 	Surface s;
@@ -143,6 +246,7 @@ CALLED int vertex_trace(const SceneView *sc, PathVertex *path, int n, V3 o, V3 d
 	if (portals) /* the edge to prev, or, from the sky, the ray back out */
 		v->cross = vertex_infinite(prev) ? portal_crossings(sc, v->p, prev->p, 1)
 						    : portal_crossings(sc, prev->p, v->p, 0);
+	VCOMMIT(VAT(path, n), v);
 	return 1;
 }
 
@@ -152,13 +256,15 @@ CALLED int vertex_trace(const SceneView *sc, PathVertex *path, int n, V3 o, V3 d
  * density of path[n - 2]. Russian roulette (roulette.h) at path[rr_depth] and
  * beyond, relative to beta_ref (none while beta_ref is 0). Returns 0 if the
  * subpath ends here. */
-INLINE int vertex_scatter(const SceneView *sc, PathVertex *path, int n, int light_side, float beta_ref, V3 *beta,
-			  V3 *o, V3 *d, float *pdf_w, Rng *rng)
+INLINE int vertex_scatter(const SceneView *sc, VRef path, int n, int light_side, float beta_ref, V3 *beta, V3 *o,
+			  V3 *d, float *pdf_w, Rng *rng)
 {
-	PathVertex *v = &path[n - 1], *prev = &path[n - 2];
+	VTMP(vt);
+	VTMP(pt);
 	BsdfSample bsm;
-	if (v->type != VERTEX_SURFACE)
+	if (VGETI(VAT(path, n - 1), type) != VERTEX_SURFACE)
 		return 0;
+	const PathVertex *v = VLOAD(VAT(path, n - 1), vt), *prev = VLOAD(VAT(path, n - 2), pt);
 	float u0, u1, u2;
 	rng_f3(rng, &u0, &u1, &u2);
 	if (!bsdf_sample(&v->bs, v->wo, u0, u1, u2, light_side ? BSDF_IMPORTANCE : BSDF_RADIANCE, &bsm) ||
@@ -168,13 +274,13 @@ INLINE int vertex_scatter(const SceneView *sc, PathVertex *path, int n, int ligh
 	if (light_side)
 		k *= vertex_shading_correction(v, v->wo, bsm.wi);
 	*beta = v3_mul(v->beta, v3_scale(bsm.f, k));
-	v->delta = bsm.delta;
+	VSETI(VAT(path, n - 1), delta, bsm.delta);
 	*pdf_w = bsm.delta ? 0.0f : bsm.pdf_w;
 	float rev_a = bsm.delta ? 0.0f : vertex_density_a(v, prev, bsm.pdf_rev_w);
 	if (light_side)
-		prev->pr = rev_a;
+		VSETF(VAT(path, n - 2), pr, rev_a);
 	else
-		prev->pf = rev_a;
+		VSETF(VAT(path, n - 2), pf, rev_a);
 	float boost = sc->params->light_paths ? RR_BOOST_CONNECTED : RR_BOOST;
 	if (n - 1 >= sc->params->rr_depth && beta_ref > 0.0f && !rr_survive(beta, beta_ref, boost, rng))
 		return 0;
@@ -189,7 +295,7 @@ INLINE int vertex_scatter(const SceneView *sc, PathVertex *path, int n, int ligh
  * until max_verts vertices, a miss, or Russian roulette. beta_ref is the
  * roulette's reference throughput; 0 takes the throughput after the first
  * scattering (camera walks, roulette.h). Returns the new vertex count. */
-CALLED int vertex_extend(const SceneView *sc, PathVertex *path, int n, int max_verts, int light_side,
+CALLED int vertex_extend(const SceneView *sc, VRef path, int n, int max_verts, int light_side,
 			 int escape_env, float beta_ref, Rng *rng)
 {
 	V3 o, d, beta;
@@ -208,7 +314,7 @@ CALLED int vertex_extend(const SceneView *sc, PathVertex *path, int n, int max_v
  * BSDF sampling (vertex_trace and vertex_extend). The roulette of a light
  * walk is relative to its starting throughput, that of a camera walk to the
  * throughput after its first scattering. */
-CALLED int vertex_walk(const SceneView *sc, PathVertex *path, int n, int max_verts, V3 o, V3 d, V3 beta,
+CALLED int vertex_walk(const SceneView *sc, VRef path, int n, int max_verts, V3 o, V3 d, V3 beta,
 		       float pdf_w, int parallel, int light_side, int escape_env, Rng *rng)
 {
 	if (n >= max_verts || !vertex_trace(sc, path, n, o, d, beta, pdf_w, parallel, light_side, escape_env))

@@ -434,6 +434,88 @@ void device_build_options(const Device *d, int integrator, const char *extra, ch
 		 regs, extra ? extra : "");
 }
 
+/* A positive integer from the environment: *out, 1 if set, -1 if malformed. */
+static int env_count(const char *name, unsigned long long *out)
+{
+	const char *v = getenv(name);
+	char *end;
+	if (!v || !v[0])
+		return 0;
+	errno = 0;
+	unsigned long long n = strtoull(v, &end, 10);
+	if (errno || *end || n == 0 || v[0] == '-')
+		return -1;
+	*out = n;
+	return 1;
+}
+
+ajar_status device_plan(const Device *d, int integrator, size_t npix, DevicePlan *p)
+{
+	cl_uint cu = 1;
+	size_t max_wg = 1;
+	cl_ulong mem = 0, max_alloc = 0;
+	unsigned long long v;
+	int got;
+	memset(p, 0, sizeof *p);
+	clGetDeviceInfo(d->id, CL_DEVICE_MAX_COMPUTE_UNITS, sizeof cu, &cu, NULL);
+	clGetDeviceInfo(d->id, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof max_wg, &max_wg, NULL);
+	clGetDeviceInfo(d->id, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof mem, &mem, NULL);
+	clGetDeviceInfo(d->id, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof max_alloc, &max_alloc, NULL);
+	if (cu < 1)
+		cu = 1;
+	if (max_wg < 1)
+		max_wg = 1;
+	/* Work-items in flight that keep the device busy: a GPU's compute
+	 * units each hold about two work-groups of the largest size (an H100
+	 * SM: 2048 threads); a CPU's, one pixel at a time each. */
+	size_t flight = d->is_cpu ? 256 * (size_t)cu : 2 * (size_t)cu * max_wg;
+	const char *mode = getenv("AJAR_SUBPATHS");
+	int bidirectional = integrator != 0; /* INTEGRATOR_PT */
+	if (mode && mode[0] && strcmp(mode, "private") && strcmp(mode, "global"))
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "AJAR_SUBPATHS='%s': expected private or global", mode);
+	p->soa = bidirectional && (mode && mode[0] ? !strcmp(mode, "global") : !d->is_cpu);
+	p->lanes = 1;
+	if (!d->is_cpu && npix > 0 && npix < flight)
+		p->lanes = (unsigned)((flight + npix - 1) / npix);
+	if ((got = env_count("AJAR_PASS_LANES", &v)) < 0 || (got && v > 1024))
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "AJAR_PASS_LANES='%s': expected 1 to 1024",
+			       getenv("AJAR_PASS_LANES"));
+	if (got)
+		p->lanes = (unsigned)v;
+	else if (p->lanes > 64)
+		p->lanes = 64;
+	while (p->lanes > 1 && (unsigned long long)npix * p->lanes >= 1ull << 31)
+		p->lanes--;
+	if (!p->soa)
+		return AJAR_OK;
+	size_t item = (size_t)(p->soa ? (integrator == 2 ? 4 * DEVICE_SUBPATH_MAX + 1 : 2 * DEVICE_SUBPATH_MAX + 1) : 0) *
+		      DEVICE_VERTEX_WORDS * 4;
+	cl_ulong budget = mem / 2 < max_alloc || !max_alloc ? mem / 2 : max_alloc;
+	size_t cap = (flight + 63) / 64 * 64;
+	if ((got = env_count("AJAR_SUBPATH_CAPACITY", &v)) < 0 || (got && v > (1ull << 31)))
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "AJAR_SUBPATH_CAPACITY='%s': expected a work-item count",
+			       getenv("AJAR_SUBPATH_CAPACITY"));
+	if (got)
+		cap = (size_t)v;
+	else if (budget > 0 && cap * (cl_ulong)item > budget)
+		cap = (size_t)(budget / item) / 64 * 64;
+	if (cap == 0 || (budget > 0 && cap * (cl_ulong)item > budget))
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY,
+			       "device %s: no room for the subpath scratch (%zu bytes a work-item, %llu bytes of memory)",
+			       d->name, item, (unsigned long long)mem);
+	p->capacity = cap;
+	p->scratch_bytes = cap * item;
+	return AJAR_OK;
+}
+
+void device_plan_options(const DevicePlan *p, char *buf, size_t cap)
+{
+	if (p->soa)
+		snprintf(buf, cap, " -DAJAR_SUBPATH_SOA=%zu -DAJAR_SUBPATH_WORDS=%d", p->capacity, DEVICE_VERTEX_WORDS);
+	else if (cap)
+		buf[0] = '\0';
+}
+
 ajar_status device_build(Device *d, const char *source, const char *options)
 {
 	char path[1200];

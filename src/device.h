@@ -47,6 +47,30 @@ ajar_status device_build(Device *d, const char *source, const char *options);
  * is not a CPU, a register cap where the device takes NVIDIA's options,
  * and last `extra` (AJAR_CL_OPTIONS, NULL for none), which can undo both. */
 void device_build_options(const Device *d, int integrator, const char *extra, char *buf, size_t cap);
+/* Where bdpt's and portal's subpaths live on a device and how a pass
+ * spreads over it (kernels/README.md, "On GPUs: subpaths in global memory").
+ * PathVertex, as the host reserves room for it: at most
+ * DEVICE_VERTEX_WORDS 32-bit words (kernels/vertex.h refuses to build
+ * otherwise), SUBPATH_MAX vertices a subpath. */
+#define DEVICE_VERTEX_WORDS 72
+#define DEVICE_SUBPATH_MAX 33
+typedef struct {
+	int soa;           /* subpaths in a global scratch buffer (-DAJAR_SUBPATH_SOA), else private arrays */
+	size_t capacity;   /* work-items the scratch holds (its stride), the most one launch covers */
+	unsigned lanes;    /* work-items per pixel: a pass's samples of a pixel are split between them */
+	size_t scratch_bytes; /* 0 without scratch */
+} DevicePlan;
+/* The plan of integrator `integrator` for an image of npix pixels on d:
+ * private arrays on CPUs and for pt, the scratch on other devices; one lane
+ * per pixel on CPUs, on other devices enough for compute units x
+ * max work-group size x 2 work-items in flight (at most 64); a scratch of
+ * that many work-items, within half the device's memory and its largest
+ * buffer. AJAR_SUBPATHS=private|global, AJAR_SUBPATH_CAPACITY=N and
+ * AJAR_PASS_LANES=N override (tests, measurements); a malformed value or a
+ * scratch that does not fit is an error. */
+ajar_status device_plan(const Device *d, int integrator, size_t npix, DevicePlan *p);
+/* The build options the plan adds (empty for private arrays). */
+void device_plan_options(const DevicePlan *p, char *buf, size_t cap);
 ajar_status device_kernel(Device *d, const char *name, cl_kernel *out);
 ajar_status device_buffer(Device *d, cl_mem_flags flags, size_t bytes, const void *host, cl_mem *out);
 

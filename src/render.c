@@ -69,6 +69,8 @@ typedef struct RenderDevice {
 	cl_uint arg_first; /* index of the render kernel's first non-scene argument */
 	cl_mem accum, splat; /* fixed-point films: own pixel, and atomic splats */
 	size_t local;        /* work-group size of render_pass */
+	DevicePlan plan;     /* subpath storage and work-items a pass (device_plan) */
+	cl_mem scratch;      /* the subpaths when plan.soa, else a one-word stand-in */
 	pthread_t thread;
 	int started;              /* thread is running this render */
 	int fail_pass, fail_mode; /* the test hook */
@@ -240,7 +242,14 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 			       strlen(extra));
 	if ((st = device_open(d, plat, id)) != AJAR_OK)
 		return st;
-	device_build_options(d, r->data.params->integrator, extra, options, sizeof options);
+	/* The options of device_build_options, the plan's, then AJAR_CL_OPTIONS. */
+	char plan_opts[96];
+	if ((st = device_plan(d, r->data.params->integrator, (size_t)r->width * r->height, &rd->plan)) != AJAR_OK)
+		return st;
+	device_plan_options(&rd->plan, plan_opts, sizeof plan_opts);
+	device_build_options(d, r->data.params->integrator, NULL, options, sizeof options);
+	snprintf(options + strlen(options), sizeof options - strlen(options), "%s%s%s", plan_opts + (plan_opts[0] == ' '),
+		 plan_opts[0] ? " " : "", extra ? extra : "");
 	if ((st = device_build(d, ajar_kernel_source, options)) != AJAR_OK) {
 		char *why = extra && extra[0] ? strdup(ajar_last_error()) : NULL;
 		if (why) {
@@ -255,7 +264,9 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 	    (st = upload_scene(d, &r->data, &rd->bufs)) != AJAR_OK ||
 	    (st = upload_bind(d, rd->k_render, &rd->bufs, &rd->arg_first)) != AJAR_OK ||
 	    (st = device_buffer(d, CL_MEM_READ_WRITE, bytes, NULL, &rd->accum)) != AJAR_OK ||
-	    (st = device_buffer(d, CL_MEM_READ_WRITE, sbytes, NULL, &rd->splat)) != AJAR_OK)
+	    (st = device_buffer(d, CL_MEM_READ_WRITE, sbytes, NULL, &rd->splat)) != AJAR_OK ||
+	    (st = device_buffer(d, CL_MEM_READ_WRITE, rd->plan.soa ? rd->plan.scratch_bytes : 4, NULL, &rd->scratch)) !=
+		    AJAR_OK)
 		return st;
 	CL_TRY(d, clEnqueueFillBuffer(d->queue, rd->accum, &zero, sizeof zero, 0, bytes, 0, NULL, NULL));
 	CL_TRY(d, clEnqueueFillBuffer(d->queue, rd->splat, &zero, sizeof zero, 0, sbytes, 0, NULL, NULL));
@@ -264,6 +275,7 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 	/* The AOV film: the same buffer, after the layers (the kernel adds aov_at). */
 	cl_ulong aov_at = r->opt.aov ? aov_offset(r) : 0;
 	CL_TRY(d, clSetKernelArg(rd->k_render, rd->arg_first + 4, sizeof aov_at, &aov_at));
+	CL_TRY(d, clSetKernelArg(rd->k_render, rd->arg_first + 5, sizeof(cl_mem), &rd->scratch));
 	CL_TRY(d, clFinish(d->queue));
 	/* An explicit work-group size, measured on PoCL 3.1's CPU device (2
 	 * cores, 128x128 path tracing, first pass = PoCL's cold work-group
@@ -281,6 +293,15 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 					   &max_local, NULL));
 	for (rd->local = 64; rd->local > 1 && rd->local > max_local; rd->local /= 2)
 		;
+	if (rd->plan.soa && rd->plan.capacity % rd->local)
+		rd->plan.capacity -= rd->plan.capacity % rd->local; /* whole groups; the stride is the built one */
+	if (rd->plan.soa && rd->plan.capacity == 0)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "device %s: subpath capacity below the work-group size %zu",
+			       d->name, rd->local);
+	if (rd->plan.soa || rd->plan.lanes > 1)
+		log_msg(AJAR_LOG_INFO, "device %s: subpaths %s, %u work-items a pixel, at most %zu a launch", d->name,
+			rd->plan.soa ? "in global memory" : "private", rd->plan.lanes,
+			rd->plan.soa ? rd->plan.capacity : (size_t)r->width * r->height * rd->plan.lanes);
 	log_msg(AJAR_LOG_INFO, "device %s (%s): kernels %s in %.2f s", d->name, d->selector,
 		d->from_cache ? "loaded from cache" : "compiled", d->build_seconds);
 	return AJAR_OK;
@@ -293,6 +314,8 @@ static void device_teardown(RenderDevice *rd)
 		clReleaseMemObject(rd->accum);
 	if (rd->splat)
 		clReleaseMemObject(rd->splat);
+	if (rd->scratch)
+		clReleaseMemObject(rd->scratch);
 	if (rd->k_render)
 		clReleaseKernel(rd->k_render);
 	device_close(&rd->dev);
@@ -608,12 +631,24 @@ static int run_pass(RenderDevice *rd, Range g, int *film_ok)
 	    (err = clSetKernelArg(rd->k_render, rd->arg_first + 3, sizeof n, &n)) != CL_SUCCESS)
 		return pass_failed(rd, "clSetKernelArg", err);
 	size_t npix = (size_t)r->width * r->height;
-	size_t global = (npix + rd->local - 1) / rd->local * rd->local; /* the kernel skips the excess */
+	/* Work units: pixel x lane (no more lanes than samples); with the
+	 * scratch, launches of at most its capacity (device_plan). */
+	cl_uint lanes = rd->plan.lanes < n ? rd->plan.lanes : n;
+	size_t units = npix * lanes, step = rd->plan.soa ? rd->plan.capacity : units;
 	if (inject && rd->fail_mode == FAIL_LAUNCH)
 		return pass_failed(rd, "clEnqueueNDRangeKernel (test hook AJAR_TEST_FAIL_DEVICE)", CL_OUT_OF_RESOURCES);
-	if ((err = clEnqueueNDRangeKernel(d->queue, rd->k_render, 1, NULL, &global, &rd->local, 0, NULL, NULL)) !=
-	    CL_SUCCESS)
-		return pass_failed(rd, "clEnqueueNDRangeKernel", err);
+	if ((err = clSetKernelArg(rd->k_render, rd->arg_first + 6, sizeof lanes, &lanes)) != CL_SUCCESS)
+		return pass_failed(rd, "clSetKernelArg", err);
+	for (size_t u0 = 0; u0 < units; u0 += step) {
+		cl_uint unit_first = (cl_uint)u0;
+		size_t todo = units - u0 < step ? units - u0 : step;
+		size_t global = (todo + rd->local - 1) / rd->local * rd->local; /* the kernel skips the excess */
+		if ((err = clSetKernelArg(rd->k_render, rd->arg_first + 7, sizeof unit_first, &unit_first)) !=
+			    CL_SUCCESS ||
+		    (err = clEnqueueNDRangeKernel(d->queue, rd->k_render, 1, NULL, &global, &rd->local, 0, NULL, NULL)) !=
+			    CL_SUCCESS)
+			return pass_failed(rd, "clEnqueueNDRangeKernel", err);
+	}
 	err = clFinish(d->queue);
 	if (err == CL_SUCCESS && inject)
 		err = CL_DEVICE_NOT_AVAILABLE;
