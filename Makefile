@@ -53,6 +53,7 @@ DEPS_test_integrators := $(BUILD)/libajar.a
 DEPS_test_traversal := $(BUILD)/libajar.a
 DEPS_test_checkpoint := $(BUILD)/libajar.a
 DEPS_test_aov := $(BUILD)/libajar.a
+DEPS_test_subpaths := $(BUILD)/libajar.a
 
 .PHONY: all lib cli tests test test-unit asan demo bench bench-peers install uninstall clean deps help
 all: lib cli

@@ -486,15 +486,16 @@ ajar_status device_plan(const Device *d, int integrator, size_t npix, DevicePlan
 		p->lanes = 64;
 	while (p->lanes > 1 && (unsigned long long)npix * p->lanes >= 1ull << 31)
 		p->lanes--;
-	if (!p->soa)
-		return AJAR_OK;
-	size_t item = (size_t)(p->soa ? (integrator == 2 ? 4 * DEVICE_SUBPATH_MAX + 1 : 2 * DEVICE_SUBPATH_MAX + 1) : 0) *
-		      DEVICE_VERTEX_WORDS * 4;
-	cl_ulong budget = mem / 2 < max_alloc || !max_alloc ? mem / 2 : max_alloc;
-	size_t cap = (flight + 63) / 64 * 64;
 	if ((got = env_count("AJAR_SUBPATH_CAPACITY", &v)) < 0 || (got && v > (1ull << 31)))
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "AJAR_SUBPATH_CAPACITY='%s': expected a work-item count",
 			       getenv("AJAR_SUBPATH_CAPACITY"));
+	if (!p->soa)
+		return AJAR_OK;
+	/* The slots of kernels/ajar.cl: light, eye and its next-event vertex, the two halves (portal). */
+	size_t item = (size_t)(integrator == 2 ? 4 * DEVICE_SUBPATH_MAX + 1 : 2 * DEVICE_SUBPATH_MAX + 1) *
+		      DEVICE_VERTEX_WORDS * 4;
+	cl_ulong budget = mem / 2 < max_alloc || !max_alloc ? mem / 2 : max_alloc;
+	size_t cap = (flight + 63) / 64 * 64;
 	if (got)
 		cap = (size_t)v;
 	else if (budget > 0 && cap * (cl_ulong)item > budget)
