@@ -509,12 +509,16 @@ ajar_status device_plan(const Device *d, int integrator, size_t npix, DevicePlan
 	return AJAR_OK;
 }
 
-void device_plan_options(const DevicePlan *p, char *buf, size_t cap)
+void device_render_options(const Device *d, int integrator, const DevicePlan *p, const char *extra, char *buf,
+			   size_t cap)
 {
+	device_build_options(d, integrator, NULL, buf, cap);
+	size_t n = strlen(buf);
 	if (p->soa)
-		snprintf(buf, cap, " -DAJAR_SUBPATH_SOA=%zu -DAJAR_SUBPATH_WORDS=%d", p->capacity, DEVICE_VERTEX_WORDS);
-	else if (cap)
-		buf[0] = '\0';
+		snprintf(buf + n, cap - n, "-DAJAR_SUBPATH_SOA=%zu -DAJAR_SUBPATH_WORDS=%d%s%s", p->capacity,
+			 DEVICE_VERTEX_WORDS, extra && extra[0] ? " " : "", extra ? extra : "");
+	else
+		snprintf(buf + n, cap - n, "%s", extra ? extra : "");
 }
 
 ajar_status device_build(Device *d, const char *source, const char *options)

@@ -69,8 +69,11 @@ typedef struct {
  * AJAR_PASS_LANES=N override (tests, measurements); a malformed value or a
  * scratch that does not fit is an error. */
 ajar_status device_plan(const Device *d, int integrator, size_t npix, DevicePlan *p);
-/* The build options the plan adds (empty for private arrays). */
-void device_plan_options(const DevicePlan *p, char *buf, size_t cap);
+/* The options render_pass is built with: device_build_options', the
+ * plan's (-DAJAR_SUBPATH_SOA=capacity -DAJAR_SUBPATH_WORDS=n for the
+ * scratch), then `extra` (AJAR_CL_OPTIONS, NULL for none). */
+void device_render_options(const Device *d, int integrator, const DevicePlan *p, const char *extra, char *buf,
+			   size_t cap);
 ajar_status device_kernel(Device *d, const char *name, cl_kernel *out);
 ajar_status device_buffer(Device *d, cl_mem_flags flags, size_t bytes, const void *host, cl_mem *out);
 

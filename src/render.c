@@ -242,14 +242,9 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 			       strlen(extra));
 	if ((st = device_open(d, plat, id)) != AJAR_OK)
 		return st;
-	/* The options of device_build_options, the plan's, then AJAR_CL_OPTIONS. */
-	char plan_opts[96];
 	if ((st = device_plan(d, r->data.params->integrator, (size_t)r->width * r->height, &rd->plan)) != AJAR_OK)
 		return st;
-	device_plan_options(&rd->plan, plan_opts, sizeof plan_opts);
-	device_build_options(d, r->data.params->integrator, NULL, options, sizeof options);
-	snprintf(options + strlen(options), sizeof options - strlen(options), "%s%s%s", plan_opts + (plan_opts[0] == ' '),
-		 plan_opts[0] ? " " : "", extra ? extra : "");
+	device_render_options(d, r->data.params->integrator, &rd->plan, extra, options, sizeof options);
 	if ((st = device_build(d, ajar_kernel_source, options)) != AJAR_OK) {
 		char *why = extra && extra[0] ? strdup(ajar_last_error()) : NULL;
 		if (why) {

@@ -137,7 +137,10 @@ static void test_plan(void **state)
 	DevicePlan p;
 	cl_uint cu = 0;
 	size_t wg = 0;
-	assert_int_equal(device_select("cpu", &plat, &id, 1, &n), AJAR_OK);
+	if (device_select("cpu", &plat, &id, 1, &n) != AJAR_OK) {
+		skip(); /* a GPU machine without PoCL (tests/gpu/run.sh) */
+		return;
+	}
 	assert_int_equal(device_open(&d, plat, id), AJAR_OK);
 	clGetDeviceInfo(id, CL_DEVICE_MAX_COMPUTE_UNITS, sizeof cu, &cu, NULL);
 	clGetDeviceInfo(id, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof wg, &wg, NULL);
