@@ -37,7 +37,11 @@ export LD_LIBRARY_PATH=$PWD/$C/lib:/usr/local/nvidia/lib64:/usr/local/nvidia/lib
 if [ ! -e /etc/OpenCL/vendors/nvidia.icd ]; then
 	mkdir -p /tmp/gpu-icd
 	cp /etc/OpenCL/vendors/*.icd /tmp/gpu-icd/ 2>/dev/null
-	echo libnvidia-opencl.so.1 >/tmp/gpu-icd/nvidia.icd
+	lib=$(ldconfig -p 2>/dev/null | awk '/libnvidia-opencl\.so\.1/ {print $NF; exit}')
+	[ -n "$lib" ] || lib=$(find /usr/local/nvidia /usr/lib /usr/lib64 /usr/local/cuda* -name 'libnvidia-opencl.so*' \
+		2>/dev/null | head -1)
+	say "NVIDIA's OpenCL library: ${lib:-not found (trying the name)}"
+	echo "${lib:-libnvidia-opencl.so.1}" >/tmp/gpu-icd/nvidia.icd
 	export OCL_ICD_VENDORS=/tmp/gpu-icd
 fi
 export AJAR_CACHE_DIR=/tmp/gpu-ajar-cache
