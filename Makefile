@@ -21,7 +21,16 @@ CPPFLAGS += -Iinclude -Isrc -MMD -MP
 CFLAGS += -std=c11 -D_GNU_SOURCE -ffp-contract=off $(WARN) $(MFLAGS) -fPIC
 CXXFLAGS += -std=c++14 $(WARN) $(MFLAGS) -fPIC
 LDFLAGS += $(MFLAGS)
-LDLIBS = $(PKG_LIBS) -lz -lm -lpthread
+LDLIBS = $(PKG_LIBS) $(MPI_LIBS) -lz -lm -lpthread
+
+# Open MPI (several machines, src/cluster.c): built in when found, unless
+# MPI=0. Only cluster.c is compiled with its flags (and AJAR_MPI); without
+# it the library is built exactly as before, with one rank.
+MPI ?= $(if $(shell pkg-config --exists ompi-c 2>/dev/null && echo y),1,0)
+ifeq ($(MPI),1)
+MPI_CFLAGS := $(shell pkg-config --cflags ompi-c) -DAJAR_MPI
+MPI_LIBS := $(shell pkg-config --libs ompi-c)
+endif
 
 LIB_C := $(wildcard src/*.c)
 LIB_CXX := $(wildcard src/*.cpp)
@@ -91,6 +100,16 @@ $(BUILD)/src/%.o: src/%.c
 	@mkdir -p $(@D)
 	@echo "  CC      $<"
 	$(Q)$(CC) $(CPPFLAGS) $(PKG_CFLAGS) $(CFLAGS) -c -o $@ $<
+
+# With or without MPI: a marker file that changes when MPI does rebuilds cluster.o.
+$(BUILD)/src/cluster.o: src/cluster.c $(BUILD)/mpi-$(MPI)
+	@mkdir -p $(@D)
+	@echo "  CC      $< (MPI=$(MPI))"
+	$(Q)$(CC) $(CPPFLAGS) $(MPI_CFLAGS) $(CFLAGS) -c -o $@ $<
+
+$(BUILD)/mpi-$(MPI):
+	@mkdir -p $(@D)
+	$(Q)rm -f $(BUILD)/mpi-* && touch $@
 
 $(BUILD)/src/%.o: src/%.cpp
 	@mkdir -p $(@D)
