@@ -2,7 +2,7 @@
 # Installs the Debian packages Ajar needs when they are missing (as root), or
 # prints the exact command to run. Used by `make demo`, `make test`, CI.
 PKGS="make gcc g++ pkg-config pocl-opencl-icd ocl-icd-opencl-dev opencl-headers \
-libopenexr-dev libtinygltf-dev libstb-dev libcmocka-dev"
+libopenexr-dev libtinygltf-dev libstb-dev libcmocka-dev libopenmpi-dev openmpi-bin"
 missing=""
 for p in $PKGS; do
 	dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
