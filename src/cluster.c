@@ -128,7 +128,33 @@ int cluster_send(int to, int tag, const void *buf, size_t bytes)
 	return wait_request(&rq, "MPI_Isend", NULL);
 }
 
-int cluster_recv(int from, int tag, void *buf, size_t bytes, int *tag_out, int wait, const atomic_int *cancel)
+_Static_assert(sizeof(MPI_Request) <= sizeof(((ClusterSend *)0)->opaque), "MPI_Request fits ClusterSend");
+
+int cluster_post(int to, int tag, const void *buf, size_t bytes, ClusterSend *q)
+{
+	MPI_Request rq;
+	pthread_mutex_lock(&g_lock);
+	int rc = MPI_Isend(buf, (int)bytes, MPI_BYTE, to, tag, MPI_COMM_WORLD, &rq);
+	pthread_mutex_unlock(&g_lock);
+	q->active = rc == MPI_SUCCESS;
+	if (rc != MPI_SUCCESS)
+		return mpi_failed("MPI_Isend", rc);
+	memcpy(q->opaque, &rq, sizeof rq);
+	return 1;
+}
+
+int cluster_wait(ClusterSend *q)
+{
+	if (!q->active)
+		return 1;
+	MPI_Request rq;
+	memcpy(&rq, q->opaque, sizeof rq);
+	q->active = 0;
+	return wait_request(&rq, "MPI_Isend", NULL);
+}
+
+int cluster_recv(int from, int tag, void *buf, size_t bytes, int *tag_out, const atomic_int *stop,
+		 const atomic_int *cancel)
 {
 	long ns = 50000;
 	double deadline = 0;
@@ -157,7 +183,7 @@ int cluster_recv(int from, int tag, void *buf, size_t bytes, int *tag_out, int w
 				*tag_out = s.MPI_TAG;
 			return 1;
 		}
-		if (!wait)
+		if (stop && atomic_load(stop))
 			return 0;
 		if (cancel && atomic_load(cancel)) {
 			if (deadline == 0)
@@ -228,9 +254,20 @@ int cluster_send(int to, int tag, const void *buf, size_t bytes)
 	(void)to, (void)tag, (void)buf, (void)bytes;
 	return err_set(AJAR_ERROR_DEVICE, "built without MPI"), -1;
 }
-int cluster_recv(int from, int tag, void *buf, size_t bytes, int *tag_out, int wait, const atomic_int *cancel)
+int cluster_post(int to, int tag, const void *buf, size_t bytes, ClusterSend *q)
 {
-	(void)from, (void)tag, (void)buf, (void)bytes, (void)tag_out, (void)wait, (void)cancel;
+	q->active = 0;
+	return cluster_send(to, tag, buf, bytes);
+}
+int cluster_wait(ClusterSend *q)
+{
+	(void)q;
+	return 1;
+}
+int cluster_recv(int from, int tag, void *buf, size_t bytes, int *tag_out, const atomic_int *stop,
+		 const atomic_int *cancel)
+{
+	(void)from, (void)tag, (void)buf, (void)bytes, (void)tag_out, (void)stop, (void)cancel;
 	return err_set(AJAR_ERROR_DEVICE, "built without MPI"), -1;
 }
 int cluster_allgather(const void *mine, void *all, size_t bytes, const atomic_int *cancel)

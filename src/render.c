@@ -76,8 +76,8 @@ typedef struct RenderDevice {
 	uint32_t attempts;        /* passes started, for the test hook */
 	int rank;                 /* on rank 0: the rank this device renders on (0: here) */
 	uint32_t remote;          /* its index there; see "Several machines" */
-	int job_has, job_ok, job_kept; /* on other ranks: the range handed over (job_g), its result */
-	Range job_g;
+	uint32_t job_ranges;      /* on rank 0, for a device of another rank: passes after its first, */
+	double job_idle;          /* and the seconds it waited for them there (dealing, messages) */
 	/* Under the renderer's lock: */
 	int alive, reported;
 	RangeList done;      /* ranges its film holds */
@@ -125,7 +125,7 @@ struct ajar_renderer {
 	/* Several machines (Open MPI, see the section at the end): */
 	long *remote, *remote_splat; /* rank 0: the other ranks' films, summed at the last gather */
 	int job_lost;                /* rank 0: a rank that stopped answering, or 0 */
-	int job_over;                /* other ranks: the render is over (device threads end) */
+	atomic_int job_over;         /* other ranks: the render is over (device threads end) */
 };
 
 static double seconds(void)
@@ -482,8 +482,6 @@ ajar_status ajar_renderer_restart(ajar_renderer *r, uint32_t seed)
 		CL_TRY(d, clEnqueueFillBuffer(d->queue, rd->accum, &zero, sizeof zero, 0, film_bytes(r), 0, NULL, NULL));
 		CL_TRY(d, clEnqueueFillBuffer(d->queue, rd->splat, &zero, sizeof zero, 0, splat_bytes(r), 0, NULL, NULL));
 		CL_TRY(d, clFinish(d->queue));
-		rd->done.n = 0;
-		rd->spp_kept = 0;
 	}
 	free(r->salvage);
 	free(r->salvage_splat);
@@ -616,12 +614,8 @@ static int pass_failed(RenderDevice *rd, const char *what, cl_int err)
 
 /* Renders range g on rd; on failure sets *film_ok to whether the film
  * still holds exactly the completed ranges (the kernel never started). */
-static int job_pass(RenderDevice *rd, Range g, int *film_ok);
-
 static int run_pass(RenderDevice *rd, Range g, int *film_ok)
 {
-	if (rd->rank) /* a device of another rank */
-		return job_pass(rd, g, film_ok);
 	ajar_renderer *r = rd->r;
 	Device *d = &rd->dev;
 	cl_uint first = g.first, n = g.count;
@@ -731,7 +725,7 @@ static void *device_thread(void *arg)
 		int ok = run_pass(rd, g, &film_ok);
 		double dt = seconds() - tp;
 		long *accum = NULL, *splat = NULL;
-		if (!ok && film_ok && !rd->rank)
+		if (!ok && film_ok)
 			read_films(rd, &accum, &splat);
 		pthread_mutex_lock(&r->lock);
 		r->in_flight--;
@@ -744,7 +738,7 @@ static void *device_thread(void *arg)
 			rd->per_spp = dt / g.count;
 			r->spp_done += g.count;
 		} else {
-			drop_device(r, rd, g, accum, splat, rd->rank && film_ok);
+			drop_device(r, rd, g, accum, splat, 0);
 		}
 		free(accum);
 		free(splat);
@@ -769,6 +763,11 @@ static void device_shares(const ajar_renderer *r, char *buf, size_t cap)
 		len += (size_t)snprintf(buf + len, cap - len, "%s%s (%s): %.1f%% %.3g Msamples/s%s", i ? "; " : "",
 					s.name, s.selector, 100 * s.share, s.samples_per_second * 1e-6,
 					s.failed ? " (failed)" : "");
+		/* Another rank's device: what a range cost beyond its kernel there. */
+		const RenderDevice *rd = &r->devs[i];
+		if (rd->job_ranges && len < cap)
+			len += (size_t)snprintf(buf + len, cap - len, ", idle %.2f ms between ranges (mean of %u)",
+						1e3 * rd->job_idle / rd->job_ranges, rd->job_ranges);
 	}
 }
 
@@ -836,6 +835,8 @@ ajar_status ajar_renderer_render(ajar_renderer *r, ajar_progress_fn fn, void *us
 	return cluster_size() > 1 ? job_end(r, st) : st;
 }
 
+static void *job_proxy_thread(void *arg);
+
 static ajar_status render_run(ajar_renderer *r, ajar_progress_fn fn, void *user)
 {
 	pthread_mutex_lock(&r->lock);
@@ -844,7 +845,9 @@ static ajar_status render_run(ajar_renderer *r, ajar_progress_fn fn, void *user)
 	r->running = 0;
 	for (uint32_t i = 0; i < r->ndev; i++) {
 		RenderDevice *rd = &r->devs[i];
-		rd->started = rd->alive && pthread_create(&rd->thread, NULL, device_thread, rd) == 0;
+		/* A device of another rank is driven by a proxy thread (see "Several machines"). */
+		rd->started = rd->alive && pthread_create(&rd->thread, NULL, rd->rank ? job_proxy_thread : device_thread,
+							  rd) == 0;
 		r->running += (uint32_t)rd->started;
 	}
 	if (r->running == 0 && r->last_dropped != NULL) {
@@ -1363,14 +1366,16 @@ static ajar_status resume_options(ajar_options *want, const ajar_options *o, con
  * ends with an error and nothing but the last checkpoint is kept. */
 
 enum { JOB_PASS = 1, JOB_GATHER, JOB_END };
-enum { TAG_CMD = 1, TAG_GATHERED = 2, TAG_DONE = 100 }; /* TAG_DONE + the device's index on its rank */
+/* TAG_PASS and TAG_DONE + the device's index on its rank */
+enum { TAG_CMD = 1, TAG_GATHERED = 2, TAG_PASS = 1000, TAG_DONE = 2000 };
 
 typedef struct {
 	uint32_t op, device, first, count; /* JOB_END: `first` is rank 0's status */
-} JobCmd;
+} JobCmd; /* TAG_CMD, and TAG_PASS + device straight to the device's thread */
 
 typedef struct {
 	int32_t ok, kept; /* the pass rendered; else whether the rank kept the film */
+	double idle;      /* seconds the device waited for this range since its previous one ended (-1: first) */
 	char error[1024];
 } JobDone;
 
@@ -1497,32 +1502,94 @@ static ajar_status job_resume(const ajar_scene *scene, const char *path, const a
 	return st;
 }
 
-/* Rank 0: one pass of a device of another rank. */
-static int job_pass(RenderDevice *rd, Range g, int *film_ok)
+/* Rank 0: the thread of a device of another rank. It keeps two ranges
+ * there (PIPELINE): the device starts the next as soon as it ends one, so
+ * the messages' latency is hidden. The speed is measured from one end of
+ * a pass to the next (or from the send, when the device was idle). A
+ * failure there comes back with whether the rank kept the device's film;
+ * the range queued behind it comes back unrendered. */
+#define PIPELINE 2
+
+static void *job_proxy_thread(void *arg)
 {
+	RenderDevice *rd = arg;
 	ajar_renderer *r = rd->r;
-	JobCmd c = {JOB_PASS, rd->remote, g.first, g.count};
-	JobDone d;
-	*film_ok = 0;
-	int rc = cluster_send(rd->rank, TAG_CMD, &c, sizeof c);
-	if (rc == 1)
-		rc = cluster_recv(rd->rank, TAG_DONE + (int)rd->remote, &d, sizeof d, NULL, 1, &r->cancel);
-	if (rc != 1) {
-		snprintf(rd->error, sizeof rd->error, "rank %d stopped answering%s%s", rd->rank, rc < 0 ? ": " : "",
-			 rc < 0 ? ajar_last_error() : " (killed, or its machine failed)");
-		pthread_mutex_lock(&r->lock);
-		if (!r->job_lost)
-			r->job_lost = rd->rank;
+	Range q[PIPELINE];
+	double sent[PIPELINE], last = 0;
+	int nq = 0, tag_pass = TAG_PASS + (int)rd->remote, tag_done = TAG_DONE + (int)rd->remote;
+	pthread_mutex_lock(&r->lock);
+	for (;;) {
+		int lost = 0;
+		while (nq < PIPELINE && !r->pausing && take_range(r, rd, &q[nq])) {
+			r->in_flight++;
+			JobCmd c = {JOB_PASS, rd->remote, q[nq].first, q[nq].count};
+			pthread_mutex_unlock(&r->lock);
+			lost = cluster_send(rd->rank, tag_pass, &c, sizeof c) != 1;
+			sent[nq++] = seconds();
+			pthread_mutex_lock(&r->lock);
+			if (lost)
+				break;
+		}
+		if (nq == 0) {
+			if (!r->pausing && (r->in_flight == 0 || stopping(r)))
+				break;
+			pthread_cond_wait(&r->cond, &r->lock); /* a checkpoint, or a range may come back */
+			continue;
+		}
 		pthread_mutex_unlock(&r->lock);
-		return 0;
+		JobDone d;
+		int rc = lost ? -1 : cluster_recv(rd->rank, tag_done, &d, sizeof d, NULL, NULL, &r->cancel);
+		double t = seconds(), start = fmax(sent[0], last);
+		pthread_mutex_lock(&r->lock);
+		Range g = q[0];
+		for (int k = 1; k < nq; k++)
+			q[k - 1] = q[k], sent[k - 1] = sent[k];
+		nq--;
+		r->in_flight--;
+		r->events++;
+		if (rc == 1 && d.ok) {
+			if (!ranges_push(&rd->done, g))
+				r->out_of_memory = 1;
+			rd->spp_kept += g.count;
+			rd->busy_seconds += t - start;
+			rd->per_spp = (t - start) / g.count;
+			r->spp_done += g.count;
+			if (d.idle >= 0) {
+				rd->job_ranges++;
+				rd->job_idle += d.idle;
+			}
+			last = t;
+			pthread_cond_broadcast(&r->cond);
+			continue;
+		}
+		if (rc == 1) {
+			d.error[sizeof d.error - 1] = '\0';
+			snprintf(rd->error, sizeof rd->error, "%s", d.error);
+		} else {
+			snprintf(rd->error, sizeof rd->error, "rank %d stopped answering%s%s", rd->rank,
+				 rc < 0 ? ": " : " (killed, or its machine failed)", rc < 0 ? ajar_last_error() : "");
+			if (!r->job_lost)
+				r->job_lost = rd->rank;
+		}
+		drop_device(r, rd, g, NULL, NULL, rc == 1 && d.kept);
+		for (int k = 0; k < nq; k++) { /* queued there, never rendered */
+			if (!ranges_push(&r->holes, q[k]))
+				r->out_of_memory = 1;
+			r->in_flight--;
+		}
+		if (rc == 1 && nq) { /* their answers, so no message is left behind */
+			pthread_mutex_unlock(&r->lock);
+			for (int k = 0; k < nq; k++)
+				cluster_recv(rd->rank, tag_done, &d, sizeof d, NULL, NULL, &r->cancel);
+			pthread_mutex_lock(&r->lock);
+		}
+		pthread_cond_broadcast(&r->cond);
+		break;
 	}
-	if (!d.ok) {
-		d.error[sizeof d.error - 1] = '\0';
-		snprintf(rd->error, sizeof rd->error, "%s", d.error);
-		*film_ok = d.kept;
-		return 0;
-	}
-	return 1;
+	r->running--;
+	pthread_cond_broadcast(&r->cond);
+	pthread_mutex_unlock(&r->lock);
+	return NULL;
 }
 
 /* Rank 0: the other ranks' films summed into r->remote. */
@@ -1548,7 +1615,7 @@ static ajar_status job_gather(ajar_renderer *r)
 	/* Each rank says whether its films could be read. */
 	for (int k = 1; k < cluster_size() && rc == 1; k++) {
 		JobDone d;
-		rc = cluster_recv(k, TAG_GATHERED, &d, sizeof d, NULL, 1, &r->cancel);
+		rc = cluster_recv(k, TAG_GATHERED, &d, sizeof d, NULL, NULL, &r->cancel);
 		if (rc == 1 && !d.ok) {
 			d.error[sizeof d.error - 1] = '\0';
 			memset(r->remote, 0, n * sizeof *r->remote);
@@ -1602,62 +1669,68 @@ static ajar_status job_end(ajar_renderer *r, ajar_status st)
 	return st;
 }
 
-/* Other ranks: one thread per device renders what rank 0 hands it. */
+/* Other ranks: one thread per device renders the ranges rank 0 sends it
+ * (straight to the thread: one wake-up less per range than through the
+ * main thread). */
 static void *job_device_thread(void *arg)
 {
 	RenderDevice *rd = arg;
 	ajar_renderer *r = rd->r;
-	pthread_mutex_lock(&r->lock);
+	int index = (int)(rd - r->devs);
+	double ended = -1; /* when its previous pass ended */
+	JobDone d;         /* the last answer, on its way while the next pass renders */
+	ClusterSend sending = {{0}, 0};
 	for (;;) {
-		while (!rd->job_has && !r->job_over)
-			pthread_cond_wait(&r->cond, &r->lock);
-		if (!rd->job_has)
+		JobCmd c;
+		if (cluster_recv(0, TAG_PASS + index, &c, sizeof c, NULL, &r->job_over, NULL) != 1)
+			break; /* the render is over (or MPI failed: the job ends) */
+		Range g = {c.first, c.count};
+		if (cluster_wait(&sending) != 1)
 			break;
-		Range g = rd->job_g;
-		pthread_mutex_unlock(&r->lock);
-		JobDone d;
 		memset(&d, 0, sizeof d);
 		int film_ok = 0;
+		double t0 = seconds();
+		d.idle = ended < 0 ? -1.0 : t0 - ended;
 		d.ok = rd->alive && run_pass(rd, g, &film_ok);
+		ended = seconds();
 		long *accum = NULL, *splat = NULL;
 		if (!d.ok && rd->alive) {
 			if (film_ok)
 				read_films(rd, &accum, &splat);
 			snprintf(d.error, sizeof d.error, "%s", rd->error);
 		} else if (!d.ok) {
-			snprintf(d.error, sizeof d.error, "device %u of rank %d was dropped before", rd->remote,
-				 cluster_rank());
+			snprintf(d.error, sizeof d.error, "device %d of rank %d was dropped before", index, cluster_rank());
 		}
-		pthread_mutex_lock(&r->lock);
 		if (!d.ok && rd->alive) {
+			pthread_mutex_lock(&r->lock);
 			d.kept = accum && salvage_add(r, accum, splat);
 			rd->alive = 0; /* its film is in the salvage, or lost: rank 0 renders those ranges again */
+			pthread_mutex_unlock(&r->lock);
 		}
-		rd->job_has = 0;
-		pthread_mutex_unlock(&r->lock);
 		free(accum);
 		free(splat);
-		cluster_send(0, TAG_DONE + (int)(rd - r->devs), &d, sizeof d);
-		pthread_mutex_lock(&r->lock);
+		if (cluster_post(0, TAG_DONE + index, &d, sizeof d, &sending) != 1)
+			break;
 	}
-	pthread_mutex_unlock(&r->lock);
+	cluster_wait(&sending);
 	return NULL;
 }
 
 static ajar_status job_serve(ajar_renderer *r)
 {
 	ajar_status st = AJAR_OK;
-	r->job_over = 0;
-	for (uint32_t i = 0; i < r->ndev; i++) {
+	atomic_store(&r->job_over, 0);
+	for (uint32_t i = 0; i < r->ndev && st == AJAR_OK; i++) {
 		RenderDevice *rd = &r->devs[i];
-		rd->job_has = 0;
 		rd->started = pthread_create(&rd->thread, NULL, job_device_thread, rd) == 0;
-		if (!rd->started)
-			rd->alive = 0;
+		if (!rd->started) {
+			st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "rank %d: cannot start a render thread", cluster_rank());
+			log_msg(AJAR_LOG_WARNING, "%s; the job stops", ajar_last_error());
+		}
 	}
-	for (;;) {
+	while (st == AJAR_OK) {
 		JobCmd c;
-		if (cluster_recv(0, TAG_CMD, &c, sizeof c, NULL, 1, NULL) != 1) {
+		if (cluster_recv(0, TAG_CMD, &c, sizeof c, NULL, NULL, NULL) != 1) {
 			st = AJAR_ERROR_DEVICE;
 			break;
 		}
@@ -1665,24 +1738,10 @@ static ajar_status job_serve(ajar_renderer *r)
 			st = (ajar_status)c.first;
 			break;
 		}
-		if (c.op == JOB_PASS) {
-			pthread_mutex_lock(&r->lock);
-			if (c.device < r->ndev && r->devs[c.device].started) {
-				RenderDevice *rd = &r->devs[c.device];
-				rd->job_g = (Range){c.first, c.count};
-				rd->job_has = 1;
-				pthread_cond_broadcast(&r->cond);
-				pthread_mutex_unlock(&r->lock);
-			} else {
-				pthread_mutex_unlock(&r->lock);
-				JobDone d = {0, 0, ""};
-				snprintf(d.error, sizeof d.error, "rank %d has no device %u", cluster_rank(), c.device);
-				cluster_send(0, TAG_DONE + (int)c.device, &d, sizeof d);
-			}
-		} else if (c.op == JOB_GATHER) {
+		if (c.op == JOB_GATHER) {
 			/* Rank 0 gathers only while no pass is in flight anywhere. */
 			size_t n = 3 * (size_t)r->width * r->height, ns = splat_count(r);
-			JobDone d = {1, 0, ""};
+			JobDone d = {1, 0, -1.0, ""};
 			if (reduce(r) != AJAR_OK) {
 				d.ok = 0;
 				snprintf(d.error, sizeof d.error, "%s", ajar_last_error());
@@ -1696,10 +1755,7 @@ static ajar_status job_serve(ajar_renderer *r)
 			}
 		}
 	}
-	pthread_mutex_lock(&r->lock);
-	r->job_over = 1;
-	pthread_cond_broadcast(&r->cond);
-	pthread_mutex_unlock(&r->lock);
+	atomic_store(&r->job_over, 1);
 	for (uint32_t i = 0; i < r->ndev; i++)
 		if (r->devs[i].started) {
 			pthread_join(r->devs[i].thread, NULL);
