@@ -1352,9 +1352,10 @@ static ajar_status resume_options(ajar_options *want, const ajar_options *o, con
  * Under mpirun every rank creates the same renderer on its own devices
  * (job_join checks they prepared the same scene and tells every rank of a
  * failure anywhere). Rank 0 adds one device per device of the other ranks
- * to its scheduler: such a device's pass (job_pass) sends the range to its
- * rank and waits for the answer, so its measured speed includes the trip,
- * and the dealing, the time limit, cancels and device failures are rank
+ * to its scheduler, each driven by a proxy thread (job_proxy_thread) that
+ * takes ranges with take_range like a device thread, sends them to that
+ * rank and counts them done when the answer comes: the dealing by measured
+ * speed, the time limit, cancels, checkpoints and device failures are rank
  * 0's, exactly as for its own devices. The other ranks serve (job_serve):
  * they render the ranges they are sent, and on a gather (at a checkpoint
  * and at the end) sum their films into rank 0's `remote` films with an MPI
@@ -1438,9 +1439,11 @@ static ajar_status job_join(ajar_renderer *r, ajar_status st)
 		r->devs = devs;
 		memset(devs + r->ndev, 0, sizeof *devs * (total - r->ndev));
 		size_t len = 0;
-		for (uint32_t i = 0; i < r->ndev; i++)
-			len += (size_t)snprintf(r->device_names + len, sizeof r->device_names - len, "%s%s (rank 0, %s)",
+		for (uint32_t i = 0; i < r->ndev; i++) {
+			snprintf(devs[i].dev.selector, sizeof devs[i].dev.selector, "rank 0, %s", all[0].selector[i]);
+			len += (size_t)snprintf(r->device_names + len, sizeof r->device_names - len, "%s%s (%s)",
 						i ? " + " : "", devs[i].dev.name, devs[i].dev.selector);
+		}
 		for (int k = 1; k < size; k++)
 			for (uint32_t j = 0; j < all[k].ndev; j++) {
 				RenderDevice *rd = &devs[r->ndev++];

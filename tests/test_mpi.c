@@ -5,7 +5,8 @@
  * root) and compares the job's last checkpoint, which holds the integer
  * films and the sample ranges, and its EXR with one process rendering the
  * same sample indices through the API: bit for bit, for pt and for portal
- * with strategy layers and AOVs; with --time (rank 0 stops the job); with a
+ * with strategy layers and AOVs; with --time (rank 0 stops the job) and
+ * resumed by a job; with a
  * device failing in rank 1 (dropped, its samples rendered again); with
  * rank 1 killed (the job stops with a message, writes no image, and its
  * checkpoint resumes in one process to the same bits). Each rank gets one
@@ -249,14 +250,15 @@ static void test_two_ranks_equal_one(void **state)
 }
 
 /* --time: rank 0 stops the job; the samples are [0, n) and the films
- * those of one process rendering n. */
+ * those of one process rendering n; resumed by a job, n + 8. */
 static void test_time_limit(void **state)
 {
 	(void)state;
 	skip_without_mpi();
+	W = H = 16; /* a second at 16x16 is already some 1500 spp */
 	char *ck1 = tmp("one.ck"), *ck2 = tmp("two.ck"), *exr = tmp("two.exr");
 	const char *args[] = {MPIRUN, "-n", "2", "env", "AJAR_TEST_PASS_SPP=2", "ajar", "render",
-			      SCENE("cornell/cornell.gltf"), "-o", exr, "--size", "32x32", "--time", "1", "--seed",
+			      SCENE("cornell/cornell.gltf"), "-o", exr, "--size", "16x16", "--time", "1", "--seed",
 			      "5", "--max-depth", "6", "--checkpoint", ck2, "-q", NULL};
 	int rc = run(args, NULL, NULL);
 	if (rc != 0)
@@ -267,6 +269,23 @@ static void test_time_limit(void **state)
 	same_films(ck1, ck2);
 	same_image(exr, want);
 	free(want);
+
+	/* Resumed by a job of two ranks (rank 0 reads the checkpoint, rank 1
+	 * gets the options from it), 8 samples further (--time is the total
+	 * budget: the first second is spent). */
+	char more[16];
+	snprintf(more, sizeof more, "%u", spp + 8);
+	const char *resume[] = {MPIRUN, "-n", "2", "env", "AJAR_TEST_PASS_SPP=2", "ajar", "render",
+				SCENE("cornell/cornell.gltf"), "-o", exr, "--resume", ck2, "--spp", more, "--time", "600", "-q", NULL};
+	rc = run(resume, NULL, NULL);
+	if (rc != 0)
+		fail_msg("resume: mpirun exit %d: %s", rc, stderr_text());
+	assert_int_equal(ckpt_spp(ck2), spp + 8);
+	want = one_process(SCENE("cornell/cornell.gltf"), AJAR_INTEGRATOR_PT, spp + 8, 0, 0, ck1);
+	same_films(ck1, ck2);
+	same_image(exr, want);
+	free(want);
+	W = H = 32;
 	unlink(ck1), unlink(ck2), unlink(exr);
 	free(ck1), free(ck2), free(exr);
 }
