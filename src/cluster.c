@@ -128,31 +128,6 @@ int cluster_send(int to, int tag, const void *buf, size_t bytes)
 	return wait_request(&rq, "MPI_Isend", NULL);
 }
 
-_Static_assert(sizeof(MPI_Request) <= sizeof(((ClusterSend *)0)->opaque), "MPI_Request fits ClusterSend");
-
-int cluster_post(int to, int tag, const void *buf, size_t bytes, ClusterSend *q)
-{
-	MPI_Request rq;
-	pthread_mutex_lock(&g_lock);
-	int rc = MPI_Isend(buf, (int)bytes, MPI_BYTE, to, tag, MPI_COMM_WORLD, &rq);
-	pthread_mutex_unlock(&g_lock);
-	q->active = rc == MPI_SUCCESS;
-	if (rc != MPI_SUCCESS)
-		return mpi_failed("MPI_Isend", rc);
-	memcpy(q->opaque, &rq, sizeof rq);
-	return 1;
-}
-
-int cluster_wait(ClusterSend *q)
-{
-	if (!q->active)
-		return 1;
-	MPI_Request rq;
-	memcpy(&rq, q->opaque, sizeof rq);
-	q->active = 0;
-	return wait_request(&rq, "MPI_Isend", NULL);
-}
-
 int cluster_recv(int from, int tag, void *buf, size_t bytes, int *tag_out, const atomic_int *stop,
 		 const atomic_int *cancel)
 {
@@ -253,16 +228,6 @@ int cluster_send(int to, int tag, const void *buf, size_t bytes)
 {
 	(void)to, (void)tag, (void)buf, (void)bytes;
 	return err_set(AJAR_ERROR_DEVICE, "built without MPI"), -1;
-}
-int cluster_post(int to, int tag, const void *buf, size_t bytes, ClusterSend *q)
-{
-	q->active = 0;
-	return cluster_send(to, tag, buf, bytes);
-}
-int cluster_wait(ClusterSend *q)
-{
-	(void)q;
-	return 1;
 }
 int cluster_recv(int from, int tag, void *buf, size_t bytes, int *tag_out, const atomic_int *stop,
 		 const atomic_int *cancel)

@@ -31,15 +31,6 @@ const char *cluster_host(void);
 
 /* Sends a small message (at most a few KiB) to rank `to`. */
 int cluster_send(int to, int tag, const void *buf, size_t bytes);
-/* The same without waiting for it to leave: buf must stay as it is until
- * cluster_wait(q) returns (a renderer thread goes on with its next pass
- * meanwhile). */
-typedef struct {
-	unsigned char opaque[16];
-	int active;
-} ClusterSend;
-int cluster_post(int to, int tag, const void *buf, size_t bytes, ClusterSend *q);
-int cluster_wait(ClusterSend *q);
 /* Receives the next message from `from` with tag `tag` (CLUSTER_ANY: any
  * tag; *tag_out says which) into buf (exactly `bytes`); returns 0 without
  * one once `stop` (if not NULL) is set. */
