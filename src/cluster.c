@@ -31,7 +31,10 @@ ajar_status ajar_mpi_init(int *argc, char ***argv)
 {
 	if (g_init || !launched())
 		return AJAR_OK;
-	int provided = 0, done = 0;
+	int provided = 0, done = 0, ended = 0;
+	MPI_Finalized(&ended);
+	if (ended)
+		return err_set(AJAR_ERROR_DEVICE, "MPI was finalised: it cannot be initialised again");
 	MPI_Initialized(&done);
 	if (!done && MPI_Init_thread(argc, argv, MPI_THREAD_SERIALIZED, &provided) != MPI_SUCCESS)
 		return err_set(AJAR_ERROR_DEVICE, "MPI_Init_thread failed");

@@ -12,7 +12,8 @@
  * calls serialised by one lock (MPI_THREAD_SERIALIZED). `cancel`, when not
  * NULL, bounds a wait: once it is set, a peer that does not answer within
  * CLUSTER_STOP_WAIT seconds is given up (it was killed or its machine
- * failed). The calls return 1 when done, 0 when given up, -1 on an MPI
+ * failed; generous, since a first pass may include a minute of the
+ * driver's compiling). The calls return 1 when done, 0 when given up, -1 on an MPI
  * error (message in ajar_last_error). */
 #ifndef AJAR_CLUSTER_H
 #define AJAR_CLUSTER_H
@@ -21,7 +22,7 @@
 
 #include "ajar.h"
 
-#define CLUSTER_STOP_WAIT 10.0
+#define CLUSTER_STOP_WAIT 60.0
 #define CLUSTER_ANY (-1)
 
 int cluster_rank(void);

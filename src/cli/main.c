@@ -403,13 +403,16 @@ static int cmd_render(int argc, char **argv)
 	const char *ckpt = a.checkpoint ? a.checkpoint : a.resume;
 	if (rank > 0)
 		ckpt = NULL; /* rank 0 writes the checkpoints, and reads the one resumed */
-	if (rank == 0 &&
-	    ((rc = check_output("-o", a.exr)) != EXIT_OK || (a.png && (rc = check_output("--png", a.png)) != EXIT_OK) ||
-	     (a.strategies && (rc = check_output("--strategies", a.strategies)) != EXIT_OK) ||
-	     (ckpt && (rc = check_output(a.checkpoint ? "--checkpoint" : "--resume", ckpt)) != EXIT_OK)))
-		;
-	else if (rank == 0 && a.resume)
-		rc = resume_options(&a);
+	if (rank == 0) {
+		if ((rc = check_output("-o", a.exr)) == EXIT_OK && a.png)
+			rc = check_output("--png", a.png);
+		if (rc == EXIT_OK && a.strategies)
+			rc = check_output("--strategies", a.strategies);
+		if (rc == EXIT_OK && ckpt)
+			rc = check_output(a.checkpoint ? "--checkpoint" : "--resume", ckpt);
+		if (rc == EXIT_OK && a.resume)
+			rc = resume_options(&a);
+	}
 	if (size == 1 && rc != EXIT_OK)
 		return rc;
 
@@ -673,6 +676,11 @@ int main(int argc, char **argv)
 			fprintf(stderr, "ajar: error: %s\n", ajar_last_error());
 			return EXIT_DEVICE;
 		}
+		const char *ranks = getenv("OMPI_COMM_WORLD_SIZE");
+		if (!ajar_mpi_available() && ranks && atoi(ranks) > 1)
+			fprintf(stderr, "ajar: warning: this ajar was built without Open MPI: each of the %d processes "
+					"mpirun started renders the whole image alone\n",
+				atoi(ranks));
 		int rc = cmd_render(argc - 2, argv + 2);
 		ajar_mpi_finalize();
 		return rc;
