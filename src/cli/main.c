@@ -103,7 +103,11 @@ static const char usage_render[] =
 	"\n"
 	"Ctrl-C (SIGINT) or SIGTERM stops after the current pass and writes the image so\n"
 	"far (exit code 5), and the checkpoint with --checkpoint; a second one ends the\n"
-	"program at once.\n";
+	"program at once.\n"
+	"\n"
+	"Under mpirun (Open MPI), every rank renders the same image on its own devices\n"
+	"(--device applies per rank); rank 0 deals the samples, prints the progress and\n"
+	"alone writes the files; the image is the same bits as one process.\n";
 
 /* ---- Errors ---------------------------------------------------------------- */
 
