@@ -1108,10 +1108,12 @@ static ajar_status checkpoint_gather(ajar_renderer *r, Checkpoint *c)
 	c->ranges = malloc(sizeof *c->ranges * (n ? n : 1));
 	if (!c->ranges)
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory for a checkpoint");
-	memcpy(c->ranges, r->base.r, sizeof *c->ranges * r->base.n);
+	if (r->base.n) /* memcpy from NULL is undefined even for 0 bytes (UBSan) */
+		memcpy(c->ranges, r->base.r, sizeof *c->ranges * r->base.n);
 	n = r->base.n;
 	for (uint32_t i = 0; i < r->ndev; i++) {
-		memcpy(c->ranges + n, r->devs[i].done.r, sizeof *c->ranges * r->devs[i].done.n);
+		if (r->devs[i].done.n)
+			memcpy(c->ranges + n, r->devs[i].done.r, sizeof *c->ranges * r->devs[i].done.n);
 		n += r->devs[i].done.n;
 	}
 	qsort(c->ranges, n, sizeof *c->ranges, range_before);
