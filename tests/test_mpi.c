@@ -9,7 +9,8 @@
  * resumed by a job; with a
  * device failing in rank 1 (dropped, its samples rendered again); with
  * rank 1 killed (the job stops with a message, writes no image, and its
- * checkpoint resumes in one process to the same bits). Each rank gets one
+ * checkpoint resumes in one process to the same bits); with rank 1 unable
+ * to start. Each rank gets one
  * PoCL thread. Skipped when the library was built without MPI. (That the
  * MPI-built program run alone is one process as before is what every
  * other test of the program checks.) */
@@ -383,6 +384,37 @@ static void test_rank_killed(void **state)
 	free(ck1), free(ck2), free(exr), free(pid);
 }
 
+/* A rank that cannot start stops every rank before anything renders, with
+ * a message naming it: no device matching its --device (exit 3), another
+ * scene than rank 0's (exit 2), a scene it cannot read (exit 2). */
+static void test_rank_cannot_start(void **state)
+{
+	(void)state;
+	skip_without_mpi();
+	char *exr = tmp("never.exr");
+	static const struct {
+		const char *scene, *device;
+		int rc;
+		const char *says;
+	} cases[] = {
+		{SCENE("cornell/cornell.gltf"), "no-such-device", 3, "rank 1 ("},
+		{SCENE("window-room/window-room.gltf"), "cpu", 2, "rank 1 ("},
+		{SCENE("no-such-scene.gltf"), "cpu", 2, "ajar: rank 1: error: "},
+	};
+	for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+		const char *args[] = {MPIRUN, "-n", "1", "ajar", "render", SCENE("cornell/cornell.gltf"), "-o", exr,
+				      "--size", "16x16", "--spp", "4", ":", "-n", "1", "ajar", "render", cases[k].scene,
+				      "-o", exr, "--size", "16x16", "--spp", "4", "--device", cases[k].device, NULL};
+		int rc = run(args, NULL, NULL);
+		char *e = stderr_text();
+		if (rc != cases[k].rc || !strstr(e, cases[k].says))
+			fail_msg("case %zu: exit %d (want %d), no '%s': %s", k, rc, cases[k].rc, cases[k].says, e);
+		free(e);
+		assert_false(exists(exr));
+	}
+	free(exr);
+}
+
 static int setup(void **state)
 {
 	(void)state;
@@ -408,6 +440,7 @@ int main(void)
 		cmocka_unit_test(test_time_limit),
 		cmocka_unit_test(test_device_fails_in_rank1),
 		cmocka_unit_test(test_rank_killed),
+		cmocka_unit_test(test_rank_cannot_start),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
 }
