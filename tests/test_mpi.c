@@ -6,14 +6,13 @@
  * films and the sample ranges, and its EXR with one process rendering the
  * same sample indices through the API: bit for bit, for pt and for portal
  * with strategy layers and AOVs; with --time (rank 0 stops the job) and
- * resumed by a job; with a
- * device failing in rank 1 (dropped, its samples rendered again); with
- * rank 1 killed (the job stops with a message, writes no image, and its
- * checkpoint resumes in one process to the same bits); with rank 1 unable
- * to start. Each rank gets one
- * PoCL thread. Skipped when the library was built without MPI. (That the
- * MPI-built program run alone is one process as before is what every
- * other test of the program checks.) */
+ * resumed by a job; with a device failing in rank 1 (dropped, its samples
+ * rendered again); with rank 1 killed (the job stops with a message,
+ * writes no image, and its checkpoint resumes in one process to the same
+ * bits); with rank 1 unable to start. Each rank gets one PoCL thread.
+ * Skipped when the library was built without MPI. (That the MPI-built
+ * program run alone is one process as before is what every other test of
+ * the program checks.) */
 #include <errno.h>
 #include <fcntl.h>
 #include <signal.h>
