@@ -321,7 +321,7 @@ ajar_status ajar_renderer_resume(const ajar_scene *scene, const char *path, cons
  * A program started by mpirun calls ajar_mpi_init first; every rank then
  * loads the same scene and makes the same calls with the same options:
  * ajar_renderer_create, ajar_renderer_resume and ajar_renderer_render are
- * collective. Each rank renders on its own devices (ajar_options.device
+ * collective (and ajar_renderer_restart is made on every rank). Each rank renders on its own devices (ajar_options.device
  * applies per rank); rank 0 deals the sample ranges to every device of
  * every rank by measured speed, decides when to stop (time limit, cancel)
  * and, once ajar_renderer_render returns, its renderer holds the whole
