@@ -763,7 +763,7 @@ static void device_shares(const ajar_renderer *r, char *buf, size_t cap)
 		len += (size_t)snprintf(buf + len, cap - len, "%s%s (%s): %.1f%% %.3g Msamples/s%s", i ? "; " : "",
 					s.name, s.selector, 100 * s.share, s.samples_per_second * 1e-6,
 					s.failed ? " (failed)" : "");
-		/* Another rank's device: what a range cost beyond its kernel there. */
+		/* Another rank's device: how long it waited there between its ranges. */
 		const RenderDevice *rd = &r->devs[i];
 		if (rd->job_ranges && len < cap)
 			len += (size_t)snprintf(buf + len, cap - len, ", idle %.2f ms between ranges (mean of %u)",
