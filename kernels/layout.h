@@ -47,5 +47,5 @@
 	X(PunctualLight, disk_radius)                                                  \
 	X(Params, num_portal_planes)                                                   \
 	X(PortalPlane, o) X(PortalPlane, a0) X(PortalPlane, t) X(PortalPlane, n)      \
-	X(PortalPlane, b1) X(PortalPlane, table)
+	X(PortalPlane, b1) X(PortalPlane, table) X(PortalPlane, guide)
 #endif

@@ -138,7 +138,8 @@ typedef struct {
 	V3 n;
 	float b1;
 	int table;
-	int pad0, pad1, pad2;
+	int guide; /* whether its table guides intermediate subpaths (env_portal.h, portal_guide_plane) */
+	int pad1, pad2;
 } PortalPlane; /* 80 */
 
 /* KHR_lights_punctual light (src/lights.c converts glTF's photometric
