@@ -632,8 +632,9 @@ INLINE float bsdf_glass_delta_prob(const Bsdf *bs, V3 wo, float eta, int reflect
 
 /* Returns 0 if no sample. For delta samples f is the lobe's weight (Fresnel
  * included) divided by |wi.n| (shading normal), so f |wi.n| / pdf_w is the
- * throughput; pdf_w and pdf_rev_w are then the probabilities of picking
- * that delta event from wo and from wi. */
+ * throughput (in a bent normal m, times |wl . m| / |wl . n| as every f, the
+ * top); pdf_w and pdf_rev_w are then the probabilities of picking that delta
+ * event from wo and from wi. */
 CALLED int bsdf_sample(const Bsdf *bs, V3 wo, float u0, float u1, float u2, int mode, BsdfSample *s)
 {
 	float so = bsdf_side(bs, wo);
