@@ -24,11 +24,15 @@ is not the bare sky within 1% everywhere), the median and worst block
 differences with the worst blocks' positions, the image means, and the
 noise (the two seeds' block difference, per renderer). Side-by-side PNGs
 (Ajar | Cycles | block map: green within ASSETS_TOL, red beyond) go to
-build/peers/assets/<name>-side.png. Exits 0: a report, not a gate.
+build/peers/assets/<name>-side.png. Exits 0: a report, not a gate. An entry "glass:<roughness>" renders a
+generated scene instead (write_glass_view): a faceted rough glass sphere on
+a grey floor, the check of Ajar's rough glass against Cycles' in a scene.
 """
 import json
+import math
 import os
 import shutil
+import struct
 import subprocess
 import sys
 
@@ -98,6 +102,71 @@ def write_view(name, out_dir, width, height):
 	sc.setdefault("extras", {})["environment"] = {"color": [1, 1, 1]}
 	path = os.path.join(out_dir, name + "-view.gltf")
 	json.dump(g, open(path, "w"), indent=1)
+	return path, yfov
+
+
+def write_glass_view(roughness, out_dir, width, height):
+	"""A generated scene (ASSETS_LIST entry "glass:<roughness>"): a faceted
+	glass sphere (KHR_materials_transmission 1, ior 1.5, white) of radius
+	0.5 resting on a grey plastic floor, a white sky, the same camera rule."""
+	import base64
+	nt, npp = 24, 48
+	pos, idx = [], []
+	for i in range(nt + 1):
+		for j in range(npp):
+			th, ph = math.pi * i / nt, 2 * math.pi * j / npp
+			pos.append((0.5 * math.sin(th) * math.cos(ph), 0.5 + 0.5 * math.cos(th), 0.5 * math.sin(th) * math.sin(ph)))
+	for i in range(nt):
+		for j in range(npp):
+			a, b = i * npp + j, i * npp + (j + 1) % npp
+			c, d = a + npp, b + npp
+			if i > 0:
+				idx += [a, b, c]
+			if i < nt - 1:
+				idx += [b, d, c]
+	floor = [(-2, 0, -2), (2, 0, -2), (2, 0, 2), (-2, 0, 2)]
+	fidx = [0, 2, 1, 0, 3, 2]
+	blob = b"".join(struct.pack("<3f", *p) for p in pos) + b"".join(struct.pack("<3f", *p) for p in floor)
+	off_i = len(blob)
+	blob += b"".join(struct.pack("<I", k) for k in idx) + b"".join(struct.pack("<I", k) for k in fidx)
+	lo = [min(p[k] for p in pos) for k in range(3)]
+	hi = [max(p[k] for p in pos) for k in range(3)]
+	n1, n2 = len(pos) * 12, len(floor) * 12
+	g = {"asset": {"version": "2.0"}, "extensionsUsed": ["KHR_materials_transmission", "KHR_materials_ior"],
+	     "scenes": [{"nodes": [0, 1]}], "nodes": [{"mesh": 0}, {"mesh": 1}],
+	     "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 2, "material": 0}]},
+			{"primitives": [{"attributes": {"POSITION": 1}, "indices": 3, "material": 1}]}],
+	     "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0,
+						      "roughnessFactor": roughness},
+			    "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1},
+					   "KHR_materials_ior": {"ior": 1.5}}},
+			   {"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0,
+						      "roughnessFactor": 0.5}, "doubleSided": True}],
+	     "buffers": [{"byteLength": len(blob),
+			  "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
+	     "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": n1},
+			     {"buffer": 0, "byteOffset": n1, "byteLength": n2},
+			     {"buffer": 0, "byteOffset": off_i, "byteLength": 4 * len(idx)},
+			     {"buffer": 0, "byteOffset": off_i + 4 * len(idx), "byteLength": 4 * len(fidx)}],
+	     "accessors": [{"bufferView": 0, "componentType": 5126, "count": len(pos), "type": "VEC3", "min": lo, "max": hi},
+			   {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-2, 0, -2],
+			    "max": [2, 0, 2]},
+			   {"bufferView": 2, "componentType": 5125, "count": len(idx), "type": "SCALAR"},
+			   {"bufferView": 3, "componentType": 5125, "count": len(fidx), "type": "SCALAR"}]}
+	os.makedirs(out_dir, exist_ok=True)
+	yfov, aspect = 0.5, width / height
+	c = [0.0, 0.5, 0.0]
+	dist = 0.5 + 0.75 / math.tan(yfov / 2)
+	g["cameras"] = [{"type": "perspective", "perspective": {"yfov": yfov, "aspectRatio": aspect, "znear": 0.01,
+								"zfar": 1000}}]
+	# Looking down 15 degrees at the sphere's centre.
+	e = math.radians(15)
+	g["nodes"].append({"camera": 0, "translation": [0, c[1] + dist * math.sin(e), dist * math.cos(e)],
+			   "rotation": [-math.sin(e / 2), 0, 0, math.cos(e / 2)]})
+	g["scenes"][0]["nodes"].append(2)
+	g["scenes"][0]["extras"] = {"environment": {"color": [1, 1, 1]}}
+	path = os.path.join(out_dir, "glass-view.gltf")
+	json.dump(g, open(path, "w"))
 	return path, yfov
 
 
@@ -200,11 +269,16 @@ def main():
 	driver.ensure_ajar()
 	report = []
 	for name in names:
-		g = json.load(open(os.path.join(driver.ROOT, "scenes", "khronos", name, name + ".gltf")))
-		lo, hi = bounds(g)
-		ext = hi - lo
-		height = int(round(width * min(max(ext[1] / max(ext[0], 1e-9), 0.5), 1.5) / BLOCK)) * BLOCK
-		path, yfov = write_view(name, os.path.join(base, name), width, height)
+		if name.startswith("glass:"):
+			height = width
+			path, yfov = write_glass_view(float(name[6:]), os.path.join(base, name.replace(":", "-")), width, height)
+			name = name.replace(":", "-")
+		else:
+			g = json.load(open(os.path.join(driver.ROOT, "scenes", "khronos", name, name + ".gltf")))
+			lo, hi = bounds(g)
+			ext = hi - lo
+			height = int(round(width * min(max(ext[1] / max(ext[0], 1e-9), 0.5), 1.5) / BLOCK)) * BLOCK
+			path, yfov = write_view(name, os.path.join(base, name), width, height)
 		imgs = {}
 		for r in ("ajar", "cycles"):
 			imgs[r] = []
