@@ -535,14 +535,14 @@ static void test_bend(void **state)
 
 /* Normal-mapped surfaces: a shading normal tilted 50 degrees from ng.
  * Chi-square of the sampling (which then samples in wo's bent normal)
- * against pdf_w, from a direction the normal faces away from, a grazing
- * one it faces, and an ordinary one; the adjoint relation and pdf_rev_w
- * over random pairs. */
+ * against pdf_w, from a direction the normal faces away from and a
+ * grazing one it faces; the adjoint relation and pdf_rev_w over random
+ * pairs. */
 static void test_bent_chi2(void **state)
 {
 	(void)state;
-	const int mi[] = {0, 1, 4, 7, 9};
-	const float wo_ea[][2] = {{10, 180}, {3, 20}, {45, 120}};
+	const int mi[] = {1, 4, 7, 9}; /* plastic, metal, glass, mix (they hold every lobe) */
+	const float wo_ea[][2] = {{10, 180}, {3, 20}};
 	int nm = (int)(sizeof(mi) / sizeof(mi[0])), nw = (int)(sizeof(wo_ea) / sizeof(wo_ea[0]));
 	double alpha_each = 1.0 - pow(1.0 - ALPHA_TOTAL, 1.0 / (nm * nw)), pmin = 1;
 	for (int i = 0; i < nm; i++) {
