@@ -191,7 +191,8 @@ INLINE void bsdf_setup_mr(Bsdf *bs, GLOBAL const Material *m, V3 base_color, flo
 	V3 n = ls > 0.0f ? v3_scale(ns, 1.0f / ls) : bs->ng;
 	if (!(v3_dot(n, n) > 0.5f))
 		n = bs->ng; /* NaN or infinite shading normal */
-	if (v3_dot(n, bs->ng) < 0.0f)
+	float cn = v3_dot(n, bs->ng);
+	if (cn < 0.0f)
 		n = v3_neg(n);
 	bs->n = n;
 	v3_basis(n, &bs->t, &bs->b);
@@ -202,9 +203,7 @@ INLINE void bsdf_setup_mr(Bsdf *bs, GLOBAL const Material *m, V3 base_color, flo
 	bs->transmission = bsdf_clamp01(m->transmission);
 	bs->ior = fmin(fmax(m->ior, BSDF_MIN_IOR), BSDF_MAX_IOR);
 	bs->specular = bsdf_clamp01(m->specular);
-	bs->flags = m->flags & ~BSDF_TILTED;
-	if (v3_dot(n, bs->ng) < BSDF_TILT_COS)
-		bs->flags |= BSDF_TILTED;
+	bs->flags = (m->flags & ~BSDF_TILTED) | (fabs(cn) < BSDF_TILT_COS ? BSDF_TILTED : 0);
 	bs->coat_s1 = bs->coat_sw = bs->coat_eavg = bs->metal_eavg = 0.0f;
 	bs->metal_fms = v3(0.0f, 0.0f, 0.0f);
 	if (bsdf_w_plastic(bs) > 0.0f && bs->specular > 0.0f) {
