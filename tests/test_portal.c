@@ -890,6 +890,58 @@ static void test_portal_rate(void **state)
 	unsetenv("AJAR_PORTAL_RATE");
 }
 
+/* Scenes lit by punctual lights without emitters (window-room-sun,
+ * window-room-lamp): light subpaths on, the sky's strategy set and rate
+ * (src/prepare.c); the guided <- direction never lost to a punctual light
+ * (guided_env_share): under the sun lamp and a constant sky every guided
+ * pick is a sky direction; and the direction density against its sampling
+ * (chi-square) there and in door-ajar with a sun, a point light and a spot
+ * beside its emitter, where the guided choice divides the emitters' shares
+ * by their part of the table. Prints the wasted intermediate subpaths. */
+static void test_punctual_choices(void **state)
+{
+	(void)state;
+	HostScene h;
+	const char *scenes[] = {SCENE("window-room-sun/window-room-sun.gltf"), SCENE("window-room-lamp/window-room-lamp.gltf")};
+	for (int i = 0; i < 2; i++) {
+		unsetenv("AJAR_PORTAL_SET");
+		unsetenv("AJAR_PORTAL_RATE");
+		host_scene_open(&h, scenes[i], NULL, 8, 8, INTEGRATOR_PORTAL, 8);
+		const Params *p = h.data.params;
+		int got[5] = {p->portal_s_max, p->portal_sp_max, p->portal_tp_max, p->portal_t_max, p->light_paths};
+		const int want[5] = {1, 2, 1, 3, 1};
+		for (int j = 0; j < 5; j++)
+			if (got[j] != want[j])
+				fail_msg("%s: strategy set field %d is %d, expected %d", scenes[i], j, got[j], want[j]);
+		assert_float_equal(p->portal_rate, 0.1f, 0.0f);
+		assert_true(p->num_lights == 1 && p->num_emitters == 0 && p->env_pdf_select > 0.0f &&
+			    p->env_pdf_select < 1.0f);
+		GLOBAL const PortalTri *pt = &h.view.portals[0];
+		V3 w0 = v3_scale(v3_add(pt->p0, v3_add(pt->p1, pt->p2)), 1.0f / 3.0f);
+		Rng rng = rng_init(9, (uint)i, 0, 0);
+		int lost = 0;
+		for (int k = 0; k < 10000; k++) {
+			V3 wl;
+			int genv;
+			float gdist, u = rng_f(&rng), u1 = rng_f(&rng), u2 = rng_f(&rng);
+			lost += !portal_guided_sample(&h.view, pt, w0, u, u1, u2, &wl, &genv, &gdist) || !genv;
+		}
+		if (lost)
+			fail_msg("%s: %d of 10000 guided directions lost", scenes[i], lost);
+		check_directions(&h, 0, 8, scenes[i]);
+		printf("  %s: wasted intermediate subpaths %.1f%%\n", scenes[i], 100 * wasted(&h, 20000));
+		host_scene_close(&h);
+	}
+	const float sun[3] = {-0.4f, -0.6f, 0.5f}, lp[3] = {2.0f, 2.0f, 6.0f}, lq[3] = {1.0f, 2.4f, 2.0f};
+	host_scene_open(&h, NULL, punctual_scene(SCENE("door-ajar/door-ajar.gltf"), sun, 1, lp, lq, 0), 8, 8,
+			INTEGRATOR_PORTAL, 8);
+	float ce;
+	assert_float_equal(guided_env_share(&h.view, &ce), 0.0f, 0.0f); /* no sky */
+	assert_true(ce > 0.0f && ce < 1.0f);
+	check_directions(&h, 0, 32, "door-ajar with a sun, a point light and a spot");
+	host_scene_close(&h);
+}
+
 static void test_wasted_fewer(void **state)
 {
 	(void)state;
@@ -917,6 +969,7 @@ int main(void)
 		cmocka_unit_test(test_directions_window_room),
 		cmocka_unit_test(test_directions_door_ajar),
 		cmocka_unit_test(test_wasted_fewer),
+		cmocka_unit_test(test_punctual_choices),
 		cmocka_unit_test(test_portal_set),
 		cmocka_unit_test(test_portal_rate),
 		cmocka_unit_test(test_mis_punctual),
