@@ -21,7 +21,19 @@ CPPFLAGS += -Iinclude -Isrc -MMD -MP
 CFLAGS += -std=c11 -D_GNU_SOURCE -ffp-contract=off $(WARN) $(MFLAGS) -fPIC
 CXXFLAGS += -std=c++14 $(WARN) $(MFLAGS) -fPIC
 LDFLAGS += $(MFLAGS)
-LDLIBS = $(PKG_LIBS) -lz -lm -lpthread
+LDLIBS = $(PKG_LIBS) $(MPI_LIBS) -lz -lm -lpthread
+
+# Open MPI (several machines, src/cluster.c): built in when found, unless
+# MPI=0. Only cluster.c is compiled with its flags (and AJAR_MPI); without
+# it the library is built exactly as before, with one rank.
+# Found through pkg-config (ompi-c), else through Open MPI's compiler wrapper.
+MPI_PC := $(shell pkg-config --exists ompi-c 2>/dev/null && echo y)
+MPI_CC := $(if $(MPI_PC),,$(shell command -v mpicc 2>/dev/null))
+MPI ?= $(if $(MPI_PC)$(MPI_CC),1,0)
+ifeq ($(MPI),1)
+MPI_CFLAGS := $(if $(MPI_PC),$(shell pkg-config --cflags ompi-c),$(shell mpicc --showme:compile)) -DAJAR_MPI
+MPI_LIBS := $(if $(MPI_PC),$(shell pkg-config --libs ompi-c),$(shell mpicc --showme:link))
+endif
 
 LIB_C := $(wildcard src/*.c)
 LIB_CXX := $(wildcard src/*.cpp)
@@ -53,8 +65,9 @@ DEPS_test_integrators := $(BUILD)/libajar.a
 DEPS_test_traversal := $(BUILD)/libajar.a
 DEPS_test_checkpoint := $(BUILD)/libajar.a
 DEPS_test_aov := $(BUILD)/libajar.a
+DEPS_test_mpi := $(BUILD)/libajar.a
 
-.PHONY: all lib cli tests test test-unit asan demo bench bench-peers install uninstall clean deps help
+.PHONY: FORCE all lib cli tests test test-unit asan demo bench bench-peers install uninstall clean deps help
 all: lib cli
 
 help:
@@ -91,6 +104,18 @@ $(BUILD)/src/%.o: src/%.c
 	@mkdir -p $(@D)
 	@echo "  CC      $<"
 	$(Q)$(CC) $(CPPFLAGS) $(PKG_CFLAGS) $(CFLAGS) -c -o $@ $<
+
+# With or without MPI: mpi.flag changes when MPI does, and cluster.o is rebuilt.
+$(BUILD)/src/cluster.o: src/cluster.c $(BUILD)/mpi.flag
+	@mkdir -p $(@D)
+	@echo "  CC      $< (MPI=$(MPI))"
+	$(Q)$(CC) $(CPPFLAGS) $(MPI_CFLAGS) $(CFLAGS) -c -o $@ $<
+
+$(BUILD)/mpi.flag: FORCE
+	@mkdir -p $(@D)
+	$(Q)echo '$(MPI) $(MPI_CFLAGS) $(MPI_LIBS)' | cmp -s - $@ || echo '$(MPI) $(MPI_CFLAGS) $(MPI_LIBS)' > $@
+
+FORCE:
 
 $(BUILD)/src/%.o: src/%.cpp
 	@mkdir -p $(@D)
@@ -189,7 +214,8 @@ install: all
 	$(Q)ln -sf libajar.so.$(AJAR_VERSION) $(INSTALL_LIB)/libajar.so.0
 	$(Q)ln -sf libajar.so.0 $(INSTALL_LIB)/libajar.so
 	$(Q)install -m 644 include/ajar.h $(DESTDIR)$(PREFIX)/include/ajar.h
-	$(Q)sed -e 's|@PREFIX@|$(PREFIX)|g' -e 's|@VERSION@|$(AJAR_VERSION)|g' src/ajar.pc.in \
+	$(Q)sed -e 's|@PREFIX@|$(PREFIX)|g' -e 's|@VERSION@|$(AJAR_VERSION)|g' \
+		-e 's|@MPI@|$(if $(filter 1,$(MPI)),$(if $(MPI_PC), ompi-c,),)|g' src/ajar.pc.in \
 		> $(INSTALL_LIB)/pkgconfig/ajar.pc
 
 uninstall:

@@ -317,6 +317,33 @@ ajar_status ajar_checkpoint_options(const char *path, ajar_options *o, uint32_t 
 ajar_status ajar_renderer_resume(const ajar_scene *scene, const char *path, const ajar_options *o,
 				 ajar_renderer **out);
 
+/* ---- Several machines (Open MPI) ---------------------------------------------
+ * A program started by mpirun calls ajar_mpi_init first; every rank then
+ * loads the same scene and makes the same calls with the same options:
+ * ajar_renderer_create, ajar_renderer_resume and ajar_renderer_render are
+ * collective (and ajar_renderer_restart is made on every rank). Each rank renders on its own devices (ajar_options.device
+ * applies per rank); rank 0 deals the sample ranges to every device of
+ * every rank by measured speed, decides when to stop (time limit, cancel)
+ * and, once ajar_renderer_render returns, its renderer holds the whole
+ * job's image, strategy layers, AOVs and statistics (the integer films of
+ * every rank summed): the same bits as one process on the same kind of
+ * device. Only rank 0 writes files; a resumed job reads the checkpoint on
+ * rank 0 only. The other ranks' renderers hold nothing to write. */
+
+/* 1 if the library was built with Open MPI. */
+int ajar_mpi_available(void);
+/* Initialises MPI when the process was started by mpirun (else, or
+ * without MPI built in, does nothing: one rank). */
+ajar_status ajar_mpi_init(int *argc, char ***argv);
+/* This rank (0 alone) and the number of ranks (1 alone). */
+int ajar_mpi_rank(void);
+int ajar_mpi_size(void);
+/* Collective: every rank passes its code (0: fine); returns the first
+ * non-zero code in rank order, the same on every rank. */
+int ajar_mpi_agree(int code);
+/* Ends MPI if ajar_mpi_init started it. */
+void ajar_mpi_finalize(void);
+
 #ifdef __cplusplus
 }
 #endif

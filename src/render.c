@@ -30,6 +30,7 @@
 #include <time.h>
 
 #include "checkpoint.h"
+#include "cluster.h"
 #include "device.h"
 #include "error.h"
 #include "exr.h"
@@ -73,6 +74,10 @@ typedef struct RenderDevice {
 	int started;              /* thread is running this render */
 	int fail_pass, fail_mode; /* the test hook */
 	uint32_t attempts;        /* passes started, for the test hook */
+	int rank;                 /* on rank 0: the rank this device renders on (0: here) */
+	uint32_t remote;          /* its index there; see "Several machines" */
+	uint32_t job_ranges;      /* on rank 0, for a device of another rank: passes after its first, */
+	double job_idle;          /* and the seconds it waited for them there (dealing, messages) */
 	/* Under the renderer's lock: */
 	int alive, reported;
 	RangeList done;      /* ranges its film holds */
@@ -117,6 +122,10 @@ struct ajar_renderer {
 	int hashed;
 	uint64_t scene_hash, params_hash;
 	uint32_t pass_cap; /* test hook AJAR_TEST_PASS_SPP: at most this many samples per pass */
+	/* Several machines (Open MPI, see the section at the end): */
+	long *remote, *remote_splat; /* rank 0: the other ranks' films, summed at the last gather */
+	int job_lost;                /* rank 0: a rank that stopped answering, or 0 */
+	atomic_int job_over;         /* other ranks: the render is over (device threads end) */
 };
 
 static double seconds(void)
@@ -349,6 +358,7 @@ static ajar_status open_devices(ajar_renderer *r, const char *selector)
 	return AJAR_OK;
 }
 
+static ajar_status job_join(ajar_renderer *r, ajar_status st);
 static ajar_status checkpoint_check(ajar_renderer *r, const Checkpoint *c, const char *path);
 static ajar_status checkpoint_apply(ajar_renderer *r, Checkpoint *c, const char *path);
 
@@ -413,9 +423,13 @@ static ajar_status renderer_new(const ajar_scene *scene, const ajar_options *opt
 	}
 	if (ck && (st = checkpoint_apply(r, ck, ck_path)) != AJAR_OK)
 		goto fail;
+	if ((st = job_join(r, AJAR_OK)) != AJAR_OK)
+		goto joined;
 	*out = r;
 	return AJAR_OK;
 fail:
+	st = job_join(r, st); /* the other ranks learn of it, and this rank of theirs */
+joined:
 	ajar_renderer_destroy(&r);
 	return st;
 }
@@ -438,6 +452,8 @@ void ajar_renderer_destroy(ajar_renderer **rp)
 	free(r->film_splat);
 	free(r->salvage);
 	free(r->salvage_splat);
+	free(r->remote);
+	free(r->remote_splat);
 	free(r->holes.r);
 	free(r->base.r);
 	free(r->ckpt_path);
@@ -456,7 +472,9 @@ ajar_status ajar_renderer_restart(ajar_renderer *r, uint32_t seed)
 	for (uint32_t k = 0; k < r->ndev; k++) {
 		RenderDevice *rd = &r->devs[k];
 		Device *d = &rd->dev;
-		if (!rd->alive)
+		rd->done.n = 0;
+		rd->spp_kept = 0;
+		if (!rd->alive || rd->rank)
 			continue;
 		cl_mem params = rd->bufs.mem[rd->bufs.count - 1]; /* last in AJAR_SCENE_BUFFERS */
 		CL_TRY(d, clEnqueueWriteBuffer(d->queue, params, CL_TRUE, 0, sizeof(Params), r->data.params, 0, NULL,
@@ -464,12 +482,12 @@ ajar_status ajar_renderer_restart(ajar_renderer *r, uint32_t seed)
 		CL_TRY(d, clEnqueueFillBuffer(d->queue, rd->accum, &zero, sizeof zero, 0, film_bytes(r), 0, NULL, NULL));
 		CL_TRY(d, clEnqueueFillBuffer(d->queue, rd->splat, &zero, sizeof zero, 0, splat_bytes(r), 0, NULL, NULL));
 		CL_TRY(d, clFinish(d->queue));
-		rd->done.n = 0;
-		rd->spp_kept = 0;
 	}
 	free(r->salvage);
 	free(r->salvage_splat);
-	r->salvage = r->salvage_splat = NULL;
+	free(r->remote);
+	free(r->remote_splat);
+	r->salvage = r->salvage_splat = r->remote = r->remote_splat = NULL;
 	r->holes.n = 0;
 	r->base.n = 0;
 	r->seed = seed;
@@ -538,7 +556,7 @@ static uint64_t work_left(const ajar_renderer *r)
 /* The stop conditions other than running out of work. */
 static int stopping(const ajar_renderer *r)
 {
-	return atomic_load(&r->cancel) || r->out_of_memory || time_left(r) <= 0;
+	return atomic_load(&r->cancel) || r->out_of_memory || r->job_lost || time_left(r) <= 0;
 }
 
 /* The next range for device rd, or 0 if there is none now. */
@@ -663,9 +681,11 @@ static int salvage_add(ajar_renderer *r, const long *accum, const long *splat)
 
 /* Drops rd after its pass g failed (under the lock): g goes back to the
  * pool, and so do its completed ranges unless its film was read back. */
-static void drop_device(ajar_renderer *r, RenderDevice *rd, Range g, const long *accum, const long *splat)
+static void drop_device(ajar_renderer *r, RenderDevice *rd, Range g, const long *accum, const long *splat,
+			int kept_there)
 {
-	int kept = accum && salvage_add(r, accum, splat);
+	/* kept_there: a device of another rank whose film that rank kept. */
+	int kept = kept_there || (accum && salvage_add(r, accum, splat));
 	rd->alive = 0;
 	r->last_dropped = rd;
 	if (!ranges_push(&r->holes, g))
@@ -718,7 +738,7 @@ static void *device_thread(void *arg)
 			rd->per_spp = dt / g.count;
 			r->spp_done += g.count;
 		} else {
-			drop_device(r, rd, g, accum, splat);
+			drop_device(r, rd, g, accum, splat, 0);
 		}
 		free(accum);
 		free(splat);
@@ -743,6 +763,11 @@ static void device_shares(const ajar_renderer *r, char *buf, size_t cap)
 		len += (size_t)snprintf(buf + len, cap - len, "%s%s (%s): %.1f%% %.3g Msamples/s%s", i ? "; " : "",
 					s.name, s.selector, 100 * s.share, s.samples_per_second * 1e-6,
 					s.failed ? " (failed)" : "");
+		/* Another rank's device: how long it waited there between its ranges. */
+		const RenderDevice *rd = &r->devs[i];
+		if (rd->job_ranges && len < cap)
+			len += (size_t)snprintf(buf + len, cap - len, ", idle %.2f ms between ranges (mean of %u)",
+						1e3 * rd->job_idle / rd->job_ranges, rd->job_ranges);
 	}
 }
 
@@ -796,17 +821,33 @@ static int report_drops(ajar_renderer *r)
 
 static void checkpoint_during(ajar_renderer *r);
 
+static ajar_status render_run(ajar_renderer *r, ajar_progress_fn fn, void *user);
+static ajar_status job_serve(ajar_renderer *r);
+static ajar_status job_end(ajar_renderer *r, ajar_status st);
+
 ajar_status ajar_renderer_render(ajar_renderer *r, ajar_progress_fn fn, void *user)
 {
 	if (!r)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_render: renderer is NULL");
+	if (cluster_size() > 1 && cluster_rank() > 0)
+		return job_serve(r); /* rank 0 deals, this rank's devices render */
+	ajar_status st = render_run(r, fn, user);
+	return cluster_size() > 1 ? job_end(r, st) : st;
+}
+
+static void *job_proxy_thread(void *arg);
+
+static ajar_status render_run(ajar_renderer *r, ajar_progress_fn fn, void *user)
+{
 	pthread_mutex_lock(&r->lock);
 	r->t0 = seconds() - r->elapsed;
 	r->ckpt_last = seconds();
 	r->running = 0;
 	for (uint32_t i = 0; i < r->ndev; i++) {
 		RenderDevice *rd = &r->devs[i];
-		rd->started = rd->alive && pthread_create(&rd->thread, NULL, device_thread, rd) == 0;
+		/* A device of another rank is driven by a proxy thread (see "Several machines"). */
+		rd->started = rd->alive && pthread_create(&rd->thread, NULL, rd->rank ? job_proxy_thread : device_thread,
+							  rd) == 0;
 		r->running += (uint32_t)rd->started;
 	}
 	if (r->running == 0 && r->last_dropped != NULL) {
@@ -937,6 +978,9 @@ static ajar_status reduce(ajar_renderer *r)
 {
 	size_t n = 3 * (size_t)r->width * r->height, ns = splat_count(r);
 	long *sum = r->film, *sum_splat = r->film_splat;
+	if (r->job_lost)
+		return err_set(AJAR_ERROR_DEVICE, "a rank of the job stopped answering: the films of the job cannot be "
+						  "summed (a checkpoint written before is kept)");
 	if (r->salvage) {
 		memcpy(sum, r->salvage, n * sizeof *sum);
 		memcpy(sum_splat, r->salvage_splat, ns * sizeof *sum_splat);
@@ -944,11 +988,17 @@ static ajar_status reduce(ajar_renderer *r)
 		memset(sum, 0, n * sizeof *sum);
 		memset(sum_splat, 0, ns * sizeof *sum_splat);
 	}
+	if (r->remote) { /* rank 0: what the other ranks rendered */
+		for (size_t i = 0; i < n; i++)
+			sum[i] += r->remote[i];
+		for (size_t i = 0; i < ns; i++)
+			sum_splat[i] += r->remote_splat[i];
+	}
 	/* Integer sums first, scaled once: the same bits whatever the device count. */
 	for (uint32_t k = 0; k < r->ndev; k++) {
 		RenderDevice *rd = &r->devs[k];
 		long *a, *s;
-		if (!rd->alive)
+		if (!rd->alive || rd->rank) /* another rank's films are in r->remote */
 			continue;
 		if (!read_films(rd, &a, &s))
 			return err_set(AJAR_ERROR_DEVICE, "OpenCL device %s: reading the film back failed",
@@ -1058,10 +1108,12 @@ static ajar_status checkpoint_gather(ajar_renderer *r, Checkpoint *c)
 	c->ranges = malloc(sizeof *c->ranges * (n ? n : 1));
 	if (!c->ranges)
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory for a checkpoint");
-	memcpy(c->ranges, r->base.r, sizeof *c->ranges * r->base.n);
+	if (r->base.n) /* memcpy from NULL is undefined even for 0 bytes (UBSan) */
+		memcpy(c->ranges, r->base.r, sizeof *c->ranges * r->base.n);
 	n = r->base.n;
 	for (uint32_t i = 0; i < r->ndev; i++) {
-		memcpy(c->ranges + n, r->devs[i].done.r, sizeof *c->ranges * r->devs[i].done.n);
+		if (r->devs[i].done.n)
+			memcpy(c->ranges + n, r->devs[i].done.r, sizeof *c->ranges * r->devs[i].done.n);
 		n += r->devs[i].done.n;
 	}
 	qsort(c->ranges, n, sizeof *c->ranges, range_before);
@@ -1111,6 +1163,8 @@ ajar_status ajar_renderer_write_checkpoint(ajar_renderer *r, const char *path)
  * sums the films, lets the devices go on and writes the file meanwhile
  * (the sums are the main thread's own arrays). A failed write keeps the
  * previous file. */
+static ajar_status job_gather(ajar_renderer *r);
+
 static void checkpoint_during(ajar_renderer *r)
 {
 	r->pausing = 1;
@@ -1119,7 +1173,10 @@ static void checkpoint_during(ajar_renderer *r)
 	pthread_mutex_unlock(&r->lock);
 	r->elapsed = seconds() - r->t0;
 	Checkpoint c;
-	ajar_status st = checkpoint_gather(r, &c);
+	memset(&c, 0, sizeof c);
+	ajar_status st = cluster_size() > 1 ? job_gather(r) : AJAR_OK;
+	if (st == AJAR_OK)
+		st = checkpoint_gather(r, &c);
 	pthread_mutex_lock(&r->lock);
 	r->pausing = 0;
 	pthread_cond_broadcast(&r->cond);
@@ -1235,6 +1292,10 @@ static ajar_status checkpoint_apply(ajar_renderer *r, Checkpoint *c, const char 
 	return AJAR_OK;
 }
 
+static ajar_status resume_options(ajar_options *want, const ajar_options *o, const char *path);
+static ajar_status job_resume(const ajar_scene *scene, const char *path, const ajar_options *o,
+			      ajar_renderer **out);
+
 ajar_status ajar_renderer_resume(const ajar_scene *scene, const char *path, const ajar_options *o,
 				 ajar_renderer **out)
 {
@@ -1243,36 +1304,484 @@ ajar_status ajar_renderer_resume(const ajar_scene *scene, const char *path, cons
 	*out = NULL;
 	if (!scene || !path)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_resume: NULL argument");
+	if (cluster_size() > 1)
+		return job_resume(scene, path, o, out);
 	Checkpoint c;
 	ajar_status st = checkpoint_read(path, &c, 0);
 	if (st != AJAR_OK)
 		return st;
 	ajar_options want;
 	options_from_checkpoint(&c, &want);
+	if ((st = resume_options(&want, o, path)) != AJAR_OK) {
+		checkpoint_free(&c);
+		return st;
+	}
+	st = renderer_new(scene, &want, &c, path, out);
+	checkpoint_free(&c);
+	return st;
+}
+
+/* The options of a resumed render: the checkpoint's (want), with the
+ * budget and the devices of o if o is not NULL; anything else in o must
+ * agree with the checkpoint. */
+static ajar_status resume_options(ajar_options *want, const ajar_options *o, const char *path)
+{
 	if (o) {
 		/* Only the budget and the devices may change. */
-		const char *differs = o->width != want.width || o->height != want.height ? "width/height"
-				      : o->integrator != want.integrator			 ? "integrator"
-				      : o->max_depth != want.max_depth			 ? "max_depth"
-				      : o->min_depth != want.min_depth			 ? "min_depth"
-				      : o->seed != want.seed				 ? "seed"
-				      : o->mis != want.mis				 ? "mis"
-				      : o->strategy_len != want.strategy_len		 ? "strategy_len"
-				      : o->strategy_unweighted != want.strategy_unweighted ? "strategy_unweighted"
-				      : o->aov != want.aov				 ? "aov"
+		const char *differs = o->width != want->width || o->height != want->height ? "width/height"
+				      : o->integrator != want->integrator			 ? "integrator"
+				      : o->max_depth != want->max_depth			 ? "max_depth"
+				      : o->min_depth != want->min_depth			 ? "min_depth"
+				      : o->seed != want->seed				 ? "seed"
+				      : o->mis != want->mis				 ? "mis"
+				      : o->strategy_len != want->strategy_len		 ? "strategy_len"
+				      : o->strategy_unweighted != want->strategy_unweighted ? "strategy_unweighted"
+				      : o->aov != want->aov				 ? "aov"
 											   : NULL;
-		if (differs) {
-			checkpoint_free(&c);
+		if (differs)
 			return err_set(AJAR_ERROR_INVALID_ARGUMENT,
 				       "%s: options.%s differs from the checkpoint's (only spp, time_limit and device "
 				       "may change when resuming)",
 				       path, differs);
-		}
-		want.spp = o->spp;
-		want.time_limit = o->time_limit;
-		want.device = o->device;
+		want->spp = o->spp;
+		want->time_limit = o->time_limit;
+		want->device = o->device;
 	}
-	st = renderer_new(scene, &want, &c, path, out);
-	checkpoint_free(&c);
+	return AJAR_OK;
+}
+
+/* ---- Several machines (Open MPI) --------------------------------------------
+ * Under mpirun every rank creates the same renderer on its own devices
+ * (job_join checks they prepared the same scene and tells every rank of a
+ * failure anywhere). Rank 0 adds one device per device of the other ranks
+ * to its scheduler, each driven by a proxy thread (job_proxy_thread) that
+ * takes ranges with take_range like a device thread, sends them to that
+ * rank and counts them done when the answer comes: the dealing by measured
+ * speed, the time limit, cancels, checkpoints and device failures are rank
+ * 0's, exactly as for its own devices. The other ranks serve (job_serve):
+ * they render the ranges they are sent, and on a gather (at a checkpoint
+ * and at the end) sum their films into rank 0's `remote` films with an MPI
+ * reduction. Every sum is of integers, so the image is the same bits as
+ * one process that rendered the same sample indices. A device that fails
+ * on another rank is dropped like a local one (that rank keeps its film
+ * when it can, as the salvage does here). A rank that stops answering
+ * (killed; mpirun then stops the whole job) cannot be summed: the render
+ * ends with an error and nothing but the last checkpoint is kept. */
+
+enum { JOB_PASS = 1, JOB_GATHER, JOB_END };
+/* TAG_PASS, TAG_DONE and TAG_WHY + the device's index on its rank */
+enum { TAG_CMD = 1, TAG_GATHERED = 2, TAG_GATHER_WHY = 3, TAG_PASS = 1000, TAG_DONE = 2000, TAG_WHY = 3000 };
+
+typedef struct {
+	uint32_t op, device, first, count; /* JOB_END: `first` is rank 0's status */
+} JobCmd; /* TAG_CMD, and TAG_PASS + device straight to the device's thread */
+
+/* Kept small: Open MPI's shared-memory transport delivers a message of a
+ * few dozen bytes at once, while one of a KiB waited for the receiver's
+ * next poll (measured: 6 ms of a device's idle time per range, 0.02 ms
+ * with this size). A failure's message follows as a JobWhy. */
+typedef struct {
+	int32_t ok, kept; /* the pass rendered; else whether the rank kept the film */
+	double idle;      /* seconds the device waited for this range since its previous one ended (-1: first) */
+} JobDone;
+
+typedef struct {
+	char text[1024];
+} JobWhy;
+
+typedef struct {
+	int32_t status;
+	uint32_t ndev, width, height;
+	uint64_t scene_hash, params_hash;
+	char host[64];
+	char error[1024];
+	char name[MAX_RENDER_DEVICES][256];
+	char selector[MAX_RENDER_DEVICES][16];
+} JobHello;
+
+static ajar_status job_join(ajar_renderer *r, ajar_status st)
+{
+	int size = cluster_size(), me = cluster_rank();
+	if (size <= 1)
+		return st;
+	JobHello *all = calloc((size_t)size + 1, sizeof *all), *mine = all + size;
+	if (!all)
+		return st != AJAR_OK ? st : err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory");
+	mine->status = (int32_t)st;
+	snprintf(mine->host, sizeof mine->host, "%s", cluster_host());
+	if (st != AJAR_OK) {
+		snprintf(mine->error, sizeof mine->error, "%s", ajar_last_error());
+	} else {
+		ensure_hashes(r);
+		mine->scene_hash = r->scene_hash;
+		mine->params_hash = r->params_hash;
+		mine->width = r->width;
+		mine->height = r->height;
+		mine->ndev = r->ndev;
+		for (uint32_t i = 0; i < r->ndev; i++) {
+			snprintf(mine->name[i], sizeof mine->name[i], "%.255s", r->devs[i].dev.name);
+			snprintf(mine->selector[i], sizeof mine->selector[i], "%.15s", r->devs[i].dev.selector);
+		}
+	}
+	if (cluster_allgather(mine, all, sizeof *mine, NULL) != 1) {
+		free(all);
+		return st != AJAR_OK ? st : AJAR_ERROR_DEVICE;
+	}
+	for (int k = 0; k < size && st == AJAR_OK; k++)
+		if (all[k].status != AJAR_OK)
+			st = err_set((ajar_status)all[k].status, "rank %d (%s): %s", k, all[k].host, all[k].error);
+	for (int k = 1; k < size && st == AJAR_OK; k++)
+		if (all[k].scene_hash != all[0].scene_hash || all[k].params_hash != all[0].params_hash ||
+		    all[k].width != all[0].width || all[k].height != all[0].height)
+			st = err_set(AJAR_ERROR_BAD_INPUT,
+				     "rank %d (%s) prepared another scene or other options than rank 0 (%s): every rank "
+				     "must read the same scene files with the same options",
+				     k, all[k].host, all[0].host);
+	uint32_t total = r->ndev;
+	for (int k = 1; k < size; k++)
+		total += all[k].ndev;
+	RenderDevice *devs = st == AJAR_OK && me == 0 ? realloc(r->devs, sizeof *devs * total) : NULL;
+	if (st == AJAR_OK && me == 0 && !devs)
+		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory");
+	if (st == AJAR_OK && me == 0) {
+		/* Rank 0 deals to every device of every rank. */
+		r->devs = devs;
+		memset(devs + r->ndev, 0, sizeof *devs * (total - r->ndev));
+		size_t len = 0;
+		for (uint32_t i = 0; i < r->ndev; i++) {
+			snprintf(devs[i].dev.selector, sizeof devs[i].dev.selector, "rank 0, %s", all[0].selector[i]);
+			len += (size_t)snprintf(r->device_names + len, sizeof r->device_names - len, "%s%s (%s)",
+						i ? " + " : "", devs[i].dev.name, devs[i].dev.selector);
+		}
+		for (int k = 1; k < size; k++)
+			for (uint32_t j = 0; j < all[k].ndev; j++) {
+				RenderDevice *rd = &devs[r->ndev++];
+				rd->r = r;
+				rd->alive = 1;
+				rd->rank = k;
+				rd->remote = j;
+				snprintf(rd->dev.name, sizeof rd->dev.name, "%s", all[k].name[j]);
+				snprintf(rd->dev.selector, sizeof rd->dev.selector, "rank %d, %s", k % 100000, all[k].selector[j]);
+				if (len < sizeof r->device_names)
+					len += (size_t)snprintf(r->device_names + len, sizeof r->device_names - len, " + %s (%s)",
+								rd->dev.name, rd->dev.selector);
+			}
+	}
+	free(all);
+	return st;
+}
+
+/* Rank 0: the options of a resumed job come from the checkpoint, read
+ * here only; the other ranks receive them (they need no copy of the file). */
+static ajar_status job_resume(const ajar_scene *scene, const char *path, const ajar_options *o,
+			      ajar_renderer **out)
+{
+	struct {
+		int32_t status;
+		char error[1024];
+		ajar_options want;
+	} msg;
+	memset(&msg, 0, sizeof msg);
+	Checkpoint c;
+	int have = 0;
+	ajar_status st = AJAR_OK;
+	if (cluster_rank() == 0) {
+		st = checkpoint_read(path, &c, 0);
+		have = st == AJAR_OK;
+		if (have) {
+			options_from_checkpoint(&c, &msg.want);
+			st = resume_options(&msg.want, o, path);
+		}
+		msg.status = (int32_t)st;
+		if (st != AJAR_OK)
+			snprintf(msg.error, sizeof msg.error, "%s", ajar_last_error());
+		msg.want.device = NULL;
+	}
+	if (cluster_bcast(&msg, sizeof msg, NULL) != 1) {
+		if (have)
+			checkpoint_free(&c);
+		return AJAR_ERROR_DEVICE;
+	}
+	msg.want.device = o ? o->device : NULL;
+	if (msg.status != AJAR_OK) {
+		if (have)
+			checkpoint_free(&c);
+		return cluster_rank() == 0 ? st : err_set((ajar_status)msg.status, "rank 0: %s", msg.error);
+	}
+	st = renderer_new(scene, &msg.want, have ? &c : NULL, have ? path : NULL, out);
+	if (have)
+		checkpoint_free(&c);
+	return st;
+}
+
+/* Rank 0: the thread of a device of another rank. It keeps two ranges
+ * there (PIPELINE): the device starts the next as soon as it ends one, so
+ * the messages' latency is hidden. The speed is measured from one end of
+ * a pass to the next (or from the send, when the device was idle). A
+ * failure there comes back with whether the rank kept the device's film;
+ * the range queued behind it comes back unrendered. */
+#define PIPELINE 2
+
+static void *job_proxy_thread(void *arg)
+{
+	RenderDevice *rd = arg;
+	ajar_renderer *r = rd->r;
+	Range q[PIPELINE];
+	double sent[PIPELINE], last = 0;
+	int nq = 0, tag_pass = TAG_PASS + (int)rd->remote, tag_done = TAG_DONE + (int)rd->remote,
+	    tag_why = TAG_WHY + (int)rd->remote;
+	pthread_mutex_lock(&r->lock);
+	for (;;) {
+		int lost = 0;
+		while (nq < PIPELINE && !r->pausing && take_range(r, rd, &q[nq])) {
+			r->in_flight++;
+			JobCmd c = {JOB_PASS, rd->remote, q[nq].first, q[nq].count};
+			pthread_mutex_unlock(&r->lock);
+			lost = cluster_send(rd->rank, tag_pass, &c, sizeof c) != 1;
+			sent[nq++] = seconds();
+			pthread_mutex_lock(&r->lock);
+			if (lost)
+				break;
+		}
+		if (nq == 0) {
+			if (!r->pausing && (r->in_flight == 0 || stopping(r)))
+				break;
+			pthread_cond_wait(&r->cond, &r->lock); /* a checkpoint, or a range may come back */
+			continue;
+		}
+		pthread_mutex_unlock(&r->lock);
+		JobDone d;
+		int rc = lost ? -1 : cluster_recv(rd->rank, tag_done, &d, sizeof d, NULL, NULL, &r->cancel);
+		double t = seconds(), start = fmax(sent[0], last);
+		pthread_mutex_lock(&r->lock);
+		Range g = q[0];
+		for (int k = 1; k < nq; k++)
+			q[k - 1] = q[k], sent[k - 1] = sent[k];
+		nq--;
+		r->in_flight--;
+		r->events++;
+		if (rc == 1 && d.ok) {
+			if (!ranges_push(&rd->done, g))
+				r->out_of_memory = 1;
+			rd->spp_kept += g.count;
+			rd->busy_seconds += t - start;
+			rd->per_spp = (t - start) / g.count;
+			r->spp_done += g.count;
+			if (d.idle >= 0) {
+				rd->job_ranges++;
+				rd->job_idle += d.idle;
+			}
+			last = t;
+			pthread_cond_broadcast(&r->cond);
+			continue;
+		}
+		if (rc == 1) {
+			JobWhy why = {"?"};
+			pthread_mutex_unlock(&r->lock);
+			rc = cluster_recv(rd->rank, tag_why, &why, sizeof why, NULL, NULL, &r->cancel);
+			pthread_mutex_lock(&r->lock);
+			why.text[sizeof why.text - 1] = '\0';
+			snprintf(rd->error, sizeof rd->error, "%s", why.text);
+		}
+		if (rc != 1) {
+			snprintf(rd->error, sizeof rd->error, "rank %d stopped answering%s%s", rd->rank,
+				 rc < 0 ? ": " : " (killed, or its machine failed)", rc < 0 ? ajar_last_error() : "");
+			if (!r->job_lost)
+				r->job_lost = rd->rank;
+		}
+		drop_device(r, rd, g, NULL, NULL, rc == 1 && d.kept);
+		for (int k = 0; k < nq; k++) { /* queued there, never rendered */
+			if (!ranges_push(&r->holes, q[k]))
+				r->out_of_memory = 1;
+			r->in_flight--;
+		}
+		if (rc == 1 && nq) { /* their answers, so no message is left behind */
+			pthread_mutex_unlock(&r->lock);
+			JobWhy why;
+			for (int k = 0; k < nq; k++)
+				if (cluster_recv(rd->rank, tag_done, &d, sizeof d, NULL, NULL, &r->cancel) == 1 && !d.ok)
+					cluster_recv(rd->rank, tag_why, &why, sizeof why, NULL, NULL, &r->cancel);
+			pthread_mutex_lock(&r->lock);
+		}
+		pthread_cond_broadcast(&r->cond);
+		break;
+	}
+	r->running--;
+	pthread_cond_broadcast(&r->cond);
+	pthread_mutex_unlock(&r->lock);
+	return NULL;
+}
+
+/* Rank 0: the other ranks' films summed into r->remote. */
+static ajar_status job_gather(ajar_renderer *r)
+{
+	size_t n = 3 * (size_t)r->width * r->height, ns = splat_count(r);
+	if (!r->remote) {
+		r->remote = calloc(n ? n : 1, sizeof *r->remote);
+		r->remote_splat = calloc(ns ? ns : 1, sizeof *r->remote_splat);
+		if (!r->remote || !r->remote_splat)
+			return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory for the other ranks' films");
+	}
+	memset(r->remote, 0, n * sizeof *r->remote);
+	memset(r->remote_splat, 0, ns * sizeof *r->remote_splat);
+	JobCmd c = {JOB_GATHER, 0, 0, 0};
+	int rc = 1;
+	for (int k = 1; k < cluster_size() && rc == 1; k++)
+		rc = cluster_send(k, TAG_CMD, &c, sizeof c);
+	if (rc == 1)
+		rc = cluster_sum(r->remote, n, &r->cancel);
+	if (rc == 1)
+		rc = cluster_sum(r->remote_splat, ns, &r->cancel);
+	/* Each rank says whether its films could be read. */
+	for (int k = 1; k < cluster_size() && rc == 1; k++) {
+		JobDone d;
+		JobWhy why = {"?"};
+		rc = cluster_recv(k, TAG_GATHERED, &d, sizeof d, NULL, NULL, &r->cancel);
+		if (rc == 1 && !d.ok) {
+			cluster_recv(k, TAG_GATHER_WHY, &why, sizeof why, NULL, NULL, &r->cancel);
+			why.text[sizeof why.text - 1] = '\0';
+			memset(r->remote, 0, n * sizeof *r->remote);
+			return err_set(AJAR_ERROR_DEVICE, "rank %d: %s", k, why.text);
+		}
+	}
+	if (rc == 1)
+		return AJAR_OK;
+	if (rc == 0)
+		r->job_lost = -1;
+	/* The films are incomplete: nothing may be written from them. */
+	memset(r->remote, 0, n * sizeof *r->remote);
+	return err_set(AJAR_ERROR_DEVICE, "summing the other ranks' films failed: %s",
+		       rc < 0 ? ajar_last_error() : "a rank stopped answering (killed, or its machine failed)");
+}
+
+/* Rank 0, after its render loop: the last gather, and the other ranks
+ * told to stop. */
+static ajar_status job_end(ajar_renderer *r, ajar_status st)
+{
+	if (r->job_lost) {
+		/* No reduction can complete: mpirun ends the job. */
+		char why[1024] = "";
+		for (uint32_t i = 0; i < r->ndev; i++)
+			if (r->devs[i].rank == r->job_lost)
+				snprintf(why, sizeof why, "%s", r->devs[i].error);
+		free(r->remote);
+		free(r->remote_splat);
+		r->remote = r->remote_splat = NULL;
+		return err_set(AJAR_ERROR_DEVICE,
+			       "%s; the job cannot be finished: no image is written%s", why[0] ? why : "a rank stopped answering",
+			       r->ckpt_path ? " and the last checkpoint is kept" : "");
+	}
+	char msg[1024];
+	snprintf(msg, sizeof msg, "%s", ajar_last_error());
+	ajar_status g = job_gather(r);
+	JobCmd c = {JOB_END, 0, (uint32_t)st, 0};
+	for (int k = 1; k < cluster_size() && g == AJAR_OK; k++)
+		if (cluster_send(k, TAG_CMD, &c, sizeof c) != 1)
+			g = AJAR_ERROR_DEVICE;
+	if (g != AJAR_OK) {
+		free(r->remote);
+		free(r->remote_splat);
+		r->remote = r->remote_splat = NULL;
+		r->job_lost = -1;
+		return err_set(AJAR_ERROR_DEVICE, "%s; the job cannot be finished: no image is written%s",
+			       ajar_last_error(), r->ckpt_path ? " and the last checkpoint is kept" : "");
+	}
+	if (st != AJAR_OK)
+		err_set(st, "%s", msg);
+	return st;
+}
+
+/* Other ranks: one thread per device renders the ranges rank 0 sends it
+ * (straight to the thread: one wake-up less per range than through the
+ * main thread). */
+static void *job_device_thread(void *arg)
+{
+	RenderDevice *rd = arg;
+	ajar_renderer *r = rd->r;
+	int index = (int)(rd - r->devs);
+	double ended = -1; /* when its previous pass ended */
+	for (;;) {
+		JobCmd c;
+		if (cluster_recv(0, TAG_PASS + index, &c, sizeof c, NULL, &r->job_over, NULL) != 1)
+			break; /* the render is over (or MPI failed: the job ends) */
+		Range g = {c.first, c.count};
+		JobDone d = {0, 0, -1.0};
+		JobWhy why;
+		memset(&why, 0, sizeof why);
+		int film_ok = 0;
+		double t0 = seconds();
+		d.idle = ended < 0 ? -1.0 : t0 - ended;
+		d.ok = rd->alive && run_pass(rd, g, &film_ok);
+		ended = seconds();
+		long *accum = NULL, *splat = NULL;
+		if (!d.ok && rd->alive) {
+			if (film_ok)
+				read_films(rd, &accum, &splat);
+			snprintf(why.text, sizeof why.text, "%s", rd->error);
+		} else if (!d.ok) {
+			snprintf(why.text, sizeof why.text, "device %d of rank %d was dropped before", index, cluster_rank());
+		}
+		if (!d.ok && rd->alive) {
+			pthread_mutex_lock(&r->lock);
+			d.kept = accum && salvage_add(r, accum, splat);
+			rd->alive = 0; /* its film is in the salvage, or lost: rank 0 renders those ranges again */
+			pthread_mutex_unlock(&r->lock);
+		}
+		free(accum);
+		free(splat);
+		if (cluster_send(0, TAG_DONE + index, &d, sizeof d) != 1 ||
+		    (!d.ok && cluster_send(0, TAG_WHY + index, &why, sizeof why) != 1))
+			break;
+	}
+	return NULL;
+}
+
+static ajar_status job_serve(ajar_renderer *r)
+{
+	ajar_status st = AJAR_OK;
+	atomic_store(&r->job_over, 0);
+	for (uint32_t i = 0; i < r->ndev && st == AJAR_OK; i++) {
+		RenderDevice *rd = &r->devs[i];
+		rd->started = pthread_create(&rd->thread, NULL, job_device_thread, rd) == 0;
+		if (!rd->started) {
+			st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "rank %d: cannot start a render thread", cluster_rank());
+			log_msg(AJAR_LOG_WARNING, "%s; the job stops", ajar_last_error());
+		}
+	}
+	while (st == AJAR_OK) {
+		JobCmd c;
+		if (cluster_recv(0, TAG_CMD, &c, sizeof c, NULL, NULL, NULL) != 1) {
+			st = AJAR_ERROR_DEVICE;
+			break;
+		}
+		if (c.op == JOB_END) {
+			st = (ajar_status)c.first;
+			break;
+		}
+		if (c.op == JOB_GATHER) {
+			/* Rank 0 gathers only while no pass is in flight anywhere. */
+			size_t n = 3 * (size_t)r->width * r->height, ns = splat_count(r);
+			JobDone d = {1, 0, -1.0};
+			JobWhy why = {""};
+			if (reduce(r) != AJAR_OK) {
+				d.ok = 0;
+				snprintf(why.text, sizeof why.text, "%s", ajar_last_error());
+				memset(r->film, 0, n * sizeof *r->film);
+				memset(r->film_splat, 0, ns * sizeof *r->film_splat);
+			}
+			if (cluster_sum(r->film, n, NULL) != 1 || cluster_sum(r->film_splat, ns, NULL) != 1 ||
+			    cluster_send(0, TAG_GATHERED, &d, sizeof d) != 1 ||
+			    (!d.ok && cluster_send(0, TAG_GATHER_WHY, &why, sizeof why) != 1)) {
+				st = AJAR_ERROR_DEVICE;
+				break;
+			}
+		}
+	}
+	atomic_store(&r->job_over, 1);
+	for (uint32_t i = 0; i < r->ndev; i++)
+		if (r->devs[i].started) {
+			pthread_join(r->devs[i].thread, NULL);
+			r->devs[i].started = 0;
+		}
 	return st;
 }

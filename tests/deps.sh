@@ -1,22 +1,33 @@
 #!/bin/sh
 # Installs the Debian packages Ajar needs when they are missing (as root), or
 # prints the exact command to run. Used by `make demo`, `make test`, CI.
+# OPTIONAL (Open MPI, for one render on several machines) is installed as
+# root like the rest; without root its absence is only reported: `make`
+# then builds Ajar with one rank and test_mpi is skipped.
 PKGS="make gcc g++ pkg-config pocl-opencl-icd ocl-icd-opencl-dev opencl-headers \
 libopenexr-dev libtinygltf-dev libstb-dev libcmocka-dev"
+OPTIONAL="libopenmpi-dev openmpi-bin"
 missing=""
+optional=""
 for p in $PKGS; do
 	dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
 done
-[ -z "$missing" ] && exit 0
+for p in $OPTIONAL; do
+	dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || optional="$optional $p"
+done
+[ -z "$missing$optional" ] && exit 0
 if [ "$(id -u)" = 0 ]; then
-	echo "Installing missing packages:$missing"
+	echo "Installing missing packages:$missing$optional"
 	export DEBIAN_FRONTEND=noninteractive
-	apt-get update -qq && apt-get install -y -qq --no-install-recommends $missing >/dev/null || {
-		echo "apt-get failed; run: apt-get install$missing" >&2
+	apt-get update -qq && apt-get install -y -qq --no-install-recommends $missing $optional >/dev/null || {
+		echo "apt-get failed; run: apt-get install$missing$optional" >&2
 		exit 1
 	}
-else
-	echo "Missing packages:$missing" >&2
-	echo "Run: sudo apt-get install$missing" >&2
+elif [ -n "$missing" ]; then
+	echo "Missing packages:$missing$optional" >&2
+	echo "Run: sudo apt-get install$missing$optional" >&2
 	exit 1
+else
+	echo "Open MPI is not installed: Ajar is built for one machine and test_mpi is skipped" >&2
+	echo "(for several machines: sudo apt-get install$optional)" >&2
 fi

@@ -8,6 +8,7 @@
  * every failure ends with one `ajar: error: ...` line and a documented exit
  * code (see usage_main). */
 #include <errno.h>
+#include <fcntl.h>
 #include <libgen.h>
 #include <math.h>
 #include <signal.h>
@@ -21,6 +22,10 @@
 #include "ajar.h"
 #include "args.h"
 #include "progress.h"
+
+/* Under mpirun (ajar_mpi_init): "ajar: " on rank 0, "ajar: rank N (host): "
+ * elsewhere, so a message from another machine says where it came from. */
+static char g_prefix[128] = "ajar: ";
 
 /* More OpenCL devices than any machine we know of has. */
 #define MAX_DEVICES 256
@@ -98,7 +103,11 @@ static const char usage_render[] =
 	"\n"
 	"Ctrl-C (SIGINT) or SIGTERM stops after the current pass and writes the image so\n"
 	"far (exit code 5), and the checkpoint with --checkpoint; a second one ends the\n"
-	"program at once.\n";
+	"program at once.\n"
+	"\n"
+	"Under mpirun (Open MPI), every rank renders the same image on its own devices\n"
+	"(--device applies per rank); rank 0 deals the samples, prints the progress and\n"
+	"alone writes the files; the image is the same bits as one process.\n";
 
 /* ---- Errors ---------------------------------------------------------------- */
 
@@ -124,9 +133,9 @@ static void report(ajar_status st, const char *file)
 	if (!msg[0])
 		msg = ajar_status_name(st);
 	if (file && !strstr(msg, file))
-		fprintf(stderr, "ajar: error: %s: %s\n", file, msg);
+		fprintf(stderr, "%serror: %s: %s\n", g_prefix, file, msg);
 	else
-		fprintf(stderr, "ajar: error: %s\n", msg);
+		fprintf(stderr, "%serror: %s\n", g_prefix, msg);
 }
 
 /* Loads a scene; a scene that cannot be read is bad input (exit 2) even
@@ -212,7 +221,7 @@ static void on_log(ajar_log_level level, const char *message, void *user)
 	if (level != AJAR_LOG_WARNING || progress->quiet)
 		return;
 	progress_break_line(progress);
-	fprintf(stderr, "ajar: warning: %s\n", message);
+	fprintf(stderr, "%swarning: %s\n", g_prefix, message);
 }
 
 static int on_progress(const ajar_progress *p, void *user)
@@ -357,22 +366,58 @@ static void print_device_shares(const ajar_renderer *r)
 	}
 }
 
+/* Under mpirun every rank runs this with the same arguments: rank 0 checks
+ * the outputs, reads a checkpoint, prints and writes; every rank loads the
+ * scene and renders on its own devices (ajar.h, "Several machines"); a
+ * failure on any rank before the render is agreed on (ajar_mpi_agree), so
+ * every rank stops with the same exit code. */
 static int cmd_render(int argc, char **argv)
 {
 	RenderArgs a;
+	int rank = ajar_mpi_rank(), size = ajar_mpi_size();
+	if (size > 1 && rank > 0)
+		snprintf(g_prefix, sizeof g_prefix, "ajar: rank %d: ", rank);
+	/* Rank 0 alone prints usage errors and help (every rank parses the same). */
+	int saved[2] = {-1, -1};
+	if (rank > 0) {
+		fflush(NULL);
+		int null = open("/dev/null", O_WRONLY);
+		for (int f = 0; f < 2 && null >= 0; f++)
+			if ((saved[f] = dup(f + 1)) >= 0)
+				dup2(null, f + 1);
+		if (null >= 0)
+			close(null);
+	}
 	int rc = args_parse_render(argc, argv, &a);
+	if (rank > 0) {
+		fflush(NULL);
+		for (int f = 0; f < 2; f++)
+			if (saved[f] >= 0) {
+				dup2(saved[f], f + 1);
+				close(saved[f]);
+			}
+	}
 	if (rc != EXIT_OK)
 		return rc;
 	if (a.help) {
-		fputs(usage_render, stdout);
+		if (rank == 0)
+			fputs(usage_render, stdout);
 		return EXIT_OK;
 	}
 	const char *ckpt = a.checkpoint ? a.checkpoint : a.resume;
-	if ((rc = check_output("-o", a.exr)) != EXIT_OK || (a.png && (rc = check_output("--png", a.png)) != EXIT_OK) ||
-	    (a.strategies && (rc = check_output("--strategies", a.strategies)) != EXIT_OK) ||
-	    (ckpt && (rc = check_output(a.checkpoint ? "--checkpoint" : "--resume", ckpt)) != EXIT_OK))
-		return rc;
-	if (a.resume && (rc = resume_options(&a)) != EXIT_OK)
+	if (rank > 0)
+		ckpt = NULL; /* rank 0 writes the checkpoints, and reads the one resumed */
+	if (rank == 0) {
+		if ((rc = check_output("-o", a.exr)) == EXIT_OK && a.png)
+			rc = check_output("--png", a.png);
+		if (rc == EXIT_OK && a.strategies)
+			rc = check_output("--strategies", a.strategies);
+		if (rc == EXIT_OK && ckpt)
+			rc = check_output(a.checkpoint ? "--checkpoint" : "--resume", ckpt);
+		if (rc == EXIT_OK && a.resume)
+			rc = resume_options(&a);
+	}
+	if (size == 1 && rc != EXIT_OK)
 		return rc;
 
 	Progress progress;
@@ -382,24 +427,36 @@ static int cmd_render(int argc, char **argv)
 
 	ajar_scene *scene = NULL;
 	ajar_renderer *r = NULL;
-	if ((rc = load_scene(a.scene, a.allow_outside_files, &scene)) != EXIT_OK)
-		goto done;
-	if (g_interrupted) {
+	if (rc == EXIT_OK)
+		rc = load_scene(a.scene, a.allow_outside_files, &scene);
+	if (rc == EXIT_OK && g_interrupted)
 		rc = interrupted_early();
+	if (size > 1)
+		rc = ajar_mpi_agree(rc);
+	if (rc != EXIT_OK)
 		goto done;
-	}
 	ajar_status st = a.resume ? ajar_renderer_resume(scene, a.resume, &a.opt, &r)
 				  : ajar_renderer_create(scene, &a.opt, &r);
 	if (st == AJAR_OK && ckpt)
 		st = ajar_renderer_set_checkpoint(r, ckpt, a.checkpoint_every);
 	if (st != AJAR_OK) {
-		report(st, NULL);
+		if (rank == 0) /* its message names the rank that failed */
+			report(st, NULL);
 		rc = exit_code(st);
 		goto done;
 	}
 	atomic_store(&g_renderer, r);
 	if (g_interrupted) {
-		rc = interrupted_early();
+		if (size == 1) {
+			rc = interrupted_early();
+			goto done;
+		}
+		ajar_renderer_cancel(r); /* the other ranks wait for rank 0's render: end it at once */
+	}
+	if (rank > 0) {
+		/* Renders what rank 0 deals until it ends the job. */
+		st = ajar_renderer_render(r, NULL, NULL);
+		rc = exit_code(st);
 		goto done;
 	}
 	if (!a.quiet) {
@@ -413,8 +470,11 @@ static int cmd_render(int argc, char **argv)
 		char from[64] = "";
 		if (a.resume)
 			snprintf(from, sizeof from, " from %u spp", ajar_renderer_spp(r));
-		fprintf(stderr, "ajar: %s %s with %s (%s%s) on %s\n", a.resume ? "resuming" : "rendering", a.scene,
-			args_integrator_name(a.opt.integrator), budget, from, device ? device : "?");
+		char ranks[32] = "";
+		if (size > 1)
+			snprintf(ranks, sizeof ranks, "%d ranks: ", size);
+		fprintf(stderr, "ajar: %s %s with %s (%s%s) on %s%s\n", a.resume ? "resuming" : "rendering", a.scene,
+			args_integrator_name(a.opt.integrator), budget, from, ranks, device ? device : "?");
 	}
 
 	st = ajar_renderer_render(r, on_progress, &progress);
@@ -424,7 +484,12 @@ static int cmd_render(int argc, char **argv)
 		/* A device failure keeps what the others rendered. */
 		if (ckpt && spp > 0 && st == AJAR_ERROR_DEVICE) {
 			char *msg = strdup(ajar_last_error());
-			final_checkpoint(r, &a, ckpt);
+			/* Under mpirun a rank lost leaves films that cannot be summed:
+			 * then the checkpoint written during the render stays. */
+			if (size == 1)
+				final_checkpoint(r, &a, ckpt);
+			else if (ajar_renderer_write_checkpoint(r, ckpt) == AJAR_OK && !a.quiet)
+				fprintf(stderr, "ajar: checkpoint %s holds %u spp\n", ckpt, spp);
 			if (msg)
 				fprintf(stderr, "ajar: error: %s\n", msg);
 			free(msg);
@@ -608,8 +673,22 @@ int main(int argc, char **argv)
 		printf("ajar %s\n", ajar_version());
 		return EXIT_OK;
 	}
-	if (!strcmp(cmd, "render"))
-		return cmd_render(argc - 2, argv + 2);
+	if (!strcmp(cmd, "render")) {
+		/* Started by mpirun: one rank of a job (else nothing happens). */
+		ajar_status st = ajar_mpi_init(&argc, &argv);
+		if (st != AJAR_OK) {
+			fprintf(stderr, "ajar: error: %s\n", ajar_last_error());
+			return EXIT_DEVICE;
+		}
+		const char *ranks = getenv("OMPI_COMM_WORLD_SIZE");
+		if (!ajar_mpi_available() && ranks && atoi(ranks) > 1)
+			fprintf(stderr, "ajar: warning: this ajar was built without Open MPI: each of the %d processes "
+					"mpirun started renders the whole image alone\n",
+				atoi(ranks));
+		int rc = cmd_render(argc - 2, argv + 2);
+		ajar_mpi_finalize();
+		return rc;
+	}
 	if (!strcmp(cmd, "devices"))
 		return cmd_devices(argc - 2, argv + 2);
 	if (!strcmp(cmd, "info"))
