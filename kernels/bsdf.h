@@ -37,8 +37,28 @@
  * Frames: reflection is two-sided: the frame is flipped to the side of wo as
  * the geometric normal ng sees it. Reflection needs wo, wi on the same side of
  * ng, transmission on opposite sides (no light leaks through shading
- * normals); both must also lie on the right side of the shading normal n, or
- * the BSDF is 0. Glass's outside (ior on the far side) is the side ng points to.
+ * normals). Glass's outside (ior on the far side) is the side ng points to.
+ *
+ * Shading normals that face away: where the shading normal n (interpolated
+ * or normal-mapped) differs from ng, a direction above ng can lie below n,
+ * or mirror about n to below ng; a BSDF that is 0 there paints black rims.
+ * As Cycles (ensure_valid_reflection) the normal is then turned toward ng,
+ * along the arc from n to ng, just far enough that the direction's mirror
+ * image lies above ng (by min(0.9 cos, 0.01)): bsdf_bend_t. The BSDF of a
+ * vertex is the one in the normal its camera-side direction needs: wo's in
+ * radiance mode, wi's in importance mode, so f_radiance(wo, wi) =
+ * f_importance(wi, wo) holds and a vertex has the same BSDF whichever
+ * subpath made it. Sampling from wo uses wo's normal; pdf_w is that density
+ * and pdf_rev_w the one from wi in wi's normal. Camera walks therefore
+ * sample exactly the support of what they evaluate (unbiased alone, and
+ * glossy lobes sample their peak); a light walk may not reach every
+ * direction its f covers, and MIS gives those paths to the other
+ * strategies (their pdf for it is 0). Integrators weigh by |wi . n| (and,
+ * on light subpaths, Veach's correction with n, vertex.h); f is returned
+ * multiplied by |wl . m| / |wl . n|, wl the direction toward the light (wi
+ * in radiance mode, wo in importance mode), so their products are those of
+ * the bent normal m. Where n equals ng (flat shading) none of this runs.
+ * Delta lobes reflect about wo's normal in both modes.
  *
  * E1, Es and G come from bsdf_tables.h (src/tools/bsdf_tables.c integrates
  * them from microfacet.h at build time), bilinear in sqrt(alpha) and
@@ -65,6 +85,8 @@
 #define BSDF_MIN_ALPHA 1e-3f   /* the plastic coat's alpha floor */
 #define BSDF_MIN_IOR 1.01f     /* eta = 1 makes the refraction half vector vanish */
 #define BSDF_MAX_IOR 4.0f
+#define BSDF_TILTED (1 << 30)  /* in Bsdf.flags: n differs from ng, normals may bend (the top) */
+#define BSDF_TILT_COS 0.99999f /* n . ng below this counts as tilted */
 
 typedef struct {
 	V3 t, b, n;      /* shading frame, n on the side of ng */
@@ -169,7 +191,8 @@ INLINE void bsdf_setup_mr(Bsdf *bs, GLOBAL const Material *m, V3 base_color, flo
 	V3 n = ls > 0.0f ? v3_scale(ns, 1.0f / ls) : bs->ng;
 	if (!(v3_dot(n, n) > 0.5f))
 		n = bs->ng; /* NaN or infinite shading normal */
-	if (v3_dot(n, bs->ng) < 0.0f)
+	float cn = v3_dot(n, bs->ng);
+	if (cn < 0.0f)
 		n = v3_neg(n);
 	bs->n = n;
 	v3_basis(n, &bs->t, &bs->b);
@@ -180,7 +203,7 @@ INLINE void bsdf_setup_mr(Bsdf *bs, GLOBAL const Material *m, V3 base_color, flo
 	bs->transmission = bsdf_clamp01(m->transmission);
 	bs->ior = fmin(fmax(m->ior, BSDF_MIN_IOR), BSDF_MAX_IOR);
 	bs->specular = bsdf_clamp01(m->specular);
-	bs->flags = m->flags;
+	bs->flags = (m->flags & ~BSDF_TILTED) | (fabs(cn) < BSDF_TILT_COS ? BSDF_TILTED : 0);
 	bs->coat_s1 = bs->coat_sw = bs->coat_eavg = bs->metal_eavg = 0.0f;
 	bs->metal_fms = v3(0.0f, 0.0f, 0.0f);
 	if (bsdf_w_plastic(bs) > 0.0f && bs->specular > 0.0f) {
@@ -338,15 +361,87 @@ INLINE BsdfLobes bsdf_lobes(const Bsdf *bs, float cos_o, float eta)
 	return p;
 }
 
-/* Local coordinates of w in the frame flipped by `side` (+-1). */
-INLINE V3 bsdf_local(const Bsdf *bs, V3 w, float side)
+/* A shading frame: the Bsdf's own, or a bent one (bsdf_bend_t). */
+typedef struct {
+	V3 t, b, n;
+} BsdfFrame;
+
+INLINE BsdfFrame bsdf_frame_own(const Bsdf *bs)
 {
-	return v3(v3_dot(w, bs->t), v3_dot(w, bs->b), side * v3_dot(w, bs->n));
+	BsdfFrame f;
+	f.t = bs->t;
+	f.b = bs->b;
+	f.n = bs->n;
+	return f;
 }
 
-INLINE V3 bsdf_world(const Bsdf *bs, V3 w, float side)
+/* The tilt of n from ng: *x the unit direction of n's component along the
+ * surface; returns the angle tn between n and ng, n = sin tn x + cos tn ng.
+ * Bent normals are kept as their angle from ng: a cosine rounds small
+ * angles (1e-4) to 0. */
+INLINE float bsdf_tilt(const Bsdf *bs, V3 *x)
 {
-	return v3_from_local(v3(w.x, w.y, side * w.z), bs->t, bs->b, bs->n);
+	float nz = v3_dot(bs->n, bs->ng);
+	V3 d = v3_madd(bs->n, bs->ng, -nz);
+	float l = v3_len(d);
+	*x = l > 0.0f ? v3_scale(d, 1.0f / l) : bs->t;
+	return atan2(l, fmax(nz, 0.0f));
+}
+
+/* The angle from ng of the normal that direction w needs, on the arc from
+ * n (angle tn, tilt direction x) to ng: tn where w's mirror image about n
+ * lies at least thr = min(0.9 |w . ng|, 0.01) above the surface (w's own
+ * side), else the normal whose mirror image lies at exactly thr. With w =
+ * (ix, iz) in (x, ng) (w's y does not enter) and the normal at angle t, the
+ * mirror's height is 2 (w . N) cos t - iz = ix sin 2t + iz cos 2t
+ * = A cos(2t - phi), A = |(ix, iz)|, phi = atan2(ix, iz): >= thr for t in
+ * [0, (phi + acos(thr / A)) / 2], so every normal from there to ng keeps w
+ * (and its mirror image) above it. */
+INLINE float bsdf_bend_t(const Bsdf *bs, V3 x, float tn, V3 w)
+{
+	float iz = v3_dot(w, bs->ng);
+	float sgn = iz < 0.0f ? -1.0f : 1.0f;
+	iz *= sgn;
+	float ix = sgn * v3_dot(w, x);
+	float thr = fmin(0.9f * iz, 0.01f);
+	if (ix * sin(2.0f * tn) + iz * cos(2.0f * tn) >= thr)
+		return tn;
+	float a = sqrt(ix * ix + iz * iz);
+	if (!(a > 0.0f))
+		return 0.0f;
+	float t = 0.5f * (atan2(ix, iz) + acos(fmin(thr / a, 1.0f)));
+	return fmin(fmax(t, 0.0f), tn);
+}
+
+/* The frame of the normal at angle t on the arc (the own frame at tn). */
+INLINE BsdfFrame bsdf_frame_t(const Bsdf *bs, V3 x, float tn, float t)
+{
+	if (t == tn)
+		return bsdf_frame_own(bs);
+	BsdfFrame f;
+	f.n = v3_norm(v3_add(v3_scale(x, sin(t)), v3_scale(bs->ng, cos(t))));
+	v3_basis(f.n, &f.t, &f.b);
+	return f;
+}
+
+/* Local coordinates of w in frame fr flipped by `side` (+-1). */
+INLINE V3 bsdf_local(const BsdfFrame *fr, V3 w, float side)
+{
+	return v3(v3_dot(w, fr->t), v3_dot(w, fr->b), side * v3_dot(w, fr->n));
+}
+
+INLINE V3 bsdf_world(const BsdfFrame *fr, V3 w, float side)
+{
+	return v3_from_local(v3(w.x, w.y, side * w.z), fr->t, fr->b, fr->n);
+}
+
+/* |wl . m| / |wl . n| for the light-side direction wl (see the top): what
+ * f is multiplied by where the normal m is bent; 0 where wl lies in n's
+ * plane (the integrators' cosine is 0 there). */
+INLINE float bsdf_bend_ratio(const Bsdf *bs, V3 m, V3 wl)
+{
+	float d = fabs(v3_dot(wl, bs->n));
+	return d > 1e-7f ? fabs(v3_dot(wl, m)) / d : 0.0f;
 }
 
 /* Relative ior eta_t / eta_i for light leaving toward the side `side` of ng. */
@@ -423,19 +518,49 @@ INLINE float bsdf_side(const Bsdf *bs, V3 w)
 	return c > 0.0f ? 1.0f : (c < 0.0f ? -1.0f : 0.0f);
 }
 
-/* The flipped local pair for world wo, wi, or 0 if the pair is on
- * inconsistent sides of ng and n. */
-INLINE int bsdf_pair(const Bsdf *bs, V3 wo, V3 wi, V3 *lo, V3 *li, float *eta)
+/* The flipped local pair for world wo, wi in frame fr, or 0 if the pair is
+ * on inconsistent sides of ng and fr's normal. */
+INLINE int bsdf_pair(const Bsdf *bs, const BsdfFrame *fr, V3 wo, V3 wi, V3 *lo, V3 *li, float *eta)
 {
 	float so = bsdf_side(bs, wo), si = bsdf_side(bs, wi);
 	if (so == 0.0f || si == 0.0f)
 		return 0;
-	*lo = bsdf_local(bs, wo, so);
-	*li = bsdf_local(bs, wi, so);
+	*lo = bsdf_local(fr, wo, so);
+	*li = bsdf_local(fr, wi, so);
 	*eta = bsdf_eta(bs, so);
 	if (!(lo->z > 0.0f))
 		return 0;
 	return so == si ? li->z > 0.0f : li->z < 0.0f;
+}
+
+/* bsdf_eval where n differs from ng (the top): f in the camera side's
+ * normal (wo's in radiance mode, wi's in importance mode) times the light
+ * side's cosine ratio, pdf_w in wo's normal and, if `rev`, pdf_rev_w in
+ * wi's. */
+INLINE V3 bsdf_eval_bent(const Bsdf *bs, V3 wo, V3 wi, int mode, float *pdf_w, float *pdf_rev_w, int rev)
+{
+	V3 lo, li, x, f = v3(0.0f, 0.0f, 0.0f);
+	float eta, unused;
+	*pdf_w = *pdf_rev_w = 0.0f;
+	if (bsdf_side(bs, wo) == 0.0f || bsdf_side(bs, wi) == 0.0f)
+		return f;
+	float tn = bsdf_tilt(bs, &x);
+	float to = bsdf_bend_t(bs, x, tn, wo), ti = bsdf_bend_t(bs, x, tn, wi);
+	BsdfFrame fo = bsdf_frame_t(bs, x, tn, to), fi = ti == to ? fo : bsdf_frame_t(bs, x, tn, ti);
+	if (bsdf_pair(bs, &fo, wo, wi, &lo, &li, &eta))
+		f = bsdf_eval_local(bs, lo, li, eta, mode, pdf_w);
+	if (rev && bsdf_pair(bs, &fi, wi, wo, &lo, &li, &eta))
+		bsdf_eval_local(bs, lo, li, eta, mode, pdf_rev_w);
+	int radiance = mode == BSDF_RADIANCE;
+	float tf = radiance ? to : ti;
+	if (!radiance && ti != to) { /* the camera side is wi: f in wi's normal */
+		f = v3(0.0f, 0.0f, 0.0f);
+		if (bsdf_pair(bs, &fi, wo, wi, &lo, &li, &eta))
+			f = bsdf_eval_local(bs, lo, li, eta, mode, &unused);
+	}
+	if (tf != tn)
+		f = v3_scale(f, bsdf_bend_ratio(bs, radiance ? fo.n : fi.n, radiance ? wi : wo));
+	return f;
 }
 
 /* f without the cosine, of the non-delta lobes only, and pdf_w of
@@ -443,9 +568,12 @@ INLINE int bsdf_pair(const Bsdf *bs, V3 wo, V3 wi, V3 *lo, V3 *li, float *eta)
 INLINE V3 bsdf_eval_fwd(const Bsdf *bs, V3 wo, V3 wi, int mode, float *pdf_w)
 {
 	V3 lo, li;
-	float eta;
+	float eta, unused;
 	*pdf_w = 0.0f;
-	if (!bsdf_pair(bs, wo, wi, &lo, &li, &eta))
+	if (bs->flags & BSDF_TILTED)
+		return bsdf_eval_bent(bs, wo, wi, mode, pdf_w, &unused, 0);
+	BsdfFrame fr = bsdf_frame_own(bs);
+	if (!bsdf_pair(bs, &fr, wo, wi, &lo, &li, &eta))
 		return v3(0.0f, 0.0f, 0.0f);
 	return bsdf_eval_local(bs, lo, li, eta, mode, pdf_w);
 }
@@ -457,12 +585,27 @@ CALLED V3 bsdf_eval(const Bsdf *bs, V3 wo, V3 wi, int mode, float *pdf_w, float 
 	float eta;
 	*pdf_w = 0.0f;
 	*pdf_rev_w = 0.0f;
-	if (!bsdf_pair(bs, wo, wi, &lo, &li, &eta))
+	if (bs->flags & BSDF_TILTED)
+		return bsdf_eval_bent(bs, wo, wi, mode, pdf_w, pdf_rev_w, 1);
+	BsdfFrame fr = bsdf_frame_own(bs);
+	if (!bsdf_pair(bs, &fr, wo, wi, &lo, &li, &eta))
 		return v3(0.0f, 0.0f, 0.0f);
 	V3 f = bsdf_eval_local(bs, lo, li, eta, mode, pdf_w);
-	if (bsdf_pair(bs, wi, wo, &lo, &li, &eta))
+	if (bsdf_pair(bs, &fr, wi, wo, &lo, &li, &eta))
 		bsdf_eval_local(bs, lo, li, eta, mode, pdf_rev_w);
 	return f;
+}
+
+/* The frame that sampling from wo uses: the own one, or wo's bent normal. */
+INLINE BsdfFrame bsdf_frame_for(const Bsdf *bs, V3 wo, int *bent)
+{
+	*bent = 0;
+	if (!(bs->flags & BSDF_TILTED))
+		return bsdf_frame_own(bs);
+	V3 x;
+	float tn = bsdf_tilt(bs, &x), t = bsdf_bend_t(bs, x, tn, wo);
+	*bent = t != tn;
+	return bsdf_frame_t(bs, x, tn, t);
 }
 
 /* Only the solid-angle density of sampling wi given wo (non-delta lobes):
@@ -471,7 +614,9 @@ INLINE float bsdf_pdf_w(const Bsdf *bs, V3 wo, V3 wi)
 {
 	V3 lo, li;
 	float eta, pdf = 0.0f;
-	if (bsdf_pair(bs, wo, wi, &lo, &li, &eta))
+	int bent;
+	BsdfFrame fr = bsdf_frame_for(bs, wo, &bent);
+	if (bsdf_pair(bs, &fr, wo, wi, &lo, &li, &eta))
 		bsdf_eval_local(bs, lo, li, eta, BSDF_RADIANCE, &pdf);
 	return pdf;
 }
@@ -486,14 +631,17 @@ INLINE float bsdf_glass_delta_prob(const Bsdf *bs, V3 wo, float eta, int reflect
 
 /* Returns 0 if no sample. For delta samples f is the lobe's weight (Fresnel
  * included) divided by |wi.n| (shading normal), so f |wi.n| / pdf_w is the
- * throughput; pdf_w and pdf_rev_w are then the probabilities of picking
- * that delta event from wo and from wi. */
+ * throughput (in a bent normal m, times |wl . m| / |wl . n| as every f, the
+ * top); pdf_w and pdf_rev_w are then the probabilities of picking that delta
+ * event from wo and from wi. */
 CALLED int bsdf_sample(const Bsdf *bs, V3 wo, float u0, float u1, float u2, int mode, BsdfSample *s)
 {
 	float so = bsdf_side(bs, wo);
 	if (so == 0.0f)
 		return 0;
-	V3 lo = bsdf_local(bs, wo, so);
+	int bent;
+	BsdfFrame frame = bsdf_frame_for(bs, wo, &bent);
+	V3 lo = bsdf_local(&frame, wo, so);
 	if (!(lo.z > 0.0f))
 		return 0;
 	float eta = bsdf_eta(bs, so);
@@ -512,7 +660,9 @@ CALLED int bsdf_sample(const Bsdf *bs, V3 wo, float u0, float u1, float u2, int 
 			s->pdf_w = p.metal;
 			s->pdf_rev_w = p.metal; /* the mirror pair has the same cosine */
 			s->delta = 1;
-			s->wi = bsdf_world(bs, li, so);
+			s->wi = bsdf_world(&frame, li, so);
+			if (bent)
+				s->f = v3_scale(s->f, bsdf_bend_ratio(bs, frame.n, mode == BSDF_RADIANCE ? s->wi : wo));
 			return bsdf_side(bs, s->wi) == so;
 		}
 		li = bsdf_reflect(lo, ggx_sample_visible(lo, bs->alpha, u1, u2));
@@ -544,11 +694,13 @@ CALLED int bsdf_sample(const Bsdf *bs, V3 wo, float u0, float u1, float u2, int 
 			if (!reflect && mode == BSDF_RADIANCE)
 				s->f = v3_scale(s->f, 1.0f / (eta * eta));
 			s->pdf_w = p.glass * (reflect ? fr : 1.0f - fr);
-			s->wi = bsdf_world(bs, li, so);
+			s->wi = bsdf_world(&frame, li, so);
+			if (bent)
+				s->f = v3_scale(s->f, bsdf_bend_ratio(bs, frame.n, mode == BSDF_RADIANCE ? s->wi : wo));
 			float si = bsdf_side(bs, s->wi);
 			if (si != (reflect ? so : -so))
 				return 0;
-			V3 ri = bsdf_local(bs, s->wi, si);
+			V3 ri = bsdf_local(&frame, s->wi, si);
 			s->pdf_rev_w = bsdf_glass_delta_prob(bs, ri, bsdf_eta(bs, si), reflect);
 			s->delta = 1;
 			return s->pdf_w > 0.0f;
@@ -561,7 +713,7 @@ CALLED int bsdf_sample(const Bsdf *bs, V3 wo, float u0, float u1, float u2, int 
 	 * of that direction belongs to the other event. */
 	if (reflect ? !(li.z > 0.0f) : !(li.z < 0.0f))
 		return 0;
-	s->wi = bsdf_world(bs, li, so);
+	s->wi = bsdf_world(&frame, li, so);
 	s->delta = 0;
 	s->f = bsdf_eval(bs, wo, s->wi, mode, &s->pdf_w, &s->pdf_rev_w);
 	return s->pdf_w > 0.0f;

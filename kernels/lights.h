@@ -389,6 +389,27 @@ INLINE float light_pdf_w(const SceneView *sc, V3 x, V3 n, V3 wi, int tri, float 
 	return (1.0f - ps) * pdf_a * dist * dist / cos_light;
 }
 
+/* The guided <- direction of an intermediate subpath (portal.h) aims at
+ * the environment or at an emitter point, never at a punctual light (a
+ * delta direction no other strategy samples): it chooses between the two
+ * by the light choice's shares with the punctual lights' share taken out,
+ * so that none of its samples is lost to them (with a sun lamp taking a
+ * quarter of the choice, a quarter of the guided samples were). Returns
+ * the environment's probability; *ce is the emitters' part of
+ * emitter_cdf, by which their pdf_select is divided (1 without punctual
+ * lights, where the choice is the light choice itself). */
+INLINE float guided_env_share(const SceneView *sc, float *ce)
+{
+	GLOBAL const Params *prm = sc->params;
+	float ps = prm->env_pdf_select;
+	*ce = 1.0f;
+	if (prm->num_lights == 0)
+		return ps;
+	*ce = sc->emitter_cdf[prm->num_emitters];
+	float rest = (1.0f - ps) * *ce;
+	return ps + rest > 0.0f ? ps / (ps + rest) : 0.0f;
+}
+
 /* Picks a portal triangle by area (u_sel) and a uniform point on it:
  * *p, unit normal *n (p1 - p0) x (p2 - p0), *pdf_a including the
  * selection. Returns the portal triangle's index, or -1 if none. */

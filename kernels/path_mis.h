@@ -109,7 +109,7 @@ INLINE V3 portal_mirror(V3 d, V3 n) { return v3_sub(d, v3_scale(n, 2.0f * v3_dot
 
 INLINE float portal_direction_psa(const SceneView *sc, GLOBAL const PortalTri *pt, const PathVertex *xm, V3 w)
 {
-	float ps = sc->params->env_pdf_select;
+	float ce, ps = guided_env_share(sc, &ce);
 	V3 to_m; /* from w toward x_m */
 	float guided = 0.0f; /* never toward a punctual light (portal.h) */
 	if (vertex_infinite(xm)) {
@@ -133,7 +133,9 @@ INLINE float portal_direction_psa(const SceneView *sc, GLOBAL const PortalTri *p
 		to_m = v3_scale(d, 1.0f / dist);
 		if (xm->type != VERTEX_PUNCTUAL && xm->tri >= 0 && sc->tris[xm->tri].emitter >= 0) {
 			float cos_l = -v3_dot(xm->ng, to_m); /* ng is the front face */
-			guided = cos_l > 0.0f ? (1.0f - ps) * emitter_pdf_a(sc, xm->tri, xm->p) * dist * dist / cos_l : 0.0f;
+			guided = cos_l > 0.0f && ce > 0.0f
+					 ? (1.0f - ps) * emitter_pdf_a(sc, xm->tri, xm->p) / ce * dist * dist / cos_l
+					 : 0.0f;
 		}
 	}
 	float cn = v3_dot(to_m, pt->n), c = fabs(cn);

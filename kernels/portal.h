@@ -45,7 +45,7 @@
 INLINE int portal_guided_sample(const SceneView *sc, GLOBAL const PortalTri *pt, V3 w0, float u_sel, float u1,
 				float u2, V3 *wl, int *is_env, float *dist)
 {
-	float ps = sc->params->env_pdf_select;
+	float ce, ps = guided_env_share(sc, &ce);
 	*is_env = u_sel < ps;
 	if (*is_env) {
 		int k = portal_guide_plane(sc, pt); /* the sky behind pt's plane (env_portal.h) */
@@ -62,9 +62,11 @@ INLINE int portal_guided_sample(const SceneView *sc, GLOBAL const PortalTri *pt,
 	LightSample ls;
 	/* Not at a punctual light: its light reaches the <- half by next-event
 	 * estimation and light subpaths; a guided direction at it would be a
-	 * delta direction that no other strategy samples. That share of the
-	 * guided samples is lost, which portal_direction_psa leaves out. */
-	if (!light_sample_emitter(sc, w0, fmin((u_sel - ps) / (1.0f - ps), 0.99999994f), u1, u2, 1.0f - ps, &ls) ||
+	 * delta direction that no other strategy samples. The emitters' part
+	 * of the table alone (guided_env_share); a pick that rounding still
+	 * sends to a light is lost. */
+	if (!(ce > 0.0f) ||
+	    !light_sample_emitter(sc, w0, fmin((u_sel - ps) / (1.0f - ps), 0.99999994f) * ce, u1, u2, 1.0f - ps, &ls) ||
 	    ls.delta)
 		return 0;
 	*wl = ls.wi;

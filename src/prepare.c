@@ -162,10 +162,17 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	 * subpaths carry the indirect light on both sides of it, with halves
 	 * and eye parts as long as the depth allows. AJAR_PORTAL_SET="s,s',t'[,t[,light paths]]"
 	 * overrides it for experiments, e.g. "32,32,32,33,1" for all of them. */
+	/* Punctual lights without emitters (kernels/README.md, "Punctual
+	 * lights"): their light subpaths are kept (a sun's start on the
+	 * portals and find its patch), but the intermediate subpaths, which
+	 * reach a delta light only by next-event estimation, carry the sky, so
+	 * the sky's set and rate: on window-room-sun the long halves at rate 1
+	 * cost 3x in time for no less noise. */
+	int long_set = p->light_paths && !(p->num_lights > 0 && p->num_emitters == 0);
 	p->portal_s_max = 1;
-	p->portal_sp_max = p->light_paths ? AJAR_BIDIR_MAX_DEPTH : 2;
-	p->portal_tp_max = p->light_paths ? AJAR_BIDIR_MAX_DEPTH : 1;
-	p->portal_t_max = p->light_paths ? 1 << 20 : 3; /* any t, or 3 */
+	p->portal_sp_max = long_set ? AJAR_BIDIR_MAX_DEPTH : 2;
+	p->portal_tp_max = long_set ? AJAR_BIDIR_MAX_DEPTH : 1;
+	p->portal_t_max = long_set ? 1 << 20 : 3; /* any t, or 3 */
 	const char *set = getenv("AJAR_PORTAL_SET");
 	if (set) {
 		int v[5] = {p->portal_s_max, p->portal_sp_max, p->portal_tp_max, p->portal_t_max, p->light_paths};
@@ -211,7 +218,7 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	 * needs them seldom; light from emitters behind an opening more often.
 	 * AJAR_PORTAL_RATE in (0, 1] overrides it. Layers without MIS weights
 	 * (tests) take every intermediate subpath. */
-	float rate = p->light_paths ? PORTAL_RATE_EMITTERS : PORTAL_RATE_SKY;
+	float rate = long_set ? PORTAL_RATE_EMITTERS : PORTAL_RATE_SKY;
 	/* Under a sky image (with a sun), sampled through planar portals, the
 	 * <- halves guided by the sky's importance find the sun and the ->
 	 * halves the patch it lights: worth a higher rate than a constant sky. */

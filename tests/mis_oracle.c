@@ -250,7 +250,12 @@ static double sky_behind_pdf(const SceneView *sc, GLOBAL const PortalTri *pt, co
 static double direction_psa(const SceneView *sc, GLOBAL const PortalTri *pt, const PathVertex *a, const double *w)
 {
 	double to[3], guided = 0, n[3] = {pt->n.x, pt->n.y, pt->n.z};
-	double ps = sc->params->env_pdf_select;
+	/* The guided choice leaves the punctual lights' share out. */
+	double ps = sc->params->env_pdf_select, ce = 1;
+	if (sc->params->num_lights > 0) {
+		ce = sc->emitter_cdf[sc->params->num_emitters];
+		ps = ps + (1 - ps) * ce > 0 ? ps / (ps + (1 - ps) * ce) : 0;
+	}
 	if (a->type == VERTEX_SUN) { /* the guided half never aims at a punctual light */
 		to[0] = a->p.x, to[1] = a->p.y, to[2] = a->p.z;
 	} else if (a->type == VERTEX_ENV) {
@@ -274,8 +279,8 @@ static double direction_psa(const SceneView *sc, GLOBAL const PortalTri *pt, con
 		if (tri >= 0) {
 			V3 fn = v3_norm(tri_normal(&sc->tris[tri]));
 			double cos_l = -(fn.x * to[0] + fn.y * to[1] + fn.z * to[2]);
-			if (cos_l > 0)
-				guided = (1 - ps) * emitter_pdf_a(sc, tri, a->p) * dist * dist / cos_l;
+			if (cos_l > 0 && ce > 0)
+				guided = (1 - ps) * emitter_pdf_a(sc, tri, a->p) / ce * dist * dist / cos_l;
 		}
 	}
 	double cn = to[0] * n[0] + to[1] * n[1] + to[2] * n[2], c = fabs(cn);

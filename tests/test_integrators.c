@@ -15,6 +15,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "ajar.h"
 #include "scene.h"
@@ -183,6 +184,99 @@ static void test_window_room_punctual(void **state)
 			 683.0f * 10.0f, p, q, 683.0f, 32, 32, 64, 16);
 }
 
+/* A quad (corners a, a + e1, a + e1 + e2, a + e2; uv (0,0) (1,0) (1,1) (0,1);
+ * normal e1 x e2 normalised, tangent e1 with w = -1 as glTF generates
+ * for v along e2, i.e. up the image) with material `mat`. */
+static void add_quad(Scene *s, const char *what, V3 a, V3 e1, V3 e2, uint32_t mat)
+{
+	V3 p[4] = {a, v3_add(a, e1), v3_add(v3_add(a, e1), e2), v3_add(a, e2)};
+	V3 n = v3_norm(v3_cross(e1, e2)), t = v3_norm(e1);
+	float pos[12], nrm[12], tan[16], uv[] = {0, 0, 1, 0, 1, 1, 0, 1};
+	for (int k = 0; k < 4; k++) {
+		pos[3 * k] = p[k].x, pos[3 * k + 1] = p[k].y, pos[3 * k + 2] = p[k].z;
+		nrm[3 * k] = n.x, nrm[3 * k + 1] = n.y, nrm[3 * k + 2] = n.z;
+		tan[4 * k] = t.x, tan[4 * k + 1] = t.y, tan[4 * k + 2] = t.z, tan[4 * k + 3] = -1;
+	}
+	uint32_t idx[] = {0, 1, 2, 0, 2, 3};
+	assert_int_equal(scene_add_triangles_ex(s, what, pos, nrm, uv, NULL, NULL, tan, 4, idx, 2, mat), AJAR_OK);
+}
+
+static uint32_t add_material(Scene *s, V3 base, float metallic, float roughness, int flags, float alpha,
+			     int base_tex, int normal_tex, V3 emission)
+{
+	Material m;
+	memset(&m, 0, sizeof m);
+	m.base_color = base;
+	m.base_tex = base_tex;
+	m.metallic = metallic;
+	m.roughness = roughness;
+	m.ior = 1.5f;
+	m.specular = 1.0f;
+	m.flags = flags | MATERIAL_DOUBLE_SIDED;
+	m.alpha_cutoff = 0.5f;
+	m.base_alpha = alpha;
+	m.normal_tex = normal_tex;
+	m.normal_scale = 1.0f;
+	m.emission = emission;
+	uint32_t id;
+	assert_int_equal(scene_add_material(s, &m, &id), AJAR_OK);
+	return id;
+}
+
+/* Normal maps and alpha: a floor of glTF plastic and a wall of rough
+ * metal, both with a strongly tilted 4 x 4 normal map (tilts up to 50
+ * degrees in every direction, so grazing views bend the shading normal,
+ * bsdf.h), an alpha-masked card (a 4 x 4 checker of alpha 0 and 1, cutoff
+ * 0.5) and a half-transparent BLEND card (alpha 0.5) between them and the
+ * camera, lit by a white sky and a small emitter over the floor. Every
+ * ray kind meets the alpha (camera rays, shadow rays, connections, light
+ * subpaths) and every vertex kind the bent normals. */
+static void test_normal_alpha(void **state)
+{
+	(void)state;
+	Scene *s;
+	assert_int_equal(scene_new("<normal maps and alpha>", &s), AJAR_OK);
+	uint8_t nm[4 * 16], checker[4 * 16];
+	for (int i = 0; i < 16; i++) {
+		float a = 0.4f * (float)i, tilt = 0.87f * (float)((i * 7) % 5) / 4.0f; /* sin(60 deg) at most */
+		float x = tilt * cosf(a), y = tilt * sinf(a), z = sqrtf(fmaxf(1 - x * x - y * y, 0));
+		nm[4 * i] = (uint8_t)lrintf((x + 1) * 127.5f);
+		nm[4 * i + 1] = (uint8_t)lrintf((y + 1) * 127.5f);
+		nm[4 * i + 2] = (uint8_t)lrintf((z + 1) * 127.5f);
+		nm[4 * i + 3] = 255;
+		int on = ((i & 3) + (i >> 2)) & 1;
+		checker[4 * i] = on ? 230 : 40;
+		checker[4 * i + 1] = 200;
+		checker[4 * i + 2] = 120;
+		checker[4 * i + 3] = on ? 255 : 0;
+	}
+	uint32_t nmi, chi;
+	assert_int_equal(scene_add_texture(s, 4, 4, nm, &nmi), AJAR_OK);
+	assert_int_equal(scene_add_texture(s, 4, 4, checker, &chi), AJAR_OK);
+	V3 none = v3(0, 0, 0);
+	uint32_t floor = add_material(s, v3(0.7f, 0.7f, 0.7f), 0, 0.4f, 0, 1, -1, (int)nmi + 1, none);
+	uint32_t wall = add_material(s, v3(0.9f, 0.7f, 0.5f), 1, 0.3f, 0, 1, -1, (int)nmi + 1, none);
+	uint32_t mask = add_material(s, v3(1, 1, 1), 0, 0.6f, MATERIAL_ALPHA_MASK, 1, (int)chi, 0, none);
+	uint32_t blend = add_material(s, v3(0.3f, 0.8f, 0.4f), 0, 0.5f, MATERIAL_ALPHA_BLEND, 0.5f, -1, 0, none);
+	uint32_t lamp = add_material(s, v3(0, 0, 0), 0, 1, 0, 1, -1, 0, v3(6, 6, 6));
+	add_quad(s, "floor", v3(-1, 0, 1), v3(2, 0, 0), v3(0, 0, -2), floor);
+	add_quad(s, "wall", v3(-1, 0, -1), v3(2, 0, 0), v3(0, 1.5f, 0), wall);
+	add_quad(s, "mask card", v3(-0.7f, 0, 0), v3(0.9f, 0, 0), v3(0, 0.9f, 0), mask);
+	add_quad(s, "blend card", v3(-0.2f, 0.1f, 0.4f), v3(0.8f, 0, 0), v3(0, 0.6f, 0), blend);
+	add_quad(s, "lamp", v3(0.2f, 1.3f, 0.6f), v3(0, 0, -0.4f), v3(0.4f, 0, 0), lamp);
+	scene_set_env_color(s, v3(0.5f, 0.5f, 0.5f));
+	assert_int_equal(scene_set_camera(s, v3(0.3f, 0.5f, 2.2f), v3_norm(v3(-0.1f, -0.15f, -1)), v3(0, 1, 0), 0.8f, 1),
+			 AJAR_OK);
+	int alpha = 0, tangent = 0;
+	for (uint32_t i = 0; i < s->ntris; i++) {
+		alpha += (s->tris[i].flags & TRI_ALPHA) != 0;
+		tangent += (s->tris[i].flags & TRI_TANGENT) != 0;
+	}
+	assert_int_equal(alpha, 4);
+	assert_int_equal(tangent, 4);
+	compare_scene(s, "normal maps and alpha", 24, 24, 64, 16);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -194,6 +288,7 @@ int main(void)
 		cmocka_unit_test(test_door_ajar),
 		cmocka_unit_test(test_cornell_punctual),
 		cmocka_unit_test(test_window_room_punctual),
+		cmocka_unit_test(test_normal_alpha),
 	};
 	return cmocka_run_group_tests_name("integrators", tests, NULL, NULL);
 }

@@ -6,7 +6,8 @@ in a folder of its own with copies of the room's .bin and textures and of the
 sky (Ajar reads no file outside a scene's folder unless told to), the sky turned
 about +Y so that the sun's rays pass through a window onto a chosen surface,
 or, for window-room-sun, a KHR_lights_punctual directional light as the sun
-under a constant sky. Python 3 standard library only; the output is
+under a constant sky, and for window-room-lamp a point lamp in the room under
+the room's own sky. Python 3 standard library only; the output is
 byte-for-byte the same on every run.
 
     python3 make_sky_scenes.py          # writes ../<variant>/ (glTF and copies)
@@ -95,6 +96,13 @@ VARIANTS = {
 	# travelling +Z and toward -X); the forest sun's irradiance, and the
 	# forest's average sky without its sun as a constant sky.
 	"window-room-sun": {"room": "window-room", "lamp": (32.0, 15.0)},
+	# A point lamp under the ceiling in the far left corner (x 0.8, y 2.2,
+	# z 2.2: 0.5 m below the ceiling, 0.8 m from the walls), 1000 cd of warm
+	# white (1.46 W/sr, a Blender lamp of 18.4 W), with the room's own sky
+	# through the window: a lamp inside the room beside the light through
+	# an opening.
+	"window-room-lamp": {"room": "window-room",
+			     "point": {"position": [0.8, 2.2, 2.2], "intensity": 1000.0, "color": [1.0, 0.75, 0.5]}},
 }
 
 
@@ -122,6 +130,14 @@ def make(name, spec):
 		copy(os.path.join(HERE, spec["sky"] + ".exr"), os.path.join(out, spec["sky"] + ".exr"))
 		extras["environment"] = {"image": "%s.exr" % spec["sky"], "strength": 1.0,
 					 "rotation": rotation_for(spec["sky"], spec["phi"])}
+	elif "point" in spec:
+		lamp = spec["point"]
+		g.setdefault("extensionsUsed", []).append("KHR_lights_punctual")
+		g.setdefault("extensions", {})["KHR_lights_punctual"] = {"lights": [{
+			"name": "lamp", "type": "point", "color": lamp["color"], "intensity": lamp["intensity"]}]}
+		g["nodes"].append({"name": "lamp", "translation": lamp["position"],
+				   "extensions": {"KHR_lights_punctual": {"light": 0}}})
+		g["scenes"][0]["nodes"].append(len(g["nodes"]) - 1)
 	else:
 		elev, phi = spec["lamp"]
 		to_sun = sun_vector(elev, phi)

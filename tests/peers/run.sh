@@ -9,7 +9,9 @@
 # Python 3.11; the others accept that, so one environment serves all). Then
 # runs tests/peers/driver.py. Knobs: PEERS_SECONDS, PEERS_SCENES, PEERS_SIZE,
 # PEERS_REF_SECONDS, PEERS_DEPTH, PEERS_THREADS, PEERS_RENDERERS (driver.py).
-# `run.sh rays` instead compares Ajar's ray queries with Embree's (rays.py).
+# `run.sh rays` instead compares Ajar's ray queries with Embree's (rays.py);
+# after driver.py, assets.py compares textured Khronos assets with Cycles
+# through Blender's glTF importer (`run.sh assets`: only that).
 set -eu
 cd "$(dirname "$0")/../.."
 
@@ -53,4 +55,9 @@ export PYTHONDONTWRITEBYTECODE=1
 if [ "${1:-}" = rays ]; then
 	exec "$VENV/bin/python" tests/peers/rays.py
 fi
-exec "$VENV/bin/python" tests/peers/driver.py
+# `run.sh assets`: only the textured Khronos assets against Blender's importer (assets.py).
+if [ "${1:-}" = assets ]; then
+	exec "$VENV/bin/python" tests/peers/assets.py
+fi
+"$VENV/bin/python" tests/peers/driver.py
+exec "$VENV/bin/python" tests/peers/assets.py
