@@ -20,7 +20,11 @@
  * its film still holds exactly its completed ranges and is read back into
  * `salvage`; otherwise the film is untrusted and its completed ranges are
  * re-rendered by the others. Every range covers all pixels, so the image is
- * always the exact mean of the sample indices it holds. */
+ * always the exact mean of the sample indices it holds.
+ *
+ * The scheduler is in render_scheduler.c, checkpoints in
+ * render_checkpoint.c, several machines in render_job.c; the state they
+ * share is in render_internal.h. */
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>

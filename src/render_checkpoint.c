@@ -1,6 +1,6 @@
 /* render_checkpoint.c — the renderer's side of checkpoints (checkpoint.c
- * holds the file format). A checkpoint holds the reduced integer films and the sample ranges they
- * hold. Resumed, the films become the salvage (the host part every image
+ * holds the file format). A checkpoint holds the reduced integer films and
+ * the sample ranges they hold. Resumed, the films become the salvage (the host part every image
  * adds), the ranges the base, and the gaps below the highest range go back
  * to the pool, so the continued render hands out exactly the sample indices
  * an uninterrupted one would have: the sums, and so the image, are the same

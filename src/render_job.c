@@ -1,10 +1,10 @@
 /* render_job.c — one render on several machines (Open MPI, through
- * cluster.c). Under mpirun every rank creates the same renderer on its own devices
- * (job_join checks they prepared the same scene and tells every rank of a
- * failure anywhere). Rank 0 adds one device per device of the other ranks
- * to its scheduler, each driven by a proxy thread (job_proxy_thread) that
- * takes ranges with scheduler_take_range like a device thread, sends them to that
- * rank and counts them done when the answer comes: the dealing by measured
+ * cluster.c). Under mpirun every rank creates the same renderer on its own
+ * devices (job_join checks they prepared the same scene and tells every
+ * rank of a failure anywhere). Rank 0 adds one device per device of the
+ * other ranks to its scheduler, each driven by a proxy thread
+ * (job_proxy_thread) that takes ranges with scheduler_take_range like a
+ * device thread, sends them to that rank and counts them done when the answer comes: the dealing by measured
  * speed, the time limit, cancels, checkpoints and device failures are rank
  * 0's, exactly as for its own devices. The other ranks serve (job_serve):
  * they render the ranges they are sent, and on a gather (at a checkpoint
