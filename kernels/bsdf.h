@@ -87,6 +87,14 @@
 #define BSDF_MAX_IOR 4.0f
 #define BSDF_TILTED (1 << 30)  /* in Bsdf.flags: n differs from ng, normals may bend (the top) */
 #define BSDF_TILT_COS 0.99999f /* n . ng below this counts as tilted */
+/* Whether bs's normal may bend. A scene whose shading normals are all
+ * within BSDF_TILT_COS of ng (src/prepare.c, tri_may_tilt) is built with
+ * AJAR_NO_BENT_NORMALS: then never, and the bent code is left out. */
+#ifdef AJAR_NO_BENT_NORMALS
+#define BSDF_IS_TILTED(bs) 0
+#else
+#define BSDF_IS_TILTED(bs) ((bs)->flags & BSDF_TILTED)
+#endif
 
 typedef struct {
 	V3 t, b, n;      /* shading frame, n on the side of ng */
@@ -203,7 +211,11 @@ INLINE void bsdf_setup_mr(Bsdf *bs, GLOBAL const Material *m, V3 base_color, flo
 	bs->transmission = bsdf_clamp01(m->transmission);
 	bs->ior = fmin(fmax(m->ior, BSDF_MIN_IOR), BSDF_MAX_IOR);
 	bs->specular = bsdf_clamp01(m->specular);
+#ifdef AJAR_NO_BENT_NORMALS
+	bs->flags = m->flags & ~BSDF_TILTED;
+#else
 	bs->flags = (m->flags & ~BSDF_TILTED) | (fabs(cn) < BSDF_TILT_COS ? BSDF_TILTED : 0);
+#endif
 	bs->coat_s1 = bs->coat_sw = bs->coat_eavg = bs->metal_eavg = 0.0f;
 	bs->metal_fms = v3(0.0f, 0.0f, 0.0f);
 	if (bsdf_w_plastic(bs) > 0.0f && bs->specular > 0.0f) {
@@ -570,7 +582,7 @@ INLINE V3 bsdf_eval_fwd(const Bsdf *bs, V3 wo, V3 wi, int mode, float *pdf_w)
 	V3 lo, li;
 	float eta, unused;
 	*pdf_w = 0.0f;
-	if (bs->flags & BSDF_TILTED)
+	if (BSDF_IS_TILTED(bs))
 		return bsdf_eval_bent(bs, wo, wi, mode, pdf_w, &unused, 0);
 	BsdfFrame fr = bsdf_frame_own(bs);
 	if (!bsdf_pair(bs, &fr, wo, wi, &lo, &li, &eta))
@@ -585,7 +597,7 @@ CALLED V3 bsdf_eval(const Bsdf *bs, V3 wo, V3 wi, int mode, float *pdf_w, float 
 	float eta;
 	*pdf_w = 0.0f;
 	*pdf_rev_w = 0.0f;
-	if (bs->flags & BSDF_TILTED)
+	if (BSDF_IS_TILTED(bs))
 		return bsdf_eval_bent(bs, wo, wi, mode, pdf_w, pdf_rev_w, 1);
 	BsdfFrame fr = bsdf_frame_own(bs);
 	if (!bsdf_pair(bs, &fr, wo, wi, &lo, &li, &eta))
@@ -600,7 +612,7 @@ CALLED V3 bsdf_eval(const Bsdf *bs, V3 wo, V3 wi, int mode, float *pdf_w, float 
 INLINE BsdfFrame bsdf_frame_for(const Bsdf *bs, V3 wo, int *bent)
 {
 	*bent = 0;
-	if (!(bs->flags & BSDF_TILTED))
+	if (!BSDF_IS_TILTED(bs))
 		return bsdf_frame_own(bs);
 	V3 x;
 	float tn = bsdf_tilt(bs, &x), t = bsdf_bend_t(bs, x, tn, wo);

@@ -249,9 +249,14 @@ INLINE int bvh_traverse(const SceneView *sc, V3 o, V3 d, float tmax, int any_hit
 			int first = BVH_LEAF_FIRST(entry), last = first + BVH_LEAF_COUNT(entry);
 			for (int i = first; i < last; i++) {
 				float t, u, v;
-				/* Alpha-tested triangles (TRI_ALPHA) may let the ray pass. */
-				if (tri_intersect(&r, &sc->tris[i], tmax, &t, &u, &v) &&
-				    (!(sc->tris[i].flags & TRI_ALPHA) || alpha_hit(sc, i, u, v, o, d))) {
+				/* Alpha-tested triangles (TRI_ALPHA) may let the ray pass;
+				 * a scene without any is built with AJAR_NO_ALPHA
+				 * (src/prepare.c, kernel_omit). */
+				if (tri_intersect(&r, &sc->tris[i], tmax, &t, &u, &v)
+#ifndef AJAR_NO_ALPHA
+				    && (!(sc->tris[i].flags & TRI_ALPHA) || alpha_hit(sc, i, u, v, o, d))
+#endif
+				) {
 					found = 1;
 					tmax = t;
 					hit->t = t;

@@ -20,6 +20,9 @@ INLINE V3 emitter_emission(const SceneView *sc, int tri, V3 p)
 {
 	GLOBAL const Tri *t = &sc->tris[tri];
 	GLOBAL const Material *m = &sc->materials[t->material];
+#if defined(AJAR_NO_TEXTURES) && defined(AJAR_NO_ALPHA)
+	return m->emission; /* a specialised program (src/prepare.c, kernel_omit) */
+#endif
 	if (!m->emissive_tex && !(t->flags & TRI_ALPHA))
 		return m->emission;
 	float b1, b2;

@@ -69,6 +69,7 @@ INLINE void surface_from_hit(const SceneView *sc, const Hit *h, Surface *s)
 	s->alpha = 1.0f;
 	s->tri = h->tri;
 	s->material = t->material;
+#ifndef AJAR_NO_TRI_EXTRA
 	if (t->flags & TRI_EXTRA) {
 		GLOBAL const TriExtra *e = &sc->extra[h->tri];
 		s->tu1 = w * e->u0 + h->u * e->u1 + h->v * e->u2;
@@ -79,6 +80,7 @@ INLINE void surface_from_hit(const SceneView *sc, const Hit *h, Surface *s)
 		s->color = v3(c[0], c[1], c[2]);
 		s->alpha = c[3];
 	}
+#endif
 	V3 n = s->ng;
 	if (sh->has_normals) {
 		V3 ni = v3_add(v3_add(v3_scale(sh->n0, w), v3_scale(sh->n1, h->u)), v3_scale(sh->n2, h->v));
@@ -86,8 +88,10 @@ INLINE void surface_from_hit(const SceneView *sc, const Hit *h, Surface *s)
 		if (len2 > 1e-12f)
 			n = v3_scale(ni, 1.0f / sqrt(len2));
 	}
+#ifndef AJAR_NO_BENT_NORMALS
 	if (t->flags & TRI_TANGENT)
 		n = surface_normal_map(sc, s, &sc->extra[h->tri], w, h->u, h->v, n);
+#endif
 	s->ns = v3_dot(n, s->ng) < 0.0f ? v3_neg(n) : n;
 }
 
@@ -113,9 +117,11 @@ INLINE V3 surface_base_color(const SceneView *sc, const Surface *s)
 {
 	GLOBAL const Material *m = &sc->materials[s->material];
 	V3 c = v3_mul(m->base_color, s->color);
-	if (m->base_tex < 0)
-		return c;
-	return v3_mul(c, surface_texture(sc, s, m->base_tex, 1).rgb);
+#ifndef AJAR_NO_TEXTURES
+	if (m->base_tex >= 0)
+		c = v3_mul(c, surface_texture(sc, s, m->base_tex, 1).rgb);
+#endif
+	return c;
 }
 
 /* The BSDF at s with base colour `base` (surface_base_color): metallic and
@@ -125,11 +131,13 @@ INLINE void surface_bsdf(const SceneView *sc, const Surface *s, V3 base, Bsdf *b
 {
 	GLOBAL const Material *m = &sc->materials[s->material];
 	float metallic = m->metallic, roughness = m->roughness;
+#ifndef AJAR_NO_TEXTURES
 	if (m->mr_tex) {
 		Rgba t = surface_texture(sc, s, m->mr_tex - 1, 0);
 		metallic *= t.rgb.z;
 		roughness *= t.rgb.y;
 	}
+#endif
 	bsdf_setup_mr(bs, m, base, metallic, roughness, s->ns, s->ng);
 }
 

@@ -111,11 +111,13 @@ INLINE Rgba tri_texture(const SceneView *sc, int tri, float b1, float b2, int te
 	float v = w * sh->v0 + b1 * sh->v1 + b2 * sh->v2;
 	if (sc->textures[tex].flags & TEX_UV1) {
 		u = v = 0.0f;
+#ifndef AJAR_NO_TRI_EXTRA
 		if (sc->tris[tri].flags & TRI_EXTRA) {
 			GLOBAL const TriExtra *e = &sc->extra[tri];
 			u = w * e->u0 + b1 * e->u1 + b2 * e->u2;
 			v = w * e->v0 + b1 * e->v1 + b2 * e->v2;
 		}
+#endif
 	}
 	return texture_rgba(sc, tex, u, v, srgb);
 }
@@ -126,10 +128,12 @@ INLINE float tri_alpha(const SceneView *sc, int tri, float b1, float b2)
 	GLOBAL const Tri *t = &sc->tris[tri];
 	GLOBAL const Material *m = &sc->materials[t->material];
 	float a = m->base_alpha;
+#ifndef AJAR_NO_TRI_EXTRA
 	if (t->flags & TRI_EXTRA) {
 		GLOBAL const TriExtra *e = &sc->extra[tri];
 		a *= (1.0f - b1 - b2) * e->c0[3] + b1 * e->c1[3] + b2 * e->c2[3];
 	}
+#endif
 	if (m->base_tex >= 0)
 		a *= tri_texture(sc, tri, b1, b2, m->base_tex, 0).a;
 	return a;

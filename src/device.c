@@ -486,6 +486,10 @@ ajar_status device_plan(const Device *d, int integrator, size_t npix, DevicePlan
 		p->lanes = 64;
 	while (p->lanes > 1 && (unsigned long long)npix * p->lanes >= 1ull << 31)
 		p->lanes--;
+	const char *feat = getenv("AJAR_KERNEL_FEATURES");
+	if (feat && feat[0] && strcmp(feat, "all") && strcmp(feat, "scene"))
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "AJAR_KERNEL_FEATURES='%s': expected all or scene", feat);
+	p->general = feat && !strcmp(feat, "all");
 	if ((got = env_count("AJAR_SUBPATH_CAPACITY", &v)) < 0 || (got && v > (1ull << 31)))
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "AJAR_SUBPATH_CAPACITY='%s': expected a work-item count",
 			       getenv("AJAR_SUBPATH_CAPACITY"));
@@ -512,12 +516,22 @@ ajar_status device_plan(const Device *d, int integrator, size_t npix, DevicePlan
 void device_render_options(const Device *d, int integrator, const DevicePlan *p, const char *extra, char *buf,
 			   size_t cap)
 {
+	static const struct {
+		unsigned bit;
+		const char *option;
+	} omit[] = {{DEVICE_OMIT_ALPHA, "-DAJAR_NO_ALPHA "},
+		    {DEVICE_OMIT_BENT_NORMALS, "-DAJAR_NO_BENT_NORMALS "},
+		    {DEVICE_OMIT_TEXTURES, "-DAJAR_NO_TEXTURES "},
+		    {DEVICE_OMIT_TRI_EXTRA, "-DAJAR_NO_TRI_EXTRA "}};
 	device_build_options(d, integrator, NULL, buf, cap);
 	size_t n = strlen(buf);
 	if (p->soa)
-		snprintf(buf + n, cap - n, "-DAJAR_SUBPATH_SOA=%zu -DAJAR_SUBPATH_WORDS=%d%s%s", p->capacity,
-			 DEVICE_VERTEX_WORDS, extra && extra[0] ? " " : "", extra ? extra : "");
-	else
+		n += (size_t)snprintf(buf + n, cap - n, "-DAJAR_SUBPATH_SOA=%zu -DAJAR_SUBPATH_WORDS=%d ", p->capacity,
+				      DEVICE_VERTEX_WORDS);
+	for (size_t i = 0; i < sizeof omit / sizeof omit[0] && n < cap; i++)
+		if (!p->general && (p->omit & omit[i].bit))
+			n += (size_t)snprintf(buf + n, cap - n, "%s", omit[i].option);
+	if (n < cap)
 		snprintf(buf + n, cap - n, "%s", extra ? extra : "");
 }
 

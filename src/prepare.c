@@ -10,6 +10,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "device.h"
 #include "error.h"
 #include "portal_flux.h"
 #include "portal_sky.h"
@@ -19,6 +20,63 @@ static double seconds(void)
 	struct timespec ts;
 	clock_gettime(CLOCK_MONOTONIC, &ts);
 	return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+/* Whether a hit on triangle t can get a shading normal that bsdf_setup_mr
+ * counts as tilted (BSDF_TILTED: |n . ng| < BSDF_TILT_COS, kernels/bsdf.h).
+ * An interpolated normal is a positive combination of the three vertex
+ * normals, so where each unit vertex normal has n . ng >= c on one side,
+ * so has the normalized interpolation; c = 0.999995 keeps a margin of
+ * 5e-6 over BSDF_TILT_COS (0.99999) for the kernel's rounding. */
+static int tri_may_tilt(const Tri *t, const TriShade *sh)
+{
+	if (t->flags & TRI_TANGENT)
+		return 1;
+	if (!sh->has_normals)
+		return 0;
+	V3 e1 = v3_sub(t->p1, t->p0), e2 = v3_sub(t->p2, t->p0);
+	double gx = (double)e1.y * e2.z - (double)e1.z * e2.y, gy = (double)e1.z * e2.x - (double)e1.x * e2.z,
+	       gz = (double)e1.x * e2.y - (double)e1.y * e2.x;
+	double lg = sqrt(gx * gx + gy * gy + gz * gz);
+	if (!(lg > 0.0))
+		return 1; /* degenerate: never hit in practice, but not provably flat */
+	const V3 *n[3] = {&sh->n0, &sh->n1, &sh->n2};
+	int side = 0;
+	for (int k = 0; k < 3; k++) {
+		double ln = sqrt((double)n[k]->x * n[k]->x + (double)n[k]->y * n[k]->y + (double)n[k]->z * n[k]->z);
+		if (!(ln > 0.0) || !isfinite(ln))
+			return 1;
+		double c = ((double)n[k]->x * gx + (double)n[k]->y * gy + (double)n[k]->z * gz) / (ln * lg);
+		int s = c >= 0.999995 ? 1 : (c <= -0.999995 ? -1 : 0);
+		if (s == 0 || (side && s != side))
+			return 1;
+		side = s;
+	}
+	return 0;
+}
+
+/* The DEVICE_OMIT_* features that no triangle or material of the prepared
+ * scene uses: alpha tests, tilted shading normals (the bend), textures,
+ * TriExtra data. Emitters with textures or alpha count as using them. */
+static unsigned kernel_omit(const SceneData *d)
+{
+	unsigned omit = DEVICE_OMIT_ALPHA | DEVICE_OMIT_BENT_NORMALS | DEVICE_OMIT_TRI_EXTRA;
+	for (size_t i = 0; i < d->n_tris; i++) {
+		if (d->tris[i].flags & TRI_ALPHA)
+			omit &= ~DEVICE_OMIT_ALPHA;
+		if (d->tris[i].flags & (TRI_EXTRA | TRI_TANGENT))
+			omit &= ~DEVICE_OMIT_TRI_EXTRA;
+		if ((omit & DEVICE_OMIT_BENT_NORMALS) && tri_may_tilt(&d->tris[i], &d->shade[i]))
+			omit &= ~DEVICE_OMIT_BENT_NORMALS;
+	}
+	int textured = 0;
+	for (size_t i = 0; i < d->n_materials; i++) {
+		const Material *m = &d->materials[i];
+		textured |= m->base_tex >= 0 || m->mr_tex || m->emissive_tex || m->normal_tex;
+	}
+	if (!textured)
+		omit |= DEVICE_OMIT_TEXTURES;
+	return omit;
 }
 
 static ajar_status setup_camera(const Scene *s, const PrepareOptions *o, Camera *c)
@@ -99,6 +157,7 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	d->n_textures = s->ntextures;
 	d->texels = s->texels;
 	d->n_texels = s->ntexels;
+	d->kernel_omit = kernel_omit(d);
 
 	scene_bounds(s, &d->bmin, &d->bmax);
 	V3 center = v3_scale(v3_add(d->bmin, d->bmax), 0.5f);

@@ -14,6 +14,7 @@ typedef struct {
 	LightTables lights;
 	double bvh_seconds;
 	V3 bmin, bmax;
+	unsigned kernel_omit; /* DEVICE_OMIT_* (device.h): features no triangle or material uses */
 } SceneData;
 
 typedef struct {

@@ -173,7 +173,7 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 	/* One program per integrator (see PARAMS_INTEGRATOR), built with
 	 * device_build_options and what AJAR_CL_OPTIONS adds (kernels/README.md, "On GPUs"). */
 	const char *extra = getenv("AJAR_CL_OPTIONS");
-	char options[512];
+	char options[768]; /* KERNEL_OPTIONS, the plan's, the -DAJAR_NO_* and 400 of AJAR_CL_OPTIONS */
 	if (extra && strlen(extra) > 400)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "AJAR_CL_OPTIONS is %zu characters long; at most 400",
 			       strlen(extra));
@@ -181,6 +181,7 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 		return st;
 	if ((st = device_plan(d, r->data.params->integrator, (size_t)r->width * r->height, &rd->plan)) != AJAR_OK)
 		return st;
+	rd->plan.omit = r->data.kernel_omit; /* features the scene lacks: a specialised program */
 	device_render_options(d, r->data.params->integrator, &rd->plan, extra, options, sizeof options);
 	if ((st = device_build(d, ajar_kernel_source, options)) != AJAR_OK) {
 		char *why = extra && extra[0] ? strdup(ajar_last_error()) : NULL;

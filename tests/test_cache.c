@@ -303,6 +303,30 @@ static void test_build_options(void **state)
 	assert_string_equal(buf, KERNEL_OPTIONS "2 -DAJAR_CALLS -cl-nv-maxrregcount=32 -UAJAR_CALLS -cl-nv-maxrregcount=255");
 }
 
+/* render_pass's options: the plan's scratch, then one -DAJAR_NO_* for each
+ * feature the scene lacks (none where `general`), AJAR_CL_OPTIONS last. */
+static void test_render_options(void **state)
+{
+	(void)state;
+	char buf[512];
+	Device cpu = {.is_cpu = 1}, gpu = {.is_cpu = 0};
+	DevicePlan p = {0};
+	device_render_options(&cpu, 0, &p, NULL, buf, sizeof buf);
+	assert_string_equal(buf, KERNEL_OPTIONS "0 ");
+	p.omit = DEVICE_OMIT_ALPHA | DEVICE_OMIT_TEXTURES;
+	device_render_options(&cpu, 0, &p, "-cl-opt-disable", buf, sizeof buf);
+	assert_string_equal(buf, KERNEL_OPTIONS "0 -DAJAR_NO_ALPHA -DAJAR_NO_TEXTURES -cl-opt-disable");
+	p.omit = DEVICE_OMIT_ALPHA | DEVICE_OMIT_BENT_NORMALS | DEVICE_OMIT_TEXTURES | DEVICE_OMIT_TRI_EXTRA;
+	p.soa = 1;
+	p.capacity = 128;
+	device_render_options(&gpu, 1, &p, NULL, buf, sizeof buf);
+	assert_string_equal(buf, KERNEL_OPTIONS "1 -DAJAR_CALLS -DAJAR_SUBPATH_SOA=128 -DAJAR_SUBPATH_WORDS=72 "
+					  "-DAJAR_NO_ALPHA -DAJAR_NO_BENT_NORMALS -DAJAR_NO_TEXTURES -DAJAR_NO_TRI_EXTRA ");
+	p.general = 1;
+	device_render_options(&gpu, 1, &p, NULL, buf, sizeof buf);
+	assert_string_equal(buf, KERNEL_OPTIONS "1 -DAJAR_CALLS -DAJAR_SUBPATH_SOA=128 -DAJAR_SUBPATH_WORDS=72 ");
+}
+
 static void test_directory_fallbacks(void **state)
 {
 	char buf[512];
@@ -343,6 +367,7 @@ int main(void)
 		cmocka_unit_test(test_off_disables_the_cache),
 		cmocka_unit_test(test_directory_fallbacks),
 		cmocka_unit_test(test_build_options),
+		cmocka_unit_test(test_render_options),
 	};
 	int rc = cmocka_run_group_tests_name("cache", tests, NULL, NULL);
 	test_remove_tree(root);

@@ -19,7 +19,9 @@
 #include <string.h>
 
 #include "ajar.h"
+#include "device.h"
 #include "exr.h"
+#include "prepare.h"
 #include "testutil.h"
 
 #include <unistd.h>
@@ -357,6 +359,58 @@ static void test_same_seed_same_bits(void **state)
 	ajar_scene_destroy(&s);
 }
 
+/* The features prepare_scene finds a scene without (DEVICE_OMIT_*). */
+static unsigned scene_omit(const char *path)
+{
+	ajar_scene *s;
+	SceneData d;
+	if (ajar_scene_load(path, &s) != AJAR_OK)
+		fail_msg("%s: %s", path, ajar_last_error());
+	PrepareOptions po = {8, 8, 0, 8, 1, 0, 0, 0, 0};
+	if (prepare_scene(s, &po, &d) != AJAR_OK)
+		fail_msg("%s: %s", path, ajar_last_error());
+	unsigned omit = d.kernel_omit;
+	prepare_free(&d);
+	ajar_scene_destroy(&s);
+	return omit;
+}
+
+/* Feature-specialised programs (kernels/README.md): the Cornell box has no
+ * alpha, no tilted normals, no textures and no TriExtra, so its program is
+ * built with all four -DAJAR_NO_* options, and renders the same bits as
+ * the general program (AJAR_KERNEL_FEATURES=all); scenes that have a
+ * feature keep its code; a malformed AJAR_KERNEL_FEATURES is refused. */
+static void test_kernel_features(void **state)
+{
+	(void)state;
+	const unsigned all = DEVICE_OMIT_ALPHA | DEVICE_OMIT_BENT_NORMALS | DEVICE_OMIT_TEXTURES | DEVICE_OMIT_TRI_EXTRA;
+	assert_int_equal(scene_omit(SCENE("cornell/cornell.gltf")), all);
+	unsigned alpha = scene_omit(SCENE("khronos/AlphaBlendModeTest/AlphaBlendModeTest.gltf"));
+	assert_int_equal(alpha & (DEVICE_OMIT_ALPHA | DEVICE_OMIT_TEXTURES), 0);
+	unsigned nmap = scene_omit(SCENE("khronos/NormalTangentTest/NormalTangentTest.gltf"));
+	assert_int_equal(nmap & (DEVICE_OMIT_BENT_NORMALS | DEVICE_OMIT_TEXTURES | DEVICE_OMIT_TRI_EXTRA), 0);
+	unsigned colour = scene_omit(SCENE("khronos/VertexColorTest/VertexColorTest.gltf"));
+	assert_int_equal(colour & DEVICE_OMIT_TRI_EXTRA, 0);
+
+	ajar_scene *s;
+	assert_int_equal(ajar_scene_load(SCENE("cornell/cornell.gltf"), &s), AJAR_OK);
+	float *spec = render(s, 24, 16, 4, 3, 8);
+	setenv("AJAR_KERNEL_FEATURES", "all", 1);
+	float *general = render(s, 24, 16, 4, 3, 8);
+	assert_memory_equal(spec, general, sizeof(float) * 4 * 24 * 16);
+	setenv("AJAR_KERNEL_FEATURES", "some", 1);
+	ajar_options o;
+	ajar_renderer *r = NULL;
+	ajar_options_default(&o);
+	o.width = o.height = 8;
+	assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_ERROR_INVALID_ARGUMENT);
+	assert_non_null(strstr(ajar_last_error(), "AJAR_KERNEL_FEATURES"));
+	unsetenv("AJAR_KERNEL_FEATURES");
+	free(spec);
+	free(general);
+	ajar_scene_destroy(&s);
+}
+
 /* Without portals the portal integrator is bdpt, sample for sample. */
 static void test_portal_without_portals_is_bdpt(void **state)
 {
@@ -482,6 +536,7 @@ int main(void)
 		cmocka_unit_test(test_strategy_file),
 		cmocka_unit_test(test_cancel_keeps_image),
 		cmocka_unit_test(test_bad_options),
+		cmocka_unit_test(test_kernel_features),
 	};
 	return cmocka_run_group_tests_name("render", tests, NULL, NULL);
 }
