@@ -97,9 +97,9 @@ $(BUILD)/libajar.a: $(LIB_OBJS)
 	@echo "  AR      $@"
 	$(Q)rm -f $@ && ar rcs $@ $^
 
-$(BUILD)/libajar.so: $(LIB_OBJS)
+$(BUILD)/libajar.so: $(LIB_OBJS) src/libajar.map
 	@echo "  LD      $@"
-	$(Q)$(CXX) -shared -Wl,-soname,libajar.so.0 $(LDFLAGS) -o $@ $^ $(LDLIBS)
+	$(Q)$(CXX) -shared -Wl,-soname,libajar.so.0 -Wl,--version-script=src/libajar.map $(LDFLAGS) -o $@ $(LIB_OBJS) $(LDLIBS)
 
 $(BUILD)/src/%.o: src/%.c
 	@mkdir -p $(@D)

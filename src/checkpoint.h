@@ -2,7 +2,7 @@
  * integer sums, the sample ranges they hold, the options and hashes of the
  * prepared scene and of the render parameters (checkpoint.c).
  *
- * render.c gathers and applies the state; this module only writes the file
+ * render_checkpoint.c gathers and applies the state; this module only writes the file
  * atomically (temporary name, fsync, rename: a failed write keeps the
  * previous file) and reads it back, refusing a file that is not a
  * checkpoint, comes from another version, is truncated or corrupted. */

@@ -1,4 +1,4 @@
-/* cluster.h — the ranks of an Open MPI job, as render.c uses them: who we
+/* cluster.h — the ranks of an Open MPI job, as render_job.c uses them: who we
  * are, small messages, and the integer sum of films at rank 0.
  *
  * Built with Open MPI (the Makefile defines AJAR_MPI for cluster.c alone

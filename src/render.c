@@ -20,7 +20,11 @@
  * its film still holds exactly its completed ranges and is read back into
  * `salvage`; otherwise the film is untrusted and its completed ranges are
  * re-rendered by the others. Every range covers all pixels, so the image is
- * always the exact mean of the sample indices it holds. */
+ * always the exact mean of the sample indices it holds.
+ *
+ * The scheduler is in render_scheduler.c, checkpoints in
+ * render_checkpoint.c, several machines in render_job.c; the state they
+ * share is in render_internal.h. */
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -38,22 +42,14 @@
 #include "prepare.h"
 #include "scene.h"
 #include "render_info.h"
+#include "render_internal.h"
 #include "upload.h"
 #include "../kernels/aov_layout.h"
 #include "../kernels/compat.h"
 #include "../kernels/film.h"
 #include "../kernels/strategies.h"
 
-#define PASS_SECONDS 0.25
 #define DEFAULT_WIDTH 512
-#define MAX_RENDER_DEVICES 16
-
-typedef SampleRange Range;
-
-typedef struct {
-	Range *r;
-	size_t n, cap;
-} RangeList;
 
 /* Test hook: AJAR_TEST_FAIL_DEVICE=<index>:<pass>[:lost] makes pass number
  * <pass> (from 1) of the renderer's device <index> (from 0, in selection
@@ -62,75 +58,7 @@ typedef struct {
  * was lost mid-pass (the film is untrusted). Read once per renderer. */
 enum { FAIL_NONE, FAIL_LAUNCH, FAIL_LOST };
 
-typedef struct RenderDevice {
-	struct ajar_renderer *r;
-	Device dev;
-	cl_kernel k_render;
-	SceneBuffers bufs;
-	cl_uint arg_first; /* index of the render kernel's first non-scene argument */
-	cl_mem accum, splat; /* fixed-point films: own pixel, and atomic splats */
-	size_t local;        /* work-group size of render_pass */
-	DevicePlan plan;     /* subpath storage and work-items a pass (device_plan) */
-	cl_mem scratch;      /* the subpaths when plan.soa, else a one-word stand-in */
-	pthread_t thread;
-	int started;              /* thread is running this render */
-	int fail_pass, fail_mode; /* the test hook */
-	uint32_t attempts;        /* passes started, for the test hook */
-	int rank;                 /* on rank 0: the rank this device renders on (0: here) */
-	uint32_t remote;          /* its index there; see "Several machines" */
-	uint32_t job_ranges;      /* on rank 0, for a device of another rank: passes after its first, */
-	double job_idle;          /* and the seconds it waited for them there (dealing, messages) */
-	/* Under the renderer's lock: */
-	int alive, reported;
-	RangeList done;      /* ranges its film holds */
-	uint64_t spp_kept;   /* sample indices of this device in the image */
-	double busy_seconds; /* time in completed passes */
-	double per_spp;      /* seconds per sample index, last pass; 0 unknown */
-	char error[1024];    /* why it was dropped */
-} RenderDevice;
-
-struct ajar_renderer {
-	SceneData data;
-	RenderDevice *devs;
-	uint32_t ndev;
-	uint32_t width, height;
-	double time_limit, elapsed;
-	ajar_integrator integrator;
-	uint32_t seed, max_depth;
-	char scene_name[256];
-	char device_names[1024];
-	atomic_int cancel;
-	int nlayers;                   /* per-strategy images after the splat film */
-	int strategy_unweighted, strategy_len;
-	long *film, *film_splat;       /* host reduction */
-	long *salvage, *salvage_splat; /* films read back from dropped devices, or NULL */
-	pthread_mutex_t lock;
-	pthread_cond_t cond;
-	/* Under the lock: */
-	uint32_t spp_done, spp_target;
-	uint32_t next_first; /* first sample index never handed out */
-	RangeList holes;     /* ranges below next_first to render again */
-	uint32_t in_flight, running;
-	uint64_t events; /* passes ended, for the main thread's wake-ups */
-	int out_of_memory;
-	RenderDevice *last_dropped;
-	double t0;
-	/* Checkpoints (see "Checkpoints" below): */
-	ajar_options opt;     /* resolved, device NULL: what a checkpoint records */
-	RangeList base;       /* ranges of the checkpoint resumed from, held in salvage */
-	char *ckpt_path;      /* written during ajar_renderer_render, or NULL */
-	double ckpt_every, ckpt_last;
-	int pausing;          /* under the lock: no device takes a new range */
-	int hashed;
-	uint64_t scene_hash, params_hash;
-	uint32_t pass_cap; /* test hook AJAR_TEST_PASS_SPP: at most this many samples per pass */
-	/* Several machines (Open MPI, see the section at the end): */
-	long *remote, *remote_splat; /* rank 0: the other ranks' films, summed at the last gather */
-	int job_lost;                /* rank 0: a rank that stopped answering, or 0 */
-	atomic_int job_over;         /* other ranks: the render is over (device threads end) */
-};
-
-static double seconds(void)
+double render_seconds(void)
 {
 	struct timespec ts;
 	clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -138,7 +66,7 @@ static double seconds(void)
 }
 
 /* Appends g, merging with the last range when they touch; 0 if out of memory. */
-static int ranges_push(RangeList *l, Range g)
+int range_list_push(RangeList *l, Range g)
 {
 	if (l->n && l->r[l->n - 1].first + l->r[l->n - 1].count == g.first) {
 		l->r[l->n - 1].count += g.count;
@@ -223,17 +151,17 @@ static size_t film_bytes(const ajar_renderer *r)
 }
 
 /* Longs before the AOV film in the splat buffer: the splats and layers. */
-static size_t aov_offset(const ajar_renderer *r) { return 3 * (size_t)r->width * r->height * (1 + (size_t)r->nlayers); }
+size_t render_aov_offset(const ajar_renderer *r) { return 3 * (size_t)r->width * r->height * (1 + (size_t)r->nlayers); }
 
 /* The splat film, followed by bdpt's per-strategy layers if asked for and
  * the first-hit AOVs (aov.h) if asked for: own-pixel sums, but kept here
  * so every path that reads, salvages, sums and checkpoints films has them. */
-static size_t splat_count(const ajar_renderer *r)
+size_t render_splat_count(const ajar_renderer *r)
 {
-	return aov_offset(r) + (r->opt.aov ? (size_t)AOV_CHANNELS * r->width * r->height : 0);
+	return render_aov_offset(r) + (r->opt.aov ? (size_t)AOV_CHANNELS * r->width * r->height : 0);
 }
 
-static size_t splat_bytes(const ajar_renderer *r) { return sizeof(cl_long) * splat_count(r); }
+static size_t splat_bytes(const ajar_renderer *r) { return sizeof(cl_long) * render_splat_count(r); }
 
 /* Context, program, scene and films on one device. */
 static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_id plat, cl_device_id id)
@@ -277,7 +205,7 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 	CL_TRY(d, clSetKernelArg(rd->k_render, rd->arg_first, sizeof(cl_mem), &rd->accum));
 	CL_TRY(d, clSetKernelArg(rd->k_render, rd->arg_first + 1, sizeof(cl_mem), &rd->splat));
 	/* The AOV film: the same buffer, after the layers (the kernel adds aov_at). */
-	cl_ulong aov_at = r->opt.aov ? aov_offset(r) : 0;
+	cl_ulong aov_at = r->opt.aov ? render_aov_offset(r) : 0;
 	CL_TRY(d, clSetKernelArg(rd->k_render, rd->arg_first + 4, sizeof aov_at, &aov_at));
 	CL_TRY(d, clSetKernelArg(rd->k_render, rd->arg_first + 5, sizeof(cl_mem), &rd->scratch));
 	CL_TRY(d, clFinish(d->queue));
@@ -376,15 +304,11 @@ static ajar_status open_devices(ajar_renderer *r, const char *selector)
 	return AJAR_OK;
 }
 
-static ajar_status job_join(ajar_renderer *r, ajar_status st);
-static ajar_status checkpoint_check(ajar_renderer *r, const Checkpoint *c, const char *path);
-static ajar_status checkpoint_apply(ajar_renderer *r, Checkpoint *c, const char *path);
-
 /* ajar_renderer_create, and ajar_renderer_resume with the checkpoint c read
  * from `path`: refused after the scene is prepared (its hash), before any
  * kernel is built; applied once the films exist. */
-static ajar_status renderer_new(const ajar_scene *scene, const ajar_options *opt, Checkpoint *ck,
-				const char *ck_path, ajar_renderer **out)
+ajar_status renderer_new(const ajar_scene *scene, const ajar_options *opt, Checkpoint *ck,
+			 const char *ck_path, ajar_renderer **out)
 {
 	ajar_status st;
 	ajar_options defaults, resolved;
@@ -429,17 +353,17 @@ static ajar_status renderer_new(const ajar_scene *scene, const ajar_options *opt
 			     (int)opt->mis, opt->min_depth, opt->strategy_len, opt->strategy_unweighted};
 	if ((st = prepare_scene(scene, &po, &r->data)) != AJAR_OK)
 		goto fail;
-	if (ck && (st = checkpoint_check(r, ck, ck_path)) != AJAR_OK)
+	if (ck && (st = render_checkpoint_check(r, ck, ck_path)) != AJAR_OK)
 		goto fail;
 	if ((st = open_devices(r, opt->device)) != AJAR_OK)
 		goto fail;
 	r->film = calloc(3 * (size_t)r->width * r->height, sizeof *r->film);
-	r->film_splat = calloc(splat_count(r), sizeof *r->film_splat);
+	r->film_splat = calloc(render_splat_count(r), sizeof *r->film_splat);
 	if (!r->film || !r->film_splat) {
 		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory for a %ux%u image", r->width, r->height);
 		goto fail;
 	}
-	if (ck && (st = checkpoint_apply(r, ck, ck_path)) != AJAR_OK)
+	if (ck && (st = render_checkpoint_apply(r, ck, ck_path)) != AJAR_OK)
 		goto fail;
 	if ((st = job_join(r, AJAR_OK)) != AJAR_OK)
 		goto joined;
@@ -555,71 +479,6 @@ ajar_status ajar_renderer_device_stats(const ajar_renderer *r, uint32_t index, a
 	return AJAR_OK;
 }
 
-/* ---- Scheduling (all under r->lock) ---------------------------------------- */
-
-static double time_left(const ajar_renderer *r)
-{
-	return r->time_limit > 0 ? r->time_limit - (seconds() - r->t0) : 1e30;
-}
-
-/* Sample indices not yet handed out (UINT64_MAX: no sample target). */
-static uint64_t work_left(const ajar_renderer *r)
-{
-	uint64_t n = r->spp_target ? r->spp_target - r->next_first : UINT64_MAX;
-	for (size_t i = 0; i < r->holes.n && n != UINT64_MAX; i++)
-		n += r->holes.r[i].count;
-	return n;
-}
-
-/* The stop conditions other than running out of work. */
-static int stopping(const ajar_renderer *r)
-{
-	return atomic_load(&r->cancel) || r->out_of_memory || r->job_lost || time_left(r) <= 0;
-}
-
-/* The next range for device rd, or 0 if there is none now. */
-static int take_range(ajar_renderer *r, RenderDevice *rd, Range *g)
-{
-	uint64_t left = work_left(r);
-	if (left == 0 || stopping(r))
-		return 0;
-	uint32_t count = 1;
-	if (rd->per_spp > 0) {
-		count = (uint32_t)fmax(1.0, fmin(fmin(PASS_SECONDS, time_left(r)) / rd->per_spp, 1e6));
-		if (left != UINT64_MAX) {
-			/* Near the end, split the rest by speed; a device not
-			 * measured yet counts as fast as this one. */
-			double rates = 0;
-			for (uint32_t i = 0; i < r->ndev; i++)
-				if (r->devs[i].alive)
-					rates += 1.0 / (r->devs[i].per_spp > 0 ? r->devs[i].per_spp : rd->per_spp);
-			double share = ceil((double)left / (rd->per_spp * rates));
-			if (share < count)
-				count = (uint32_t)share;
-		}
-	}
-	if (r->pass_cap && count > r->pass_cap)
-		count = r->pass_cap;
-	if (r->holes.n) {
-		Range *h = &r->holes.r[r->holes.n - 1];
-		g->first = h->first;
-		g->count = count < h->count ? count : h->count;
-		h->first += g->count;
-		h->count -= g->count;
-		if (h->count == 0)
-			r->holes.n--;
-		return 1;
-	}
-	if (left < count)
-		count = (uint32_t)left;
-	if (count > UINT32_MAX - r->next_first)
-		return 0; /* the sample index space is exhausted */
-	g->first = r->next_first;
-	g->count = count;
-	r->next_first += count;
-	return 1;
-}
-
 /* ---- Device threads ------------------------------------------------------- */
 
 /* The message of a failed call, kept on the device (not err_set: that is
@@ -632,7 +491,7 @@ static int pass_failed(RenderDevice *rd, const char *what, cl_int err)
 
 /* Renders range g on rd; on failure sets *film_ok to whether the film
  * still holds exactly the completed ranges (the kernel never started). */
-static int run_pass(RenderDevice *rd, Range g, int *film_ok)
+int render_run_pass(RenderDevice *rd, Range g, int *film_ok)
 {
 	ajar_renderer *r = rd->r;
 	Device *d = &rd->dev;
@@ -673,7 +532,7 @@ static int run_pass(RenderDevice *rd, Range g, int *film_ok)
 }
 
 /* Reads a device's films into fresh host arrays; 0 if it cannot. */
-static int read_films(RenderDevice *rd, long **accum, long **splat)
+int render_read_films(RenderDevice *rd, long **accum, long **splat)
 {
 	size_t bytes = film_bytes(rd->r), sbytes = splat_bytes(rd->r);
 	*accum = malloc(bytes);
@@ -689,9 +548,9 @@ static int read_films(RenderDevice *rd, long **accum, long **splat)
 }
 
 /* Adds a dropped device's films to the salvage (under the lock); 0 if out of memory. */
-static int salvage_add(ajar_renderer *r, const long *accum, const long *splat)
+int render_salvage_add(ajar_renderer *r, const long *accum, const long *splat)
 {
-	size_t n = 3 * (size_t)r->width * r->height, ns = splat_count(r);
+	size_t n = 3 * (size_t)r->width * r->height, ns = render_splat_count(r);
 	if (!r->salvage) {
 		r->salvage = calloc(n, sizeof *r->salvage);
 		r->salvage_splat = calloc(ns, sizeof *r->salvage_splat);
@@ -711,18 +570,18 @@ static int salvage_add(ajar_renderer *r, const long *accum, const long *splat)
 
 /* Drops rd after its pass g failed (under the lock): g goes back to the
  * pool, and so do its completed ranges unless its film was read back. */
-static void drop_device(ajar_renderer *r, RenderDevice *rd, Range g, const long *accum, const long *splat,
+void render_drop_device(ajar_renderer *r, RenderDevice *rd, Range g, const long *accum, const long *splat,
 			int kept_there)
 {
 	/* kept_there: a device of another rank whose film that rank kept. */
-	int kept = kept_there || (accum && salvage_add(r, accum, splat));
+	int kept = kept_there || (accum && render_salvage_add(r, accum, splat));
 	rd->alive = 0;
 	r->last_dropped = rd;
-	if (!ranges_push(&r->holes, g))
+	if (!range_list_push(&r->holes, g))
 		r->out_of_memory = 1;
 	if (!kept) {
 		for (size_t i = 0; i < rd->done.n; i++)
-			if (!ranges_push(&r->holes, rd->done.r[i]))
+			if (!range_list_push(&r->holes, rd->done.r[i]))
 				r->out_of_memory = 1;
 		r->spp_done -= (uint32_t)rd->spp_kept;
 		rd->spp_kept = 0;
@@ -741,34 +600,34 @@ static void *device_thread(void *arg)
 			pthread_cond_wait(&r->cond, &r->lock);
 			continue;
 		}
-		if (!take_range(r, rd, &g)) {
+		if (!scheduler_take_range(r, rd, &g)) {
 			/* A pass in flight elsewhere may still fail and return its range. */
-			if (r->in_flight == 0 || stopping(r))
+			if (r->in_flight == 0 || scheduler_stopping(r))
 				break;
 			pthread_cond_wait(&r->cond, &r->lock);
 			continue;
 		}
 		r->in_flight++;
 		pthread_mutex_unlock(&r->lock);
-		double tp = seconds();
+		double tp = render_seconds();
 		int film_ok;
-		int ok = run_pass(rd, g, &film_ok);
-		double dt = seconds() - tp;
+		int ok = render_run_pass(rd, g, &film_ok);
+		double dt = render_seconds() - tp;
 		long *accum = NULL, *splat = NULL;
 		if (!ok && film_ok)
-			read_films(rd, &accum, &splat);
+			render_read_films(rd, &accum, &splat);
 		pthread_mutex_lock(&r->lock);
 		r->in_flight--;
 		r->events++;
 		if (ok) {
-			if (!ranges_push(&rd->done, g))
+			if (!range_list_push(&rd->done, g))
 				r->out_of_memory = 1;
 			rd->spp_kept += g.count;
 			rd->busy_seconds += dt;
 			rd->per_spp = dt / g.count;
 			r->spp_done += g.count;
 		} else {
-			drop_device(r, rd, g, accum, splat, 0);
+			render_drop_device(r, rd, g, accum, splat, 0);
 		}
 		free(accum);
 		free(splat);
@@ -805,7 +664,7 @@ static void device_shares(const ajar_renderer *r, char *buf, size_t cap)
 
 static void fill_progress(const ajar_renderer *r, ajar_progress *p)
 {
-	double elapsed = seconds() - r->t0, rate = 0; /* sample indices per second */
+	double elapsed = render_seconds() - r->t0, rate = 0; /* sample indices per second */
 	memset(p, 0, sizeof *p);
 	for (uint32_t i = 0; i < r->ndev; i++)
 		if (r->devs[i].alive && r->devs[i].per_spp > 0)
@@ -849,11 +708,7 @@ static int report_drops(ajar_renderer *r)
 	return drops;
 }
 
-static void checkpoint_during(ajar_renderer *r);
-
 static ajar_status render_run(ajar_renderer *r, ajar_progress_fn fn, void *user);
-static ajar_status job_serve(ajar_renderer *r);
-static ajar_status job_end(ajar_renderer *r, ajar_status st);
 
 ajar_status ajar_renderer_render(ajar_renderer *r, ajar_progress_fn fn, void *user)
 {
@@ -865,13 +720,11 @@ ajar_status ajar_renderer_render(ajar_renderer *r, ajar_progress_fn fn, void *us
 	return cluster_size() > 1 ? job_end(r, st) : st;
 }
 
-static void *job_proxy_thread(void *arg);
-
 static ajar_status render_run(ajar_renderer *r, ajar_progress_fn fn, void *user)
 {
 	pthread_mutex_lock(&r->lock);
-	r->t0 = seconds() - r->elapsed;
-	r->ckpt_last = seconds();
+	r->t0 = render_seconds() - r->elapsed;
+	r->ckpt_last = render_seconds();
 	r->running = 0;
 	for (uint32_t i = 0; i < r->ndev; i++) {
 		RenderDevice *rd = &r->devs[i];
@@ -884,7 +737,7 @@ static ajar_status render_run(ajar_renderer *r, ajar_progress_fn fn, void *user)
 		pthread_mutex_unlock(&r->lock);
 		return err_set(AJAR_ERROR_DEVICE, "no OpenCL device left (the last failed: %s)", r->last_dropped->error);
 	}
-	if (r->running == 0 && work_left(r) > 0 && !atomic_load(&r->cancel)) {
+	if (r->running == 0 && scheduler_work_left(r) > 0 && !atomic_load(&r->cancel)) {
 		pthread_mutex_unlock(&r->lock);
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "cannot start a render thread");
 	}
@@ -904,9 +757,9 @@ static ajar_status render_run(ajar_renderer *r, ajar_progress_fn fn, void *user)
 			ajar_renderer_cancel(r);
 		pthread_mutex_lock(&r->lock);
 		/* After a cancel the caller writes the last checkpoint itself. */
-		if (r->ckpt_path && !stopping(r) && work_left(r) > 0 &&
-		    (dropped || seconds() - r->ckpt_last >= r->ckpt_every))
-			checkpoint_during(r);
+		if (r->ckpt_path && !scheduler_stopping(r) && scheduler_work_left(r) > 0 &&
+		    (dropped || render_seconds() - r->ckpt_last >= r->ckpt_every))
+			render_checkpoint_during(r);
 		pthread_cond_broadcast(&r->cond); /* wakes idle devices after a cancel */
 	}
 	pthread_mutex_unlock(&r->lock);
@@ -915,7 +768,7 @@ static ajar_status render_run(ajar_renderer *r, ajar_progress_fn fn, void *user)
 			pthread_join(r->devs[i].thread, NULL);
 			r->devs[i].started = 0;
 		}
-	r->elapsed = seconds() - r->t0;
+	r->elapsed = render_seconds() - r->t0;
 	report_drops(r);
 	if (r->ndev > 1) {
 		char shares[2048];
@@ -926,7 +779,7 @@ static ajar_status render_run(ajar_renderer *r, ajar_progress_fn fn, void *user)
 	uint32_t alive = 0;
 	for (uint32_t i = 0; i < r->ndev; i++)
 		alive += (uint32_t)r->devs[i].alive;
-	uint64_t left = work_left(r);
+	uint64_t left = scheduler_work_left(r);
 	if (r->out_of_memory)
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory while scheduling passes");
 	if (alive == 0 && left > 0) {
@@ -936,14 +789,12 @@ static ajar_status render_run(ajar_renderer *r, ajar_progress_fn fn, void *user)
 			       "rendered before",
 			       rd->dev.name, rd->dev.selector, rd->error, r->spp_done);
 	}
-	if (left > 0 && time_left(r) > 0 && atomic_load(&r->cancel))
+	if (left > 0 && scheduler_time_left(r) > 0 && atomic_load(&r->cancel))
 		return err_set(AJAR_ERROR_CANCELLED, "render cancelled after %u samples per pixel", r->spp_done);
 	return AJAR_OK;
 }
 
 /* ---- Reduction and output --------------------------------------------------- */
-
-static ajar_status reduce(ajar_renderer *r);
 
 ajar_status ajar_renderer_image(ajar_renderer *r, float *rgba, uint32_t *width, uint32_t *height)
 {
@@ -955,7 +806,7 @@ ajar_status ajar_renderer_image(ajar_renderer *r, float *rgba, uint32_t *width, 
 		*height = r->height;
 	if (!rgba)
 		return AJAR_OK;
-	ajar_status st = reduce(r);
+	ajar_status st = render_reduce(r);
 	if (st != AJAR_OK)
 		return st;
 	size_t n = 3 * (size_t)r->width * r->height;
@@ -975,11 +826,11 @@ ajar_status ajar_renderer_aovs(ajar_renderer *r, float *px)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_aovs: NULL argument");
 	if (!r->opt.aov)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "the renderer keeps no AOVs (set ajar_options.aov)");
-	ajar_status st = reduce(r);
+	ajar_status st = render_reduce(r);
 	if (st != AJAR_OK)
 		return st;
 	size_t npix = (size_t)r->width * r->height;
-	const long *a = r->film_splat + aov_offset(r);
+	const long *a = r->film_splat + render_aov_offset(r);
 	double n = r->spp_done, inv = n > 0 ? 1.0 / ((double)FILM_SCALE * n) : 0.0;
 	double inv_sq = n > 0 ? 1.0 / ((double)AOV_SQ_SCALE * n) : 0.0;
 	static const uint32_t bit[AOV_CHANNELS] = {AJAR_AOV_ALBEDO, AJAR_AOV_ALBEDO, AJAR_AOV_ALBEDO,
@@ -1004,9 +855,9 @@ ajar_status ajar_renderer_aovs(ajar_renderer *r, float *px)
 
 /* Sums the salvage and every live device's films into r->film and
  * r->film_splat: integer sums, the same bits whatever the device count. */
-static ajar_status reduce(ajar_renderer *r)
+ajar_status render_reduce(ajar_renderer *r)
 {
-	size_t n = 3 * (size_t)r->width * r->height, ns = splat_count(r);
+	size_t n = 3 * (size_t)r->width * r->height, ns = render_splat_count(r);
 	long *sum = r->film, *sum_splat = r->film_splat;
 	if (r->job_lost)
 		return err_set(AJAR_ERROR_DEVICE, "a rank of the job stopped answering: the films of the job cannot be "
@@ -1030,7 +881,7 @@ static ajar_status reduce(ajar_renderer *r)
 		long *a, *s;
 		if (!rd->alive || rd->rank) /* another rank's films are in r->remote */
 			continue;
-		if (!read_films(rd, &a, &s))
+		if (!render_read_films(rd, &a, &s))
 			return err_set(AJAR_ERROR_DEVICE, "OpenCL device %s: reading the film back failed",
 				       rd->dev.name);
 		for (size_t i = 0; i < n; i++)
@@ -1071,747 +922,4 @@ void render_info(const ajar_renderer *r, RenderInfo *info)
 ajar_status ajar_devices(ajar_device_info *out, uint32_t capacity, uint32_t *count)
 {
 	return device_list(out, capacity, count);
-}
-
-/* ---- Checkpoints ------------------------------------------------------------
- * A checkpoint holds the reduced integer films and the sample ranges they
- * hold. Resumed, the films become the salvage (the host part every image
- * adds), the ranges the base, and the gaps below the highest range go back
- * to the pool, so the continued render hands out exactly the sample indices
- * an uninterrupted one would have: the sums, and so the image, are the same
- * bits. The scene hash covers the prepared arrays (what the kernels read:
- * geometry, materials, textures, environment, light tables), the params
- * hash the kernels' parameters (options and derived rates). */
-
-static void ensure_hashes(ajar_renderer *r)
-{
-	if (r->hashed)
-		return;
-	const SceneData *d = &r->data;
-	uint64_t h = 0;
-#define AJAR_HASH_FIELD(type, name) \
-	if ((void *)d->name != (void *)d->params) \
-		h = checkpoint_hash(h, d->name, sizeof(type) * d->n_##name);
-	AJAR_SCENE_BUFFERS(AJAR_HASH_FIELD)
-#undef AJAR_HASH_FIELD
-	r->scene_hash = h;
-	r->params_hash = checkpoint_hash(0, d->params, sizeof *d->params);
-	r->hashed = 1;
-}
-
-static int range_before(const void *a, const void *b)
-{
-	const Range *x = a, *y = b;
-	return x->first < y->first ? -1 : x->first > y->first;
-}
-
-/* The checkpoint of r now (films reduced; c->ranges malloc'ed, the films
- * borrowed from r). Devices must be idle. */
-static ajar_status checkpoint_gather(ajar_renderer *r, Checkpoint *c)
-{
-	memset(c, 0, sizeof *c);
-	ajar_status st = reduce(r);
-	if (st != AJAR_OK)
-		return st;
-	ensure_hashes(r);
-	snprintf(c->version, sizeof c->version, "%s", AJAR_VERSION_STRING);
-	snprintf(c->scene, sizeof c->scene, "%s", r->scene_name);
-	c->scene_hash = r->scene_hash;
-	c->params_hash = r->params_hash;
-	const ajar_options *o = &r->opt;
-	c->width = r->width;
-	c->height = r->height;
-	c->integrator = (uint32_t)o->integrator;
-	c->max_depth = o->max_depth;
-	c->min_depth = o->min_depth;
-	c->seed = r->seed;
-	c->mis = (uint32_t)o->mis;
-	c->strategy_len = o->strategy_len;
-	c->strategy_unweighted = (uint32_t)o->strategy_unweighted;
-	c->spp = r->spp_target;
-	c->aov = o->aov;
-	c->time_limit = r->time_limit;
-	c->elapsed = r->elapsed;
-	size_t n = r->base.n;
-	for (uint32_t i = 0; i < r->ndev; i++)
-		n += r->devs[i].done.n;
-	c->ranges = malloc(sizeof *c->ranges * (n ? n : 1));
-	if (!c->ranges)
-		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory for a checkpoint");
-	if (r->base.n) /* memcpy from NULL is undefined even for 0 bytes (UBSan) */
-		memcpy(c->ranges, r->base.r, sizeof *c->ranges * r->base.n);
-	n = r->base.n;
-	for (uint32_t i = 0; i < r->ndev; i++) {
-		if (r->devs[i].done.n)
-			memcpy(c->ranges + n, r->devs[i].done.r, sizeof *c->ranges * r->devs[i].done.n);
-		n += r->devs[i].done.n;
-	}
-	qsort(c->ranges, n, sizeof *c->ranges, range_before);
-	uint64_t total = 0;
-	c->nranges = 0;
-	for (size_t i = 0; i < n; i++) {
-		Range *last = c->nranges ? &c->ranges[c->nranges - 1] : NULL;
-		total += c->ranges[i].count;
-		if (last && last->first + last->count == c->ranges[i].first)
-			last->count += c->ranges[i].count;
-		else
-			c->ranges[c->nranges++] = c->ranges[i];
-	}
-	if (total != r->spp_done) { /* every sample index in the films is in exactly one range */
-		free(c->ranges);
-		c->ranges = NULL;
-		return err_set(AJAR_ERROR_DEVICE, "checkpoint: the films hold %u samples per pixel, the ranges %llu",
-			       r->spp_done, (unsigned long long)total);
-	}
-	c->film[CKPT_ACCUM] = r->film;
-	c->nfilm[CKPT_ACCUM] = 3 * (size_t)r->width * r->height;
-	c->film[CKPT_SPLAT] = r->film_splat;
-	c->nfilm[CKPT_SPLAT] = aov_offset(r);
-	c->film[CKPT_AOV] = r->film_splat + aov_offset(r);
-	c->nfilm[CKPT_AOV] = splat_count(r) - aov_offset(r);
-	return AJAR_OK;
-}
-
-static ajar_status write_checkpoint(ajar_renderer *r, const char *path)
-{
-	Checkpoint c;
-	ajar_status st = checkpoint_gather(r, &c);
-	if (st == AJAR_OK)
-		st = checkpoint_write(path, &c);
-	free(c.ranges);
-	return st;
-}
-
-ajar_status ajar_renderer_write_checkpoint(ajar_renderer *r, const char *path)
-{
-	if (!r || !path || !path[0])
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_write_checkpoint: NULL argument");
-	return write_checkpoint(r, path);
-}
-
-/* From the render loop, under the lock: waits until no pass is in flight,
- * sums the films, lets the devices go on and writes the file meanwhile
- * (the sums are the main thread's own arrays). A failed write keeps the
- * previous file. */
-static ajar_status job_gather(ajar_renderer *r);
-
-static void checkpoint_during(ajar_renderer *r)
-{
-	r->pausing = 1;
-	while (r->in_flight > 0)
-		pthread_cond_wait(&r->cond, &r->lock);
-	pthread_mutex_unlock(&r->lock);
-	r->elapsed = seconds() - r->t0;
-	Checkpoint c;
-	memset(&c, 0, sizeof c);
-	ajar_status st = cluster_size() > 1 ? job_gather(r) : AJAR_OK;
-	if (st == AJAR_OK)
-		st = checkpoint_gather(r, &c);
-	pthread_mutex_lock(&r->lock);
-	r->pausing = 0;
-	pthread_cond_broadcast(&r->cond);
-	pthread_mutex_unlock(&r->lock);
-	if (st == AJAR_OK)
-		st = checkpoint_write(r->ckpt_path, &c);
-	free(c.ranges);
-	if (st != AJAR_OK)
-		log_msg(AJAR_LOG_WARNING, "checkpoint not written (the previous one is kept): %s", ajar_last_error());
-	r->ckpt_last = seconds();
-	pthread_mutex_lock(&r->lock);
-}
-
-ajar_status ajar_renderer_set_checkpoint(ajar_renderer *r, const char *path, double every)
-{
-	if (!r)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_set_checkpoint: renderer is NULL");
-	if (!(every >= 0) || every > 1e9)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "checkpoint interval %g s: must be 0 or more", every);
-	char *p = path && path[0] ? strdup(path) : NULL;
-	if (path && path[0] && !p)
-		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory");
-	free(r->ckpt_path);
-	r->ckpt_path = p;
-	r->ckpt_every = every > 0 ? every : 1e30;
-	return AJAR_OK;
-}
-
-static void options_from_checkpoint(const Checkpoint *c, ajar_options *o)
-{
-	ajar_options_default(o);
-	o->width = c->width;
-	o->height = c->height;
-	o->spp = c->spp;
-	o->time_limit = c->time_limit;
-	o->integrator = (ajar_integrator)c->integrator;
-	o->max_depth = c->max_depth;
-	o->min_depth = c->min_depth;
-	o->seed = c->seed;
-	o->mis = (ajar_mis)c->mis;
-	o->strategy_len = c->strategy_len;
-	o->strategy_unweighted = (int)c->strategy_unweighted;
-	o->aov = c->aov;
-}
-
-ajar_status ajar_checkpoint_options(const char *path, ajar_options *o, uint32_t *spp_done)
-{
-	if (!path || !o)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_checkpoint_options: NULL argument");
-	Checkpoint c;
-	ajar_status st = checkpoint_read(path, &c, spp_done == NULL);
-	if (st != AJAR_OK)
-		return st;
-	options_from_checkpoint(&c, o);
-	if (spp_done) {
-		uint64_t n = 0;
-		for (uint32_t i = 0; i < c.nranges; i++)
-			n += c.ranges[i].count;
-		*spp_done = (uint32_t)n;
-	}
-	checkpoint_free(&c);
-	return AJAR_OK;
-}
-
-static ajar_status checkpoint_check(ajar_renderer *r, const Checkpoint *c, const char *path)
-{
-	ensure_hashes(r);
-	if (c->scene_hash != r->scene_hash)
-		return err_set(AJAR_ERROR_BAD_INPUT,
-			       "%s: checkpoint is of another scene (it was made from %s, and this scene differs from it); "
-			       "it cannot be resumed here",
-			       path, c->scene[0] ? c->scene : "?");
-	if (c->params_hash != r->params_hash)
-		return err_set(AJAR_ERROR_BAD_INPUT,
-			       "%s: checkpoint was made with other render parameters (the options agree, so an "
-			       "environment variable such as AJAR_PORTAL_RATE differs); it cannot be resumed here",
-			       path);
-	return AJAR_OK;
-}
-
-static ajar_status checkpoint_apply(ajar_renderer *r, Checkpoint *c, const char *path)
-{
-	size_t n = 3 * (size_t)r->width * r->height, ns = aov_offset(r);
-	if (c->nfilm[CKPT_ACCUM] != n || c->nfilm[CKPT_SPLAT] != ns || c->nfilm[CKPT_AOV] != splat_count(r) - ns)
-		return err_set(AJAR_ERROR_BAD_INPUT, "%s: checkpoint is corrupted (film sizes)", path);
-	long *splat = realloc(c->film[CKPT_SPLAT], sizeof *splat * (splat_count(r) ? splat_count(r) : 1));
-	if (!splat)
-		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory");
-	memcpy(splat + ns, c->film[CKPT_AOV], sizeof *splat * (splat_count(r) - ns));
-	c->film[CKPT_SPLAT] = splat;
-	uint32_t end = 0;
-	uint64_t done = 0;
-	for (uint32_t i = 0; i < c->nranges; i++) {
-		Range g = c->ranges[i];
-		if (g.first > end && !ranges_push(&r->holes, (Range){end, g.first - end}))
-			return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory");
-		if (!ranges_push(&r->base, g))
-			return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory");
-		end = g.first + g.count;
-		done += g.count;
-	}
-	if (r->spp_target && r->spp_target < end)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT,
-			       "%s: the checkpoint holds %llu samples per pixel (indices up to %u); a sample count of %u "
-			       "is too few to continue it",
-			       path, (unsigned long long)done, end, r->spp_target);
-	r->salvage = c->film[CKPT_ACCUM];
-	r->salvage_splat = c->film[CKPT_SPLAT];
-	c->film[CKPT_ACCUM] = c->film[CKPT_SPLAT] = NULL;
-	r->spp_done = (uint32_t)done;
-	r->next_first = end;
-	r->elapsed = c->elapsed;
-	return AJAR_OK;
-}
-
-static ajar_status resume_options(ajar_options *want, const ajar_options *o, const char *path);
-static ajar_status job_resume(const ajar_scene *scene, const char *path, const ajar_options *o,
-			      ajar_renderer **out);
-
-ajar_status ajar_renderer_resume(const ajar_scene *scene, const char *path, const ajar_options *o,
-				 ajar_renderer **out)
-{
-	if (!out)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_resume: out is NULL");
-	*out = NULL;
-	if (!scene || !path)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_resume: NULL argument");
-	if (cluster_size() > 1)
-		return job_resume(scene, path, o, out);
-	Checkpoint c;
-	ajar_status st = checkpoint_read(path, &c, 0);
-	if (st != AJAR_OK)
-		return st;
-	ajar_options want;
-	options_from_checkpoint(&c, &want);
-	if ((st = resume_options(&want, o, path)) != AJAR_OK) {
-		checkpoint_free(&c);
-		return st;
-	}
-	st = renderer_new(scene, &want, &c, path, out);
-	checkpoint_free(&c);
-	return st;
-}
-
-/* The options of a resumed render: the checkpoint's (want), with the
- * budget and the devices of o if o is not NULL; anything else in o must
- * agree with the checkpoint. */
-static ajar_status resume_options(ajar_options *want, const ajar_options *o, const char *path)
-{
-	if (o) {
-		/* Only the budget and the devices may change. */
-		const char *differs = o->width != want->width || o->height != want->height ? "width/height"
-				      : o->integrator != want->integrator			 ? "integrator"
-				      : o->max_depth != want->max_depth			 ? "max_depth"
-				      : o->min_depth != want->min_depth			 ? "min_depth"
-				      : o->seed != want->seed				 ? "seed"
-				      : o->mis != want->mis				 ? "mis"
-				      : o->strategy_len != want->strategy_len		 ? "strategy_len"
-				      : o->strategy_unweighted != want->strategy_unweighted ? "strategy_unweighted"
-				      : o->aov != want->aov				 ? "aov"
-											   : NULL;
-		if (differs)
-			return err_set(AJAR_ERROR_INVALID_ARGUMENT,
-				       "%s: options.%s differs from the checkpoint's (only spp, time_limit and device "
-				       "may change when resuming)",
-				       path, differs);
-		want->spp = o->spp;
-		want->time_limit = o->time_limit;
-		want->device = o->device;
-	}
-	return AJAR_OK;
-}
-
-/* ---- Several machines (Open MPI) --------------------------------------------
- * Under mpirun every rank creates the same renderer on its own devices
- * (job_join checks they prepared the same scene and tells every rank of a
- * failure anywhere). Rank 0 adds one device per device of the other ranks
- * to its scheduler, each driven by a proxy thread (job_proxy_thread) that
- * takes ranges with take_range like a device thread, sends them to that
- * rank and counts them done when the answer comes: the dealing by measured
- * speed, the time limit, cancels, checkpoints and device failures are rank
- * 0's, exactly as for its own devices. The other ranks serve (job_serve):
- * they render the ranges they are sent, and on a gather (at a checkpoint
- * and at the end) sum their films into rank 0's `remote` films with an MPI
- * reduction. Every sum is of integers, so the image is the same bits as
- * one process that rendered the same sample indices. A device that fails
- * on another rank is dropped like a local one (that rank keeps its film
- * when it can, as the salvage does here). A rank that stops answering
- * (killed; mpirun then stops the whole job) cannot be summed: the render
- * ends with an error and nothing but the last checkpoint is kept. */
-
-enum { JOB_PASS = 1, JOB_GATHER, JOB_END };
-/* TAG_PASS, TAG_DONE and TAG_WHY + the device's index on its rank */
-enum { TAG_CMD = 1, TAG_GATHERED = 2, TAG_GATHER_WHY = 3, TAG_PASS = 1000, TAG_DONE = 2000, TAG_WHY = 3000 };
-
-typedef struct {
-	uint32_t op, device, first, count; /* JOB_END: `first` is rank 0's status */
-} JobCmd; /* TAG_CMD, and TAG_PASS + device straight to the device's thread */
-
-/* Kept small: Open MPI's shared-memory transport delivers a message of a
- * few dozen bytes at once, while one of a KiB waited for the receiver's
- * next poll (measured: 6 ms of a device's idle time per range, 0.02 ms
- * with this size). A failure's message follows as a JobWhy. */
-typedef struct {
-	int32_t ok, kept; /* the pass rendered; else whether the rank kept the film */
-	double idle;      /* seconds the device waited for this range since its previous one ended (-1: first) */
-} JobDone;
-
-typedef struct {
-	char text[1024];
-} JobWhy;
-
-typedef struct {
-	int32_t status;
-	uint32_t ndev, width, height;
-	uint64_t scene_hash, params_hash;
-	char host[64];
-	char error[1024];
-	char name[MAX_RENDER_DEVICES][256];
-	char selector[MAX_RENDER_DEVICES][16];
-} JobHello;
-
-static ajar_status job_join(ajar_renderer *r, ajar_status st)
-{
-	int size = cluster_size(), me = cluster_rank();
-	if (size <= 1)
-		return st;
-	JobHello *all = calloc((size_t)size + 1, sizeof *all), *mine = all + size;
-	if (!all)
-		return st != AJAR_OK ? st : err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory");
-	mine->status = (int32_t)st;
-	snprintf(mine->host, sizeof mine->host, "%s", cluster_host());
-	if (st != AJAR_OK) {
-		snprintf(mine->error, sizeof mine->error, "%s", ajar_last_error());
-	} else {
-		ensure_hashes(r);
-		mine->scene_hash = r->scene_hash;
-		mine->params_hash = r->params_hash;
-		mine->width = r->width;
-		mine->height = r->height;
-		mine->ndev = r->ndev;
-		for (uint32_t i = 0; i < r->ndev; i++) {
-			snprintf(mine->name[i], sizeof mine->name[i], "%.255s", r->devs[i].dev.name);
-			snprintf(mine->selector[i], sizeof mine->selector[i], "%.15s", r->devs[i].dev.selector);
-		}
-	}
-	if (cluster_allgather(mine, all, sizeof *mine, NULL) != 1) {
-		free(all);
-		return st != AJAR_OK ? st : AJAR_ERROR_DEVICE;
-	}
-	for (int k = 0; k < size && st == AJAR_OK; k++)
-		if (all[k].status != AJAR_OK)
-			st = err_set((ajar_status)all[k].status, "rank %d (%s): %s", k, all[k].host, all[k].error);
-	for (int k = 1; k < size && st == AJAR_OK; k++)
-		if (all[k].scene_hash != all[0].scene_hash || all[k].params_hash != all[0].params_hash ||
-		    all[k].width != all[0].width || all[k].height != all[0].height)
-			st = err_set(AJAR_ERROR_BAD_INPUT,
-				     "rank %d (%s) prepared another scene or other options than rank 0 (%s): every rank "
-				     "must read the same scene files with the same options",
-				     k, all[k].host, all[0].host);
-	uint32_t total = r->ndev;
-	for (int k = 1; k < size; k++)
-		total += all[k].ndev;
-	RenderDevice *devs = st == AJAR_OK && me == 0 ? realloc(r->devs, sizeof *devs * total) : NULL;
-	if (st == AJAR_OK && me == 0 && !devs)
-		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory");
-	if (st == AJAR_OK && me == 0) {
-		/* Rank 0 deals to every device of every rank. */
-		r->devs = devs;
-		memset(devs + r->ndev, 0, sizeof *devs * (total - r->ndev));
-		size_t len = 0;
-		for (uint32_t i = 0; i < r->ndev; i++) {
-			snprintf(devs[i].dev.selector, sizeof devs[i].dev.selector, "rank 0, %s", all[0].selector[i]);
-			len += (size_t)snprintf(r->device_names + len, sizeof r->device_names - len, "%s%s (%s)",
-						i ? " + " : "", devs[i].dev.name, devs[i].dev.selector);
-		}
-		for (int k = 1; k < size; k++)
-			for (uint32_t j = 0; j < all[k].ndev; j++) {
-				RenderDevice *rd = &devs[r->ndev++];
-				rd->r = r;
-				rd->alive = 1;
-				rd->rank = k;
-				rd->remote = j;
-				snprintf(rd->dev.name, sizeof rd->dev.name, "%s", all[k].name[j]);
-				snprintf(rd->dev.selector, sizeof rd->dev.selector, "rank %d, %s", k % 100000, all[k].selector[j]);
-				if (len < sizeof r->device_names)
-					len += (size_t)snprintf(r->device_names + len, sizeof r->device_names - len, " + %s (%s)",
-								rd->dev.name, rd->dev.selector);
-			}
-	}
-	free(all);
-	return st;
-}
-
-/* Rank 0: the options of a resumed job come from the checkpoint, read
- * here only; the other ranks receive them (they need no copy of the file). */
-static ajar_status job_resume(const ajar_scene *scene, const char *path, const ajar_options *o,
-			      ajar_renderer **out)
-{
-	struct {
-		int32_t status;
-		char error[1024];
-		ajar_options want;
-	} msg;
-	memset(&msg, 0, sizeof msg);
-	Checkpoint c;
-	int have = 0;
-	ajar_status st = AJAR_OK;
-	if (cluster_rank() == 0) {
-		st = checkpoint_read(path, &c, 0);
-		have = st == AJAR_OK;
-		if (have) {
-			options_from_checkpoint(&c, &msg.want);
-			st = resume_options(&msg.want, o, path);
-		}
-		msg.status = (int32_t)st;
-		if (st != AJAR_OK)
-			snprintf(msg.error, sizeof msg.error, "%s", ajar_last_error());
-		msg.want.device = NULL;
-	}
-	if (cluster_bcast(&msg, sizeof msg, NULL) != 1) {
-		if (have)
-			checkpoint_free(&c);
-		return AJAR_ERROR_DEVICE;
-	}
-	msg.want.device = o ? o->device : NULL;
-	if (msg.status != AJAR_OK) {
-		if (have)
-			checkpoint_free(&c);
-		return cluster_rank() == 0 ? st : err_set((ajar_status)msg.status, "rank 0: %s", msg.error);
-	}
-	st = renderer_new(scene, &msg.want, have ? &c : NULL, have ? path : NULL, out);
-	if (have)
-		checkpoint_free(&c);
-	return st;
-}
-
-/* Rank 0: the thread of a device of another rank. It keeps two ranges
- * there (PIPELINE): the device starts the next as soon as it ends one, so
- * the messages' latency is hidden. The speed is measured from one end of
- * a pass to the next (or from the send, when the device was idle). A
- * failure there comes back with whether the rank kept the device's film;
- * the range queued behind it comes back unrendered. */
-#define PIPELINE 2
-
-static void *job_proxy_thread(void *arg)
-{
-	RenderDevice *rd = arg;
-	ajar_renderer *r = rd->r;
-	Range q[PIPELINE];
-	double sent[PIPELINE], last = 0;
-	int nq = 0, tag_pass = TAG_PASS + (int)rd->remote, tag_done = TAG_DONE + (int)rd->remote,
-	    tag_why = TAG_WHY + (int)rd->remote;
-	pthread_mutex_lock(&r->lock);
-	for (;;) {
-		int lost = 0;
-		while (nq < PIPELINE && !r->pausing && take_range(r, rd, &q[nq])) {
-			r->in_flight++;
-			JobCmd c = {JOB_PASS, rd->remote, q[nq].first, q[nq].count};
-			pthread_mutex_unlock(&r->lock);
-			lost = cluster_send(rd->rank, tag_pass, &c, sizeof c) != 1;
-			sent[nq++] = seconds();
-			pthread_mutex_lock(&r->lock);
-			if (lost)
-				break;
-		}
-		if (nq == 0) {
-			if (!r->pausing && (r->in_flight == 0 || stopping(r)))
-				break;
-			pthread_cond_wait(&r->cond, &r->lock); /* a checkpoint, or a range may come back */
-			continue;
-		}
-		pthread_mutex_unlock(&r->lock);
-		JobDone d;
-		int rc = lost ? -1 : cluster_recv(rd->rank, tag_done, &d, sizeof d, NULL, NULL, &r->cancel);
-		double t = seconds(), start = fmax(sent[0], last);
-		pthread_mutex_lock(&r->lock);
-		Range g = q[0];
-		for (int k = 1; k < nq; k++)
-			q[k - 1] = q[k], sent[k - 1] = sent[k];
-		nq--;
-		r->in_flight--;
-		r->events++;
-		if (rc == 1 && d.ok) {
-			if (!ranges_push(&rd->done, g))
-				r->out_of_memory = 1;
-			rd->spp_kept += g.count;
-			rd->busy_seconds += t - start;
-			rd->per_spp = (t - start) / g.count;
-			r->spp_done += g.count;
-			if (d.idle >= 0) {
-				rd->job_ranges++;
-				rd->job_idle += d.idle;
-			}
-			last = t;
-			pthread_cond_broadcast(&r->cond);
-			continue;
-		}
-		if (rc == 1) {
-			JobWhy why = {"?"};
-			pthread_mutex_unlock(&r->lock);
-			rc = cluster_recv(rd->rank, tag_why, &why, sizeof why, NULL, NULL, &r->cancel);
-			pthread_mutex_lock(&r->lock);
-			why.text[sizeof why.text - 1] = '\0';
-			snprintf(rd->error, sizeof rd->error, "%s", why.text);
-		}
-		if (rc != 1) {
-			snprintf(rd->error, sizeof rd->error, "rank %d stopped answering%s%s", rd->rank,
-				 rc < 0 ? ": " : " (killed, or its machine failed)", rc < 0 ? ajar_last_error() : "");
-			if (!r->job_lost)
-				r->job_lost = rd->rank;
-		}
-		drop_device(r, rd, g, NULL, NULL, rc == 1 && d.kept);
-		for (int k = 0; k < nq; k++) { /* queued there, never rendered */
-			if (!ranges_push(&r->holes, q[k]))
-				r->out_of_memory = 1;
-			r->in_flight--;
-		}
-		if (rc == 1 && nq) { /* their answers, so no message is left behind */
-			pthread_mutex_unlock(&r->lock);
-			JobWhy why;
-			for (int k = 0; k < nq; k++)
-				if (cluster_recv(rd->rank, tag_done, &d, sizeof d, NULL, NULL, &r->cancel) == 1 && !d.ok)
-					cluster_recv(rd->rank, tag_why, &why, sizeof why, NULL, NULL, &r->cancel);
-			pthread_mutex_lock(&r->lock);
-		}
-		pthread_cond_broadcast(&r->cond);
-		break;
-	}
-	r->running--;
-	pthread_cond_broadcast(&r->cond);
-	pthread_mutex_unlock(&r->lock);
-	return NULL;
-}
-
-/* Rank 0: the other ranks' films summed into r->remote. */
-static ajar_status job_gather(ajar_renderer *r)
-{
-	size_t n = 3 * (size_t)r->width * r->height, ns = splat_count(r);
-	if (!r->remote) {
-		r->remote = calloc(n ? n : 1, sizeof *r->remote);
-		r->remote_splat = calloc(ns ? ns : 1, sizeof *r->remote_splat);
-		if (!r->remote || !r->remote_splat)
-			return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory for the other ranks' films");
-	}
-	memset(r->remote, 0, n * sizeof *r->remote);
-	memset(r->remote_splat, 0, ns * sizeof *r->remote_splat);
-	JobCmd c = {JOB_GATHER, 0, 0, 0};
-	int rc = 1;
-	for (int k = 1; k < cluster_size() && rc == 1; k++)
-		rc = cluster_send(k, TAG_CMD, &c, sizeof c);
-	if (rc == 1)
-		rc = cluster_sum(r->remote, n, &r->cancel);
-	if (rc == 1)
-		rc = cluster_sum(r->remote_splat, ns, &r->cancel);
-	/* Each rank says whether its films could be read. */
-	for (int k = 1; k < cluster_size() && rc == 1; k++) {
-		JobDone d;
-		JobWhy why = {"?"};
-		rc = cluster_recv(k, TAG_GATHERED, &d, sizeof d, NULL, NULL, &r->cancel);
-		if (rc == 1 && !d.ok) {
-			cluster_recv(k, TAG_GATHER_WHY, &why, sizeof why, NULL, NULL, &r->cancel);
-			why.text[sizeof why.text - 1] = '\0';
-			memset(r->remote, 0, n * sizeof *r->remote);
-			return err_set(AJAR_ERROR_DEVICE, "rank %d: %s", k, why.text);
-		}
-	}
-	if (rc == 1)
-		return AJAR_OK;
-	if (rc == 0)
-		r->job_lost = -1;
-	/* The films are incomplete: nothing may be written from them. */
-	memset(r->remote, 0, n * sizeof *r->remote);
-	return err_set(AJAR_ERROR_DEVICE, "summing the other ranks' films failed: %s",
-		       rc < 0 ? ajar_last_error() : "a rank stopped answering (killed, or its machine failed)");
-}
-
-/* Rank 0, after its render loop: the last gather, and the other ranks
- * told to stop. */
-static ajar_status job_end(ajar_renderer *r, ajar_status st)
-{
-	if (r->job_lost) {
-		/* No reduction can complete: mpirun ends the job. */
-		char why[1024] = "";
-		for (uint32_t i = 0; i < r->ndev; i++)
-			if (r->devs[i].rank == r->job_lost)
-				snprintf(why, sizeof why, "%s", r->devs[i].error);
-		free(r->remote);
-		free(r->remote_splat);
-		r->remote = r->remote_splat = NULL;
-		return err_set(AJAR_ERROR_DEVICE,
-			       "%s; the job cannot be finished: no image is written%s", why[0] ? why : "a rank stopped answering",
-			       r->ckpt_path ? " and the last checkpoint is kept" : "");
-	}
-	char msg[1024];
-	snprintf(msg, sizeof msg, "%s", ajar_last_error());
-	ajar_status g = job_gather(r);
-	JobCmd c = {JOB_END, 0, (uint32_t)st, 0};
-	for (int k = 1; k < cluster_size() && g == AJAR_OK; k++)
-		if (cluster_send(k, TAG_CMD, &c, sizeof c) != 1)
-			g = AJAR_ERROR_DEVICE;
-	if (g != AJAR_OK) {
-		free(r->remote);
-		free(r->remote_splat);
-		r->remote = r->remote_splat = NULL;
-		r->job_lost = -1;
-		return err_set(AJAR_ERROR_DEVICE, "%s; the job cannot be finished: no image is written%s",
-			       ajar_last_error(), r->ckpt_path ? " and the last checkpoint is kept" : "");
-	}
-	if (st != AJAR_OK)
-		err_set(st, "%s", msg);
-	return st;
-}
-
-/* Other ranks: one thread per device renders the ranges rank 0 sends it
- * (straight to the thread: one wake-up less per range than through the
- * main thread). */
-static void *job_device_thread(void *arg)
-{
-	RenderDevice *rd = arg;
-	ajar_renderer *r = rd->r;
-	int index = (int)(rd - r->devs);
-	double ended = -1; /* when its previous pass ended */
-	for (;;) {
-		JobCmd c;
-		if (cluster_recv(0, TAG_PASS + index, &c, sizeof c, NULL, &r->job_over, NULL) != 1)
-			break; /* the render is over (or MPI failed: the job ends) */
-		Range g = {c.first, c.count};
-		JobDone d = {0, 0, -1.0};
-		JobWhy why;
-		memset(&why, 0, sizeof why);
-		int film_ok = 0;
-		double t0 = seconds();
-		d.idle = ended < 0 ? -1.0 : t0 - ended;
-		d.ok = rd->alive && run_pass(rd, g, &film_ok);
-		ended = seconds();
-		long *accum = NULL, *splat = NULL;
-		if (!d.ok && rd->alive) {
-			if (film_ok)
-				read_films(rd, &accum, &splat);
-			snprintf(why.text, sizeof why.text, "%s", rd->error);
-		} else if (!d.ok) {
-			snprintf(why.text, sizeof why.text, "device %d of rank %d was dropped before", index, cluster_rank());
-		}
-		if (!d.ok && rd->alive) {
-			pthread_mutex_lock(&r->lock);
-			d.kept = accum && salvage_add(r, accum, splat);
-			rd->alive = 0; /* its film is in the salvage, or lost: rank 0 renders those ranges again */
-			pthread_mutex_unlock(&r->lock);
-		}
-		free(accum);
-		free(splat);
-		if (cluster_send(0, TAG_DONE + index, &d, sizeof d) != 1 ||
-		    (!d.ok && cluster_send(0, TAG_WHY + index, &why, sizeof why) != 1))
-			break;
-	}
-	return NULL;
-}
-
-static ajar_status job_serve(ajar_renderer *r)
-{
-	ajar_status st = AJAR_OK;
-	atomic_store(&r->job_over, 0);
-	for (uint32_t i = 0; i < r->ndev && st == AJAR_OK; i++) {
-		RenderDevice *rd = &r->devs[i];
-		rd->started = pthread_create(&rd->thread, NULL, job_device_thread, rd) == 0;
-		if (!rd->started) {
-			st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "rank %d: cannot start a render thread", cluster_rank());
-			log_msg(AJAR_LOG_WARNING, "%s; the job stops", ajar_last_error());
-		}
-	}
-	while (st == AJAR_OK) {
-		JobCmd c;
-		if (cluster_recv(0, TAG_CMD, &c, sizeof c, NULL, NULL, NULL) != 1) {
-			st = AJAR_ERROR_DEVICE;
-			break;
-		}
-		if (c.op == JOB_END) {
-			st = (ajar_status)c.first;
-			break;
-		}
-		if (c.op == JOB_GATHER) {
-			/* Rank 0 gathers only while no pass is in flight anywhere. */
-			size_t n = 3 * (size_t)r->width * r->height, ns = splat_count(r);
-			JobDone d = {1, 0, -1.0};
-			JobWhy why = {""};
-			if (reduce(r) != AJAR_OK) {
-				d.ok = 0;
-				snprintf(why.text, sizeof why.text, "%s", ajar_last_error());
-				memset(r->film, 0, n * sizeof *r->film);
-				memset(r->film_splat, 0, ns * sizeof *r->film_splat);
-			}
-			if (cluster_sum(r->film, n, NULL) != 1 || cluster_sum(r->film_splat, ns, NULL) != 1 ||
-			    cluster_send(0, TAG_GATHERED, &d, sizeof d) != 1 ||
-			    (!d.ok && cluster_send(0, TAG_GATHER_WHY, &why, sizeof why) != 1)) {
-				st = AJAR_ERROR_DEVICE;
-				break;
-			}
-		}
-	}
-	atomic_store(&r->job_over, 1);
-	for (uint32_t i = 0; i < r->ndev; i++)
-		if (r->devs[i].started) {
-			pthread_join(r->devs[i].thread, NULL);
-			r->devs[i].started = 0;
-		}
-	return st;
 }
