@@ -225,7 +225,7 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, VRef l,
 	uint rpix[PORTAL_RIGHT_MAX];
 	/* Each end's MIS records, built once (path_mis.h, path_join_weight). */
 	MisPortalSet set = path_portal_set(sc->params);
-	int join = path_join_exact(set);
+	int join = path_join_use(set);
 	MisRecord rrec[PORTAL_RECORDS_MAX];
 	MisEyeEnd rend[PORTAL_RIGHT_MAX];
 	float lF[2 * SUBPATH_MAX], lE[2 * SUBPATH_MAX];

@@ -193,7 +193,7 @@ static void trace_subpaths(SceneView *sc, uint seed, int n, PathVertex *l, int *
 }
 
 /* Weights joined from each end's records (path_join_weight, what the
- * kernel uses for sets with light subpaths) against path_union_weight for
+ * kernel uses for every set) against path_union_weight for
  * every pair of ends of random intermediate subpaths: the same, bit for
  * bit. Returns how many weights it compared. */
 static int check_join_weights(HostScene *h, int nsamples)
@@ -436,6 +436,39 @@ static Scene *punctual_scene(const char *path, const float dir[3], int inside, c
 
 static const float sun_in[3] = {0.3f, -0.5f, 0.8f}; /* through window-room's window */
 static const float wr_p[3] = {1.0f, 2.2f, 2.0f}, wr_q[3] = {3.0f, 2.5f, 1.5f};
+
+/* Scenes lit only by the sky (no light subpaths, bdpt strategies s <= 1,
+ * short eye parts, records within a horizon): the constant-sky window room
+ * and window-room-forest (a sky image with a sun, portal planes), with the
+ * default set and rate, the longer -> halves of set 1,2,3,4 at rate 1, and
+ * light subpaths with short eye parts (1,2,3,4,1). */
+static void set_portal_set(HostScene *h, int s_max, int sp_max, int tp_max, int t_max, int light_paths, float rate)
+{
+	Params *prm = h->data.params;
+	prm->portal_s_max = s_max;
+	prm->portal_sp_max = sp_max;
+	prm->portal_tp_max = tp_max;
+	prm->portal_t_max = t_max;
+	prm->light_paths = light_paths;
+	prm->portal_rate = rate;
+}
+
+static void test_join_weights_sky(void **state)
+{
+	static const char *scenes[] = {SCENE("window-room/window-room.gltf"),
+				       SCENE("window-room-forest/window-room-forest.gltf")};
+	for (int i = 0; i < 2; i++) {
+		HostScene h;
+		host_scene_open(&h, scenes[i], NULL, 24, 24, INTEGRATOR_PORTAL, 8);
+		assert_false(h.data.params->light_paths);
+		assert_true(check_join_weights(&h, 300) > 300);
+		set_portal_set(&h, 1, 2, 3, 4, 0, 1.0f);
+		assert_true(check_join_weights(&h, 200) > 1000);
+		set_portal_set(&h, 1, 2, 3, 4, 1, 0.5f);
+		assert_true(check_join_weights(&h, 100) > 500);
+		host_scene_close(&h);
+	}
+}
 
 static Scene *sun_window_room(int inside, int sky)
 {
@@ -1070,6 +1103,7 @@ int main(void)
 		cmocka_unit_test(test_mis_portal_surface_portal),
 		cmocka_unit_test(test_mis_window_room_sun),
 		cmocka_unit_test(test_join_weights),
+		cmocka_unit_test(test_join_weights_sky),
 		cmocka_unit_test(test_groups_unbiased_window_room),
 		cmocka_unit_test(test_groups_unbiased_window_room_sun),
 		cmocka_unit_test(test_groups_unbiased_round_trip),
