@@ -255,16 +255,13 @@ static void test_integrators_and_exr(void **state)
 static int setup(void **state)
 {
 	(void)state;
-	tmpdir = test_tmpdir();
-	return tmpdir ? 0 : -1;
+	return test_tmpdir_setup(&tmpdir);
 }
 
 static int teardown(void **state)
 {
 	(void)state;
-	test_remove_tree(tmpdir);
-	free(tmpdir);
-	return 0;
+	return test_tmpdir_teardown(&tmpdir);
 }
 
 int main(void)

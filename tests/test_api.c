@@ -10,7 +10,6 @@
  * Runs from the top of the source tree. Installs with MODE=release
  * whatever mode this test was built in: the example is compiled without
  * sanitizers, so it must link the release library. */
-#include <ftw.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -189,20 +188,14 @@ static void test_readme_example(void **state)
 
 static int setup(void **state)
 {
-	tmpdir = test_tmpdir();
-	return tmpdir ? 0 : -1;
-}
-
-static int remove_entry(const char *path, const struct stat *sb, int type, struct FTW *ftw)
-{
-	return remove(path);
+	(void)state;
+	return test_tmpdir_setup(&tmpdir);
 }
 
 static int teardown(void **state)
 {
-	int rc = nftw(tmpdir, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
-	free(tmpdir);
-	return rc;
+	(void)state;
+	return test_tmpdir_teardown(&tmpdir);
 }
 
 int main(void)

@@ -416,19 +416,13 @@ static void test_device_lost(void **state)
 
 /* ---- The program, stopped by SIGINT ------------------------------------------ */
 
-static const char *ajar_bin(void)
-{
-	const char *b = getenv("AJAR_BIN");
-	return b && b[0] ? b : "build/ajar";
-}
-
 /* Runs ajar with args; with delay_ms > 0 sends SIGINT after that long.
  * Returns the exit code; stderr goes to tmpdir/stderr.txt. */
 static int run_ajar(const char *const *args, int delay_ms)
 {
 	const char *argv[40];
 	int n = 0;
-	argv[n++] = ajar_bin();
+	argv[n++] = test_ajar_bin();
 	for (; args[n - 1] && n < 39; n++)
 		argv[n] = args[n - 1];
 	argv[n] = NULL;
@@ -567,16 +561,13 @@ static void test_cli_sigint(void **state)
 static int setup(void **state)
 {
 	(void)state;
-	tmpdir = test_tmpdir();
-	return tmpdir ? 0 : -1;
+	return test_tmpdir_setup(&tmpdir);
 }
 
 static int teardown(void **state)
 {
 	(void)state;
-	test_remove_tree(tmpdir);
-	free(tmpdir);
-	return 0;
+	return test_tmpdir_teardown(&tmpdir);
 }
 
 int main(void)

@@ -22,12 +22,6 @@
 
 static char *tmpdir;
 
-static const char *ajar_bin(void)
-{
-	const char *b = getenv("AJAR_BIN");
-	return b && b[0] ? b : "build/ajar";
-}
-
 static char *path_in(const char *name)
 {
 	size_t n = strlen(tmpdir) + strlen(name) + 2;
@@ -64,7 +58,7 @@ static pid_t spawn(const char *const *args)
 {
 	const char *argv[32];
 	int n = 0;
-	argv[n++] = ajar_bin();
+	argv[n++] = test_ajar_bin();
 	while (args[n - 1] && n < 31) {
 		argv[n] = args[n - 1];
 		n++;
@@ -145,17 +139,14 @@ static int count_tmp_entries(void)
 
 static int setup(void **state)
 {
-	tmpdir = test_tmpdir();
-	return tmpdir ? 0 : -1;
+	(void)state;
+	return test_tmpdir_setup(&tmpdir);
 }
 
 static int teardown(void **state)
 {
-	char cmd[512];
-	snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
-	int rc = system(cmd);
-	free(tmpdir);
-	return rc;
+	(void)state;
+	return test_tmpdir_teardown(&tmpdir);
 }
 
 static void test_help_version(void **state)

@@ -35,12 +35,6 @@ static char *tmpdir;
 
 static char *tmp(const char *name) { return test_path(tmpdir, name); }
 
-static const char *ajar_bin(void)
-{
-	const char *b = getenv("AJAR_BIN");
-	return b && b[0] ? b : "build/ajar";
-}
-
 static ajar_scene *load(const char *path)
 {
 	ajar_scene *s = NULL;
@@ -127,7 +121,7 @@ static int run(const char *const *args, const char *kill_after, const char *pidf
 	const char *argv[64];
 	int n = 0;
 	for (; args[n] && n < 63; n++)
-		argv[n] = strcmp(args[n], "ajar") ? args[n] : ajar_bin();
+		argv[n] = strcmp(args[n], "ajar") ? args[n] : test_ajar_bin();
 	argv[n] = NULL;
 	char *err = tmp("stderr.txt");
 	fflush(NULL);
@@ -417,16 +411,13 @@ static void test_rank_cannot_start(void **state)
 static int setup(void **state)
 {
 	(void)state;
-	tmpdir = test_tmpdir();
-	return tmpdir ? 0 : -1;
+	return test_tmpdir_setup(&tmpdir);
 }
 
 static int teardown(void **state)
 {
 	(void)state;
-	test_remove_tree(tmpdir);
-	free(tmpdir);
-	return 0;
+	return test_tmpdir_teardown(&tmpdir);
 }
 
 int main(void)

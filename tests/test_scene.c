@@ -1451,25 +1451,14 @@ static void test_api_lights(void **state)
 
 static int setup(void **state)
 {
-	tmpdir = test_tmpdir();
-	return tmpdir ? 0 : -1;
+	(void)state;
+	return test_tmpdir_setup(&tmpdir);
 }
 
 static int teardown(void **state)
 {
-	DIR *d = opendir(tmpdir);
-	struct dirent *e;
-	while (d && (e = readdir(d)))
-		if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) {
-			char *p = tmp_path(e->d_name);
-			unlink(p);
-			free(p);
-		}
-	if (d)
-		closedir(d);
-	rmdir(tmpdir);
-	free(tmpdir);
-	return 0;
+	(void)state;
+	return test_tmpdir_teardown(&tmpdir);
 }
 
 int main(void)

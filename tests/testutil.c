@@ -110,6 +110,27 @@ void test_remove_tree(const char *dir)
 	rmdir(dir);
 }
 
+int test_tmpdir_setup(char **dir)
+{
+	*dir = test_tmpdir();
+	return *dir ? 0 : -1;
+}
+
+int test_tmpdir_teardown(char **dir)
+{
+	if (*dir)
+		test_remove_tree(*dir);
+	free(*dir);
+	*dir = NULL;
+	return 0;
+}
+
+const char *test_ajar_bin(void)
+{
+	const char *b = getenv("AJAR_BIN");
+	return b && b[0] ? b : "build/ajar";
+}
+
 float *test_sun_sky(uint32_t w, uint32_t h, float sun_x, float sun_y, float sun_z, float radius, float sun_l)
 {
 	float *rgb = malloc(sizeof(float) * 3 * w * h);

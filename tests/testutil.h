@@ -32,4 +32,10 @@ char *test_tmpdir(void);
 char *test_path(const char *dir, const char *name);
 /* Removes dir and everything under it (links are not followed). */
 void test_remove_tree(const char *dir);
+/* A group's fixtures for a file-wide temporary directory: *dir gets a
+ * fresh one (0, or -1 if none could be made); teardown removes it. */
+int test_tmpdir_setup(char **dir);
+int test_tmpdir_teardown(char **dir);
+/* The ajar program the CLI tests run: $AJAR_BIN, else build/ajar. */
+const char *test_ajar_bin(void);
 #endif
