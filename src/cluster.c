@@ -95,6 +95,17 @@ static void nap(long *ns)
 		*ns *= 2;
 }
 
+/* Whether a wait should give up: cancel was set CLUSTER_STOP_WAIT ago
+ * (*deadline, 0 until cancel is first seen, remembers when). */
+static int cancel_expired(const atomic_int *cancel, double *deadline)
+{
+	if (!cancel || !atomic_load(cancel))
+		return 0;
+	if (*deadline == 0)
+		*deadline = now() + CLUSTER_STOP_WAIT;
+	return now() > *deadline;
+}
+
 /* Polls rq until it completes; 0 if cancel was set and CLUSTER_STOP_WAIT
  * passed without it (the request is then left alone: the job is over). */
 static int wait_request(MPI_Request *rq, const char *what, const atomic_int *cancel)
@@ -110,12 +121,8 @@ static int wait_request(MPI_Request *rq, const char *what, const atomic_int *can
 			return mpi_failed(what, rc);
 		if (flag)
 			return 1;
-		if (cancel && atomic_load(cancel)) {
-			if (deadline == 0)
-				deadline = now() + CLUSTER_STOP_WAIT;
-			else if (now() > deadline)
-				return 0;
-		}
+		if (cancel_expired(cancel, &deadline))
+			return 0;
 		nap(&ns);
 	}
 }
@@ -163,12 +170,8 @@ int cluster_recv(int from, int tag, void *buf, size_t bytes, int *tag_out, const
 		}
 		if (stop && atomic_load(stop))
 			return 0;
-		if (cancel && atomic_load(cancel)) {
-			if (deadline == 0)
-				deadline = now() + CLUSTER_STOP_WAIT;
-			else if (now() > deadline)
-				return 0;
-		}
+		if (cancel_expired(cancel, &deadline))
+			return 0;
 		nap(&ns);
 	}
 }
