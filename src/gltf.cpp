@@ -30,6 +30,7 @@
 
 #include "error.h"
 #include "gltf.h"
+#include "tangents.h"
 
 namespace {
 
@@ -833,98 +834,30 @@ ajar_status triangle_list(const Loader &L, const std::string &what, int mode, co
 	return AJAR_OK;
 }
 
-/* Tangents for a normal map where the mesh has none, as glTF asks (the
- * MikkTSpace way, in its main points): each triangle's tangent is the
- * direction of increasing u (from its positions and texture coordinates),
- * its handedness w the sign that makes w (n x t) point along decreasing
- * v (glTF's v runs down the image, the map's +y up it: the stored
- * tangents of NormalTangentMirrorTest agree, test_scene); a vertex averages the tangents of the triangles around it of one
- * handedness, weighted by their angles there and projected onto its
- * normal's plane. A vertex shared by triangles of both handednesses (a
- * mirrored UV seam without split vertices) is split in two. pos and nrm
- * are world space (nrm may be empty: face normals); vertices may be
- * appended to pos, nrm, uv and the other per-vertex arrays in `more`
- * (each `width` floats a vertex), and tri renumbered. */
+/* Tangents for a normal map where the mesh has none (tangents.c); the
+ * vertices it splits in two are appended to pos, nrm, uv and the other
+ * per-vertex arrays in `more` (each `width` floats a vertex). */
 struct VertexArray {
 	std::vector<float> *v;
 	size_t width;
 };
 
-void generate_tangents(std::vector<float> &pos, std::vector<float> &nrm, std::vector<float> &uvs,
-		       std::vector<VertexArray> more, std::vector<uint32_t> &tri, std::vector<float> &tan)
+ajar_status generate_tangents(const Loader &L, std::vector<float> &pos, std::vector<float> &nrm,
+			      std::vector<float> &uvs, std::vector<VertexArray> more, std::vector<uint32_t> &tri,
+			      std::vector<float> &tan)
 {
-	size_t nv = pos.size() / 3;
-	std::vector<double> acc(2 * 3 * nv, 0.0);
-	std::vector<signed char> sign(tri.size() / 3, 1);
-	auto P = [&](uint32_t i, int c) { return (double)pos[3 * (size_t)i + (size_t)c]; };
-	for (size_t f = 0; f < tri.size() / 3; f++) {
-		uint32_t k[3] = {tri[3 * f], tri[3 * f + 1], tri[3 * f + 2]};
-		double e1[3], e2[3], fn[3];
-		for (int c = 0; c < 3; c++) {
-			e1[c] = P(k[1], c) - P(k[0], c);
-			e2[c] = P(k[2], c) - P(k[0], c);
-		}
-		fn[0] = e1[1] * e2[2] - e1[2] * e2[1];
-		fn[1] = e1[2] * e2[0] - e1[0] * e2[2];
-		fn[2] = e1[0] * e2[1] - e1[1] * e2[0];
-		if (!nrm.empty()) /* the side the vertex normals say */
-			for (int c = 0; c < 3; c++)
-				fn[c] = (double)nrm[3 * (size_t)k[0] + (size_t)c] + nrm[3 * (size_t)k[1] + (size_t)c] +
-					nrm[3 * (size_t)k[2] + (size_t)c];
-		double du1 = uvs[2 * (size_t)k[1]] - uvs[2 * (size_t)k[0]], dv1 = uvs[2 * (size_t)k[1] + 1] - uvs[2 * (size_t)k[0] + 1];
-		double du2 = uvs[2 * (size_t)k[2]] - uvs[2 * (size_t)k[0]], dv2 = uvs[2 * (size_t)k[2] + 1] - uvs[2 * (size_t)k[0] + 1];
-		double r = du1 * dv2 - du2 * dv1;
-		if (!(std::fabs(r) > 1e-20))
-			continue;
-		double t[3], b[3];
-		for (int c = 0; c < 3; c++) {
-			t[c] = (e1[c] * dv2 - e2[c] * dv1) / r;
-			b[c] = (e2[c] * du1 - e1[c] * du2) / r;
-		}
-		double nxt[3] = {fn[1] * t[2] - fn[2] * t[1], fn[2] * t[0] - fn[0] * t[2], fn[0] * t[1] - fn[1] * t[0]};
-		int s = nxt[0] * b[0] + nxt[1] * b[1] + nxt[2] * b[2] > 0.0 ? 0 : 1;
-		sign[f] = (signed char)(s ? 1 : -1);
-		for (int j = 0; j < 3; j++) {
-			uint32_t a = k[j], pb = k[(j + 1) % 3], pc = k[(j + 2) % 3];
-			double x[3], y[3], lx = 0, ly = 0, d = 0;
-			for (int c = 0; c < 3; c++) {
-				x[c] = P(pb, c) - P(a, c);
-				y[c] = P(pc, c) - P(a, c);
-				lx += x[c] * x[c];
-				ly += y[c] * y[c];
-				d += x[c] * y[c];
-			}
-			if (!(lx > 0.0 && ly > 0.0))
-				continue;
-			double angle = std::acos(std::fmin(std::fmax(d / std::sqrt(lx * ly), -1.0), 1.0));
-			double n[3] = {fn[0], fn[1], fn[2]};
-			if (!nrm.empty())
-				for (int c = 0; c < 3; c++)
-					n[c] = nrm[3 * (size_t)a + (size_t)c];
-			double ln = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-			double tn = ln > 0.0 ? (t[0] * n[0] + t[1] * n[1] + t[2] * n[2]) / (ln * ln) : 0.0;
-			double p[3] = {t[0] - tn * n[0], t[1] - tn * n[1], t[2] - tn * n[2]};
-			double lp = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-			if (!(lp > 0.0))
-				continue;
-			for (int c = 0; c < 3; c++)
-				acc[(size_t)s * 3 * nv + 3 * (size_t)a + (size_t)c] += angle * p[c] / lp;
-		}
-	}
-	/* Vertices used with both handednesses get a copy for the negative one. */
-	std::vector<uint32_t> twin(nv, UINT32_MAX);
-	std::vector<char> used(2 * nv, 0);
-	for (size_t f = 0; f < sign.size(); f++)
-		for (int j = 0; j < 3; j++)
-			used[(sign[f] > 0 ? nv : 0) + tri[3 * f + (size_t)j]] = 1;
+	size_t nv = pos.size() / 3, total = 0;
+	std::vector<uint32_t> twin(nv);
+	float *t = nullptr;
+	if (tangents_generate(pos.data(), nrm.empty() ? nullptr : nrm.data(), uvs.data(), nv, tri.data(), tri.size() / 3,
+			      twin.data(), &t, &total) != AJAR_OK)
+		return fail(L, AJAR_ERROR_OUT_OF_MEMORY, "out of memory for tangents");
+	tan.assign(t, t + 4 * total);
+	free(t);
 	more.push_back({&pos, 3});
 	if (!nrm.empty())
 		more.push_back({&nrm, 3});
 	more.push_back({&uvs, 2});
-	size_t total = nv;
-	for (size_t v = 0; v < nv; v++)
-		if (used[v] && used[nv + v])
-			twin[v] = (uint32_t)total++;
 	for (const VertexArray &a : more) {
 		a.v->resize(total * a.width);
 		for (size_t v = 0; v < nv; v++)
@@ -932,23 +865,7 @@ void generate_tangents(std::vector<float> &pos, std::vector<float> &nrm, std::ve
 				for (size_t c = 0; c < a.width; c++)
 					(*a.v)[twin[v] * a.width + c] = (*a.v)[v * a.width + c];
 	}
-	for (size_t f = 0; f < sign.size(); f++)
-		if (sign[f] < 0)
-			for (int j = 0; j < 3; j++)
-				if (twin[tri[3 * f + (size_t)j]] != UINT32_MAX)
-					tri[3 * f + (size_t)j] = twin[tri[3 * f + (size_t)j]];
-	tan.assign(4 * total, 0.0f);
-	for (size_t v = 0; v < nv; v++)
-		for (int s = 0; s < 2; s++) {
-			if (!used[(size_t)s * nv + v])
-				continue;
-			size_t out = s == 0 && twin[v] != UINT32_MAX ? twin[v] : v;
-			const double *a = &acc[(size_t)s * 3 * nv + 3 * v];
-			double l = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-			for (int c = 0; c < 3; c++)
-				tan[4 * out + (size_t)c] = l > 0.0 ? (float)(a[c] / l) : 0.0f;
-			tan[4 * out + 3] = s ? 1.0f : -1.0f;
-		}
+	return AJAR_OK;
 }
 
 ajar_status load_primitive(Loader &L, int mi, int pi, const double world[16], const double nm[3][3], bool flip,
@@ -1109,7 +1026,8 @@ ajar_status load_primitive(Loader &L, int mi, int pi, const double world[16], co
 				more.push_back({other, 2});
 			if (!col.empty())
 				more.push_back({&col, 4});
-			generate_tangents(pos, nrm, set, more, tri, tan);
+			if ((st = generate_tangents(L, pos, nrm, set, more, tri, tan)) != AJAR_OK)
+				return st;
 			nv = pos.size() / 3;
 		}
 	}
