@@ -172,7 +172,7 @@ INLINE float alpha_hash(V3 o, V3 d, int tri)
  * its coverage is 1, always; BLEND with probability alpha. Never inlined:
  * the traversal's leaf loop (bvh.h) keeps only a flag test and a call
  * taken for alpha-tested triangles, not the texture lookup's code and
- * registers (untextured scenes: kernels/README.md, "Alpha"). */
+ * registers (untextured scenes: kernels/materials.md, "Alpha"). */
 static __attribute__((noinline, unused)) int alpha_hit(const SceneView *sc, int tri, float b1, float b2, V3 o, V3 d)
 {
 	float c = tri_coverage(sc, tri, b1, b2);

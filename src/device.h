@@ -48,7 +48,7 @@ ajar_status device_build(Device *d, const char *source, const char *options);
  * and last `extra` (AJAR_CL_OPTIONS, NULL for none), which can undo both. */
 void device_build_options(const Device *d, int integrator, const char *extra, char *buf, size_t cap);
 /* Where bdpt's and portal's subpaths live on a device and how a pass
- * spreads over it (kernels/README.md, "On GPUs: subpaths in global memory").
+ * spreads over it (kernels/gpu.md, "On GPUs: subpaths in global memory").
  * PathVertex, as the host reserves room for it: at most
  * DEVICE_VERTEX_WORDS 32-bit words (kernels/vertex.h refuses to build
  * otherwise), SUBPATH_MAX vertices a subpath. */
@@ -63,7 +63,7 @@ typedef struct {
 	int general;          /* AJAR_KERNEL_FEATURES=all: omit nothing, whatever `omit` says */
 } DevicePlan;
 /* Scene features render_pass can be built without (kernel specialisation,
- * kernels/README.md "Feature-specialised programs"): prepare_scene says
+ * kernels/materials.md "Feature-specialised programs"): prepare_scene says
  * which a scene lacks; each becomes a -D option, and the cache keys on it. */
 #define DEVICE_OMIT_ALPHA 1u        /* -DAJAR_NO_ALPHA: no TRI_ALPHA triangle */
 #define DEVICE_OMIT_BENT_NORMALS 2u /* -DAJAR_NO_BENT_NORMALS: no shading normal tilted from ng, no normal map */

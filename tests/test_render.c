@@ -375,7 +375,7 @@ static unsigned scene_omit(const char *path)
 	return omit;
 }
 
-/* Feature-specialised programs (kernels/README.md): the Cornell box has no
+/* Feature-specialised programs (kernels/materials.md): the Cornell box has no
  * alpha, no tilted normals, no textures and no TriExtra, so its program is
  * built with all four -DAJAR_NO_* options, and renders the same bits as
  * the general program (AJAR_KERNEL_FEATURES=all); scenes that have a

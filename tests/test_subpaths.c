@@ -1,5 +1,5 @@
 /* test_subpaths.c — where bdpt's and portal's subpaths live (kernels/vertex.h,
- * src/device.c device_plan; kernels/README.md, "On GPUs: subpaths in global
+ * src/device.c device_plan; kernels/gpu.md, "On GPUs: subpaths in global
  * memory"): private arrays or the global scratch laid out by work-item, and
  * a pass spread over several work-items a pixel, must render the same image
  * bit for bit on the same device. On PoCL the GPU's layout is forced with
