@@ -9,7 +9,13 @@
  * toward -Z): a feature at image-frame direction d is seen in the scene at
  * R(a) d. Every direction meets the image through env_texel (world to
  * image, R(-a)) and env_dir (image to world, R(a)); a rotation leaves
- * solid angles, hence every density below, unchanged. Radiance is
+ * solid angles, hence every density below, unchanged. The angles are
+ * fastmath.h's polynomials, not the builtins (PoCL's generic atan2, acos
+ * and sin/cos argument reduction were a sixth of a sky-image `portal`
+ * sample, and builtins may differ between devices): theta is
+ * atan2(sin(theta), y), which keeps its accuracy at the poles where acos
+ * loses it, and the rotation's cos and sin come from the host
+ * (Params.env_rot_cos, env_rot_sin). Radiance is
  * piecewise constant per texel (nearest texel); a texel is sampled
  * uniformly in (u, v), so the solid-angle density is
  * p_row p_col W H / (2 pi^2 sin(theta)), and env_sample reports exactly
@@ -18,40 +24,50 @@
 #define AJAR_KERNEL_ENV_H
 #include "types.h"
 #include "sampling.h"
+#include "fastmath.h"
 
 /* d turned by `sign` x the environment's rotation about +Y. Exactly d
  * when there is no rotation, so unrotated skies keep their bits. */
 INLINE V3 env_turn(GLOBAL const Params *prm, V3 d, float sign)
 {
-	float a = prm->env_rotation;
-	if (a == 0.0f)
+	if (prm->env_rotation == 0.0f)
 		return d;
-	float c = cos(a), s = sign * sin(a);
+	float c = prm->env_rot_cos, s = sign * prm->env_rot_sin;
 	return v3(c * d.x + s * d.z, d.y, c * d.z - s * d.x);
 }
 
 /* Scene direction of equirect coordinates (u, v) in [0,1]^2. */
 INLINE V3 env_dir(GLOBAL const Params *prm, float u, float v)
 {
-	float phi = 2.0f * AJAR_PI * (u - 0.5f), theta = AJAR_PI * v;
-	float st = sin(theta);
-	return env_turn(prm, v3(st * sin(phi), cos(theta), -st * cos(phi)), 1.0f);
+	float sp, cp, st, ct;
+	fast_sincos(2.0f * AJAR_PI * (u - 0.5f), &sp, &cp);
+	fast_sincos(AJAR_PI * v, &st, &ct);
+	return env_turn(prm, v3(st * sp, ct, -st * cp), 1.0f);
+}
+
+/* Equirect coordinates (u, v) of unit scene direction d; returns
+ * sin(theta) of d. Within 1e-7 of the exact map (test_lights,
+ * test_env_uv_exact). */
+INLINE float env_uv(GLOBAL const Params *prm, V3 d, float *u, float *v)
+{
+	d = env_turn(prm, d, -1.0f);
+	/* Not sqrt(1 - y^2): near the poles y rounds to 1 long before
+	 * sin(theta) is negligible. */
+	float st = sqrt(d.x * d.x + d.z * d.z);
+	*u = 0.5f + fast_atan2(d.x, -d.z) * AJAR_INV_2PI;
+	*v = fast_atan2(st, d.y) * AJAR_INV_PI;
+	return st;
 }
 
 /* Texel (row, col) under unit scene direction d; returns sin(theta) of d. */
 INLINE float env_texel(GLOBAL const Params *prm, V3 d, int *row, int *col)
 {
-	d = env_turn(prm, d, -1.0f);
-	float y = fmin(fmax(d.y, -1.0f), 1.0f);
-	float u = 0.5f + atan2(d.x, -d.z) * AJAR_INV_2PI;
-	float v = acos(y) * AJAR_INV_PI;
+	float u, v, st = env_uv(prm, d, &u, &v);
 	int w = prm->env_width, h = prm->env_height;
 	int c = (int)(u * (float)w), r = (int)(v * (float)h);
 	*col = c < 0 ? 0 : (c >= w ? w - 1 : c);
 	*row = r < 0 ? 0 : (r >= h ? h - 1 : r);
-	/* Not sqrt(1 - y^2): near the poles y rounds to 1 long before
-	 * sin(theta) is negligible. */
-	return sqrt(d.x * d.x + d.z * d.z);
+	return st;
 }
 
 INLINE V3 env_pixel(const SceneView *sc, int row, int col)
@@ -83,6 +99,23 @@ INLINE V3 env_radiance(const SceneView *sc, V3 d)
 		return v3(0.0f, 0.0f, 0.0f);
 	int row, col;
 	env_texel(prm, d, &row, &col);
+	return env_pixel(sc, row, col);
+}
+
+/* env_radiance and env_pdf_w of one direction from one texel lookup. */
+INLINE V3 env_radiance_pdf(const SceneView *sc, V3 d, float *pdf_w)
+{
+	GLOBAL const Params *prm = sc->params;
+	*pdf_w = 0.0f;
+	if (prm->env_type == ENV_COLOR) {
+		*pdf_w = pdf_uniform_sphere_w();
+		return prm->env_color;
+	}
+	if (prm->env_type != ENV_IMAGE)
+		return v3(0.0f, 0.0f, 0.0f);
+	int row, col;
+	float sin_theta = env_texel(prm, d, &row, &col);
+	*pdf_w = env_texel_pdf_w(sc, row, col, sin_theta);
 	return env_pixel(sc, row, col);
 }
 

@@ -247,19 +247,19 @@ INLINE float sky_portal_pdf_w(const SceneView *sc, const SkyWeights *sw, V3 x, V
 	return p;
 }
 
-INLINE float sky_mix_pdf_w(const SceneView *sc, const SkyWeights *sw, V3 x, V3 n, V3 wi)
+/* The whole density of wi, given pe = env_pdf_w(sc, wi). */
+INLINE float sky_mix_pdf_w(const SceneView *sc, const SkyWeights *sw, V3 x, V3 n, V3 wi, float pe)
 {
-	float pe = env_pdf_w(sc, wi);
 	if (!(sw->W > 0.0f))
 		return pe;
 	return PORTAL_SKY_NEE_MIX * sky_portal_pdf_w(sc, sw, x, n, wi) + (1.0f - PORTAL_SKY_NEE_MIX) * pe;
 }
 
-INLINE float sky_nee_pdf_w(const SceneView *sc, V3 x, V3 n, V3 wi)
+INLINE float sky_nee_pdf_w(const SceneView *sc, V3 x, V3 n, V3 wi, float pe)
 {
 	SkyWeights sw;
 	sky_weights(sc, x, n, &sw);
-	return sky_mix_pdf_w(sc, &sw, x, n, wi);
+	return sky_mix_pdf_w(sc, &sw, x, n, wi, pe);
 }
 
 /* env_nee_sample where the planes have sky tables: the density is
@@ -274,7 +274,7 @@ INLINE V3 sky_nee_sample(const SceneView *sc, V3 x, V3 n, float u_mix, float u1,
 		V3 Le = env_sample(sc, u1, u2, wi, &pe);
 		if (!(pe > 0.0f))
 			return v3(0.0f, 0.0f, 0.0f);
-		*pdf_w = sky_mix_pdf_w(sc, &sw, x, n, *wi);
+		*pdf_w = sky_mix_pdf_w(sc, &sw, x, n, *wi, pe); /* pe is env_pdf_w's (env.h) */
 		return Le;
 	}
 	float target = u_mix / PORTAL_SKY_NEE_MIX * sw.W, cum = 0.0f;
@@ -297,20 +297,30 @@ INLINE V3 sky_nee_sample(const SceneView *sc, V3 x, V3 n, float u_mix, float u1,
 	if (!sky_sample_uv(sc->portal_sky + P->table, &r, mass, u1, u2, &U, &V))
 		return v3(0.0f, 0.0f, 0.0f);
 	*wi = sky_dir(P, U, V, &jac);
-	*pdf_w = sky_mix_pdf_w(sc, &sw, x, n, *wi);
-	return *pdf_w > 0.0f ? env_radiance(sc, *wi) : v3(0.0f, 0.0f, 0.0f);
+	float pe;
+	V3 Le = env_radiance_pdf(sc, *wi, &pe);
+	*pdf_w = sky_mix_pdf_w(sc, &sw, x, n, *wi, pe);
+	return *pdf_w > 0.0f ? Le : v3(0.0f, 0.0f, 0.0f);
+}
+
+/* Solid-angle density with which env_nee_sample from x with normal n
+ * returns wi, given pe = env_pdf_w(sc, wi) (env_radiance_pdf reads both
+ * from one lookup). */
+INLINE float env_nee_pdf_w_pe(const SceneView *sc, V3 x, V3 n, V3 wi, float pe)
+{
+	if (sc->params->num_portal_planes > 0)
+		return sky_nee_pdf_w(sc, x, n, wi, pe);
+	float total = env_portal_total(sc, x, n);
+	if (!(total > 0.0f))
+		return pe;
+	return PORTAL_NEE_MIX * env_portal_pdf_w(sc, x, n, wi, total, -1) + (1.0f - PORTAL_NEE_MIX) * pe;
 }
 
 /* Solid-angle density with which env_nee_sample from x with normal n
  * returns wi. */
 INLINE float env_nee_pdf_w(const SceneView *sc, V3 x, V3 n, V3 wi)
 {
-	if (sc->params->num_portal_planes > 0)
-		return sky_nee_pdf_w(sc, x, n, wi);
-	float total = env_portal_total(sc, x, n), pe = env_pdf_w(sc, wi);
-	if (!(total > 0.0f))
-		return pe;
-	return PORTAL_NEE_MIX * env_portal_pdf_w(sc, x, n, wi, total, -1) + (1.0f - PORTAL_NEE_MIX) * pe;
+	return env_nee_pdf_w_pe(sc, x, n, wi, env_pdf_w(sc, wi));
 }
 
 /* Samples a sky direction *wi for shading point x with normal n (u_mix
@@ -432,6 +442,7 @@ INLINE SkyRect sky_rect_full(void)
 	r.f0 = 0.0f;
 	r.j1 = PORTAL_SKY_RES - 1;
 	r.f1 = 1.0f;
+	sky_rect_rows(&r);
 	return r;
 }
 

@@ -7,7 +7,7 @@
 
 #define AJAR_LAYOUT_TYPES(X) \
 	X(BvhNode, 256) X(Tri, 48) X(TriShade, 64) X(TriExtra, 128) X(Material, 80) X(Texture, 48) \
-	X(Emitter, 16) X(PortalTri, 64) X(Camera, 64) X(Params, 224) \
+	X(Emitter, 16) X(PortalTri, 64) X(Camera, 64) X(Params, 240) \
 	X(PortalPlane, 80) X(PunctualLight, 64)
 
 #define AJAR_LAYOUT_FIELDS(X)                                                          \
@@ -45,7 +45,7 @@
 	X(PunctualLight, pdf_select) X(PunctualLight, intensity) X(PunctualLight, range)\
 	X(PunctualLight, cos_outer) X(PunctualLight, cone_scale)                       \
 	X(PunctualLight, disk_radius)                                                  \
-	X(Params, num_portal_planes)                                                   \
+	X(Params, num_portal_planes) X(Params, env_rot_cos) X(Params, env_rot_sin)     \
 	X(PortalPlane, o) X(PortalPlane, a0) X(PortalPlane, t) X(PortalPlane, n)      \
 	X(PortalPlane, b1) X(PortalPlane, table) X(PortalPlane, guide)
 #endif

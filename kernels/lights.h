@@ -392,6 +392,13 @@ INLINE float light_pdf_w(const SceneView *sc, V3 x, V3 n, V3 wi, int tri, float 
 	return (1.0f - ps) * pdf_a * dist * dist / cos_light;
 }
 
+/* light_pdf_w toward the environment, given pe = env_pdf_w(sc, wi)
+ * (env_radiance_pdf). */
+INLINE float light_env_pdf_w(const SceneView *sc, V3 x, V3 n, V3 wi, float pe)
+{
+	return sc->params->env_pdf_select * env_nee_pdf_w_pe(sc, x, n, wi, pe);
+}
+
 /* The guided <- direction of an intermediate subpath (portal.h) aims at
  * the environment or at an emitter point, never at a punctual light (a
  * delta direction no other strategy samples): it chooses between the two

@@ -38,7 +38,17 @@ typedef struct {
 	float U0, U1, V0, V1;
 	int j0, j1;
 	float f0, f1;
+	int o0, o1; /* offsets of rows j0 and j1 in the table, sky_rect_rows */
 } SkyRect;
+
+#define SKY_ROW (2 * (PORTAL_SKY_RES + 1)) /* floats per table row */
+
+/* r's row offsets from its rows. */
+INLINE void sky_rect_rows(SkyRect *r)
+{
+	r->o0 = r->j0 * SKY_ROW;
+	r->o1 = r->j1 * SKY_ROW;
+}
 
 INLINE float sky_coord(float angle)
 {
@@ -70,27 +80,19 @@ INLINE int sky_rect(GLOBAL const PortalPlane *P, V3 x, SkyRect *r)
 	r->V1 = sky_coord(fast_atan2(P->b1 - xb, h));
 	r->j0 = sky_split(r->V0, &r->f0);
 	r->j1 = sky_split(r->V1, &r->f1);
+	sky_rect_rows(r);
 	return r->U1 > r->U0 && r->V1 > r->V0;
 }
 
-/* S(i, ja) - S(i, jb) and S(ia, j) - S(ib, j), from the (hi, lo) halves. */
-INLINE float sky_vdiff(GLOBAL const float *S, int i, int ja, int jb)
-{
-	int a = 2 * (ja * (PORTAL_SKY_RES + 1) + i), b = 2 * (jb * (PORTAL_SKY_RES + 1) + i);
-	return (S[a] - S[b]) + (S[a + 1] - S[b + 1]);
-}
-
-INLINE float sky_udiff(GLOBAL const float *S, int ia, int ib, int j)
-{
-	int a = 2 * (j * (PORTAL_SKY_RES + 1) + ia), b = 2 * (j * (PORTAL_SKY_RES + 1) + ib);
-	return (S[a] - S[b]) + (S[a + 1] - S[b + 1]);
-}
-
-/* B(i): the integral over [0, i] x [V0, V1]. */
+/* B(i): the integral over [0, i] x [V0, V1], (S(i, j1) - S(i, j0)) +
+ * f1 (S(i, j1 + 1) - S(i, j1)) - f0 (S(i, j0 + 1) - S(i, j0)), each
+ * difference of (hi, lo) pairs taken as (hi_a - hi_b) + (lo_a - lo_b). */
 INLINE float sky_band(GLOBAL const float *S, const SkyRect *r, int i)
 {
-	return sky_vdiff(S, i, r->j1, r->j0) + r->f1 * sky_vdiff(S, i, r->j1 + 1, r->j1) -
-	       r->f0 * sky_vdiff(S, i, r->j0 + 1, r->j0);
+	GLOBAL const float *p0 = S + r->o0 + 2 * i, *p1 = S + r->o1 + 2 * i;
+	float h0 = p0[0], l0 = p0[1], h0n = p0[SKY_ROW], l0n = p0[SKY_ROW + 1];
+	float h1 = p1[0], l1 = p1[1], h1n = p1[SKY_ROW], l1n = p1[SKY_ROW + 1];
+	return ((h1 - h0) + (l1 - l0)) + r->f1 * ((h1n - h1) + (l1n - l1)) - r->f0 * ((h0n - h0) + (l0n - l0));
 }
 
 /* The integral over [0, U] x [V0, V1], linear between the knots. */
@@ -102,8 +104,12 @@ INLINE float sky_band_at(GLOBAL const float *S, const SkyRect *r, float U)
 	return b + f * (sky_band(S, r, i + 1) - b);
 }
 
-/* C(j) of column i: its integral over rows [0, j). */
-INLINE float sky_col(GLOBAL const float *S, int i, int j) { return sky_udiff(S, i + 1, i, j); }
+/* C(j) of column i: its integral over rows [0, j), S(i + 1, j) - S(i, j). */
+INLINE float sky_col(GLOBAL const float *S, int i, int j)
+{
+	GLOBAL const float *p = S + j * SKY_ROW + 2 * i;
+	return (p[2] - p[0]) + (p[3] - p[1]);
+}
 
 INLINE float sky_col_at(GLOBAL const float *S, int i, float V)
 {

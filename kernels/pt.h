@@ -58,10 +58,10 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 		if (depth < PT_CROSS_EDGES)
 			cnt[depth] = c_edge;
 		if (!hit) {
-			V3 Le = env_radiance(sc, d);
+			float pe;
+			V3 Le = env_radiance_pdf(sc, d, &pe);
 			if (!v3_is_zero(Le)) {
-				float w = prev_delta ? 1.0f
-						     : mis_power(prev_pdf_w, light_pdf_w(sc, prev_p, prev_n, d, -1, AJAR_INF, 1.0f));
+				float w = prev_delta ? 1.0f : mis_power(prev_pdf_w, light_env_pdf_w(sc, prev_p, prev_n, d, pe));
 				w *= pt_cross_weight(prm, cnt, depth + 1, c_edge);
 				if (depth + 1 >= prm->min_depth)
 					L = v3_add(L, v3_scale(v3_mul(beta, Le), w));

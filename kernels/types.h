@@ -230,8 +230,10 @@ typedef struct {
 	int num_lights;         /* 208, PunctualLight */
 	float light_power;      /* their total power estimate (src/lights.c) */
 	int num_portal_planes;  /* 216, planar portals with sky tables (env_portal.h), 0 = none */
-	int pad2;
-} Params; /* 224 */
+	float env_rot_cos;      /* cos and sin of env_rotation, from the host in double */
+	float env_rot_sin;      /* 224 (env.h, env_turn) */
+	int pad2, pad3, pad4;
+} Params; /* 240 */
 
 /* Layout of the float array `env`: for an ENV_IMAGE of W x H,
  *   [0, 3WH)                    linear RGB radiance, row-major, row 0 = top

@@ -373,3 +373,10 @@ void lights_free(LightTables *t)
 	free(t->lights);
 	memset(t, 0, sizeof(*t));
 }
+
+void lights_set_env_rotation(Params *p, float radians)
+{
+	p->env_rotation = radians;
+	p->env_rot_cos = (float)cos((double)radians);
+	p->env_rot_sin = (float)sin((double)radians);
+}

@@ -49,6 +49,10 @@ ajar_status lights_build(const Scene *s, Tri *tris, const TriShade *shade, const
 			 LightTables *out);
 void lights_free(LightTables *t);
 
+/* Params.env_rotation and the cos and sin that kernels/env.h turns by,
+ * computed here in double so that every device reads the same floats. */
+void lights_set_env_rotation(Params *p, float radians);
+
 
 /* cdf[0..n] from n non-negative weights (summed in double). With a zero
  * total the table is uniform if `uniform_if_empty`, else all zeros (which

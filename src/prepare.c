@@ -194,7 +194,7 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	p->env_width = (int)s->env_width;
 	p->env_height = (int)s->env_height;
 	p->env_strength = s->env_strength;
-	p->env_rotation = s->env_rotation;
+	lights_set_env_rotation(p, s->env_rotation);
 	p->env_color = s->env_color;
 	p->env_pdf_select = d->lights.env_pdf_select;
 	p->scene_center = center;
