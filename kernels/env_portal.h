@@ -206,22 +206,23 @@ INLINE void sky_weights(const SceneView *sc, V3 x, V3 n, SkyWeights *sw)
 	float mass;
 	sw->W = 0.0f;
 	for (int k = 0; k < sc->params->num_portal_planes; k++) {
-		float w = sky_plane_weight(sc, &sc->portal_planes[k], x, n, &r, &mass);
-		if (k < SKY_KEPT) {
-			sw->r[k] = r;
-			sw->mass[k] = mass;
-			sw->w[k] = w;
-		}
+		GLOBAL const PortalPlane *P = &sc->portal_planes[k];
+		float w = k < SKY_KEPT ? (sw->w[k] = sky_plane_weight(sc, P, x, n, &sw->r[k], &sw->mass[k]))
+				       : sky_plane_weight(sc, P, x, n, &r, &mass);
 		sw->W += w;
 	}
 }
 
-/* Plane k's weight, rectangle and integral. */
-INLINE float sky_weight_of(const SceneView *sc, const SkyWeights *sw, int k, V3 x, V3 n, SkyRect *r, float *mass)
+/* Plane k's weight; *r points at its rectangle (kept in sw, or computed
+ * into *tmp) and *mass is its integral. */
+INLINE float sky_weight_of(const SceneView *sc, const SkyWeights *sw, int k, V3 x, V3 n, SkyRect *tmp,
+			   const SkyRect **r, float *mass)
 {
-	if (k >= SKY_KEPT)
-		return sky_plane_weight(sc, &sc->portal_planes[k], x, n, r, mass);
-	*r = sw->r[k];
+	if (k >= SKY_KEPT) {
+		*r = tmp;
+		return sky_plane_weight(sc, &sc->portal_planes[k], x, n, tmp, mass);
+	}
+	*r = &sw->r[k];
 	*mass = sw->mass[k];
 	return sw->w[k];
 }
@@ -232,15 +233,16 @@ INLINE float sky_portal_pdf_w(const SceneView *sc, const SkyWeights *sw, V3 x, V
 	float p = 0.0f;
 	for (int k = 0; k < sc->params->num_portal_planes; k++) {
 		GLOBAL const PortalPlane *P = &sc->portal_planes[k];
-		SkyRect r;
+		SkyRect tmp;
+		const SkyRect *r;
 		float mass, U, V, jac;
 		if (!(v3_dot(wi, P->n) > 0.0f))
 			continue;
-		float w = sky_weight_of(sc, sw, k, x, n, &r, &mass);
+		float w = sky_weight_of(sc, sw, k, x, n, &tmp, &r, &mass);
 		if (!(w > 0.0f))
 			continue;
 		sky_coords(P, wi, &U, &V, &jac);
-		float puv = sky_pdf_uv(sc->portal_sky + P->table, &r, mass, U, V);
+		float puv = sky_pdf_uv(sc->portal_sky + P->table, r, mass, U, V);
 		if (puv > 0.0f && jac > 0.0f)
 			p += w / sw->W * puv / jac;
 	}
@@ -280,12 +282,13 @@ INLINE V3 sky_nee_sample(const SceneView *sc, V3 x, V3 n, float u_mix, float u1,
 	float target = u_mix / PORTAL_SKY_NEE_MIX * sw.W, cum = 0.0f;
 	int pick = -1;
 	SkyRect r, rk;
+	const SkyRect *rp;
 	float mass = 0.0f, mass_k;
 	for (int k = 0; k < sc->params->num_portal_planes && cum <= target; k++) {
-		float wk = sky_weight_of(sc, &sw, k, x, n, &rk, &mass_k);
+		float wk = sky_weight_of(sc, &sw, k, x, n, &rk, &rp, &mass_k);
 		if (wk > 0.0f) { /* the last positive one if rounding leaves target >= the sum */
 			pick = k;
-			r = rk;
+			r = *rp;
 			mass = mass_k;
 			cum += wk;
 		}
