@@ -46,7 +46,7 @@ INLINE V3 env_dir(GLOBAL const Params *prm, float u, float v)
 }
 
 /* Equirect coordinates (u, v) of unit scene direction d; returns
- * sin(theta) of d. Within 1e-7 of the exact map (test_lights,
+ * sin(theta) of d. Within 2e-7 of the exact map (test_lights,
  * test_env_uv_exact). */
 INLINE float env_uv(GLOBAL const Params *prm, V3 d, float *u, float *v)
 {
