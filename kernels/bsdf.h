@@ -42,9 +42,14 @@
  * Shading normals that face away: where the shading normal n (interpolated
  * or normal-mapped) differs from ng, a direction above ng can lie below n,
  * or mirror about n to below ng; a BSDF that is 0 there paints black rims.
- * As Cycles (ensure_valid_reflection) the normal is then turned toward ng,
- * along the arc from n to ng, just far enough that the direction's mirror
- * image lies above ng (by min(0.9 cos, 0.01)): bsdf_bend_t. The BSDF of a
+ * As Cycles (ensure_valid_specular_reflection) the normal of the glossy
+ * lobes (metal, coat, glass and their multiple scattering) is then turned
+ * toward ng, along the arc from n to ng, just far enough that the
+ * direction's mirror image lies above ng (by min(0.9 cos, 0.01)):
+ * bsdf_bend_t. The diffuse base keeps n, as Cycles' diffuse closure keeps
+ * its N: it is there wherever the light side lies above n (and on the
+ * camera side's side of ng), whatever the camera side, so it paints no
+ * rims; its density is cosine sampling about n. The glossy BSDF of a
  * vertex is the one in the normal its camera-side direction needs: wo's in
  * radiance mode, wi's in importance mode, so f_radiance(wo, wi) =
  * f_importance(wi, wo) holds and a vertex has the same BSDF whichever
@@ -57,7 +62,8 @@
  * on light subpaths, Veach's correction with n, vertex.h); f is returned
  * multiplied by |wl . m| / |wl . n|, wl the direction toward the light (wi
  * in radiance mode, wo in importance mode), so their products are those of
- * the bent normal m. Where n equals ng (flat shading) none of this runs.
+ * the bent normal m (the diffuse base's f is not scaled: its normal is n).
+ * Where n equals ng (flat shading) none of this runs.
  * Delta lobes reflect about wo's normal in both modes.
  *
  * E1, Es and G come from bsdf_tables.h (src/tools/bsdf_tables.c integrates
@@ -86,6 +92,7 @@
 #define BSDF_MIN_IOR 1.01f     /* eta = 1 makes the refraction half vector vanish */
 #define BSDF_MAX_IOR 4.0f
 #define BSDF_TILTED (1 << 30)  /* in Bsdf.flags: n differs from ng, normals may bend (the top) */
+#define BSDF_LAMBERT (1 << 29) /* in Bsdf.flags: only the diffuse lobe (bsdf_lambert) */
 #define BSDF_TILT_COS 0.99999f /* n . ng below this counts as tilted */
 /* Whether bs's normal may bend. A scene whose shading normals are all
  * within BSDF_TILT_COS of ng (src/prepare.c, tri_may_tilt) is built with
@@ -211,10 +218,11 @@ INLINE void bsdf_setup_mr(Bsdf *bs, GLOBAL const Material *m, V3 base_color, flo
 	bs->transmission = bsdf_clamp01(m->transmission);
 	bs->ior = fmin(fmax(m->ior, BSDF_MIN_IOR), BSDF_MAX_IOR);
 	bs->specular = bsdf_clamp01(m->specular);
-#ifdef AJAR_NO_BENT_NORMALS
-	bs->flags = m->flags & ~BSDF_TILTED;
-#else
-	bs->flags = (m->flags & ~BSDF_TILTED) | (fabs(cn) < BSDF_TILT_COS ? BSDF_TILTED : 0);
+	int lambert = bs->metallic == 0.0f && bs->transmission == 0.0f && bs->specular == 0.0f &&
+		      v3_maxc(bs->base_color) > 0.0f;
+	bs->flags = (m->flags & ~(BSDF_TILTED | BSDF_LAMBERT)) | (lambert ? BSDF_LAMBERT : 0);
+#ifndef AJAR_NO_BENT_NORMALS
+	bs->flags |= fabs(cn) < BSDF_TILT_COS ? BSDF_TILTED : 0;
 #endif
 	bs->coat_s1 = bs->coat_sw = bs->coat_eavg = bs->metal_eavg = 0.0f;
 	bs->metal_fms = v3(0.0f, 0.0f, 0.0f);
@@ -338,16 +346,21 @@ INLINE float bsdf_glass_ms(const Bsdf *bs, int outside, int reflect, float e_o, 
 
 /* Pure Lambertian (glTF with specular 0, no metal, no transmission) and
  * not black: the diffuse lobe is then the only one. */
-INLINE int bsdf_lambert(const Bsdf *bs)
-{
-	return bs->metallic == 0.0f && bs->transmission == 0.0f && bs->specular == 0.0f && v3_maxc(bs->base_color) > 0.0f;
-}
+INLINE int bsdf_lambert(const Bsdf *bs) { return bs->flags & BSDF_LAMBERT; /* set by bsdf_setup_mr */ }
 
 /* Lobe selection for outgoing cos_o > 0 on the side of relative ior eta:
  * weight x albedo estimate. */
 INLINE BsdfLobes bsdf_lobes(const Bsdf *bs, float cos_o, float eta)
 {
 	BsdfLobes p;
+	if (bsdf_lambert(bs)) { /* what the general case gives, the same bits, without its tables */
+		float d = v3_avg(bs->base_color);
+		p.metal = p.coat = p.glass = p.ms = p.glass_r = p.glass_t = 0.0f;
+		p.diffuse = d * (1.0f / d);
+		p.e_metal = p.e_glass = 1.0f;
+		p.e_coat = 0.0f;
+		return p;
+	}
 	float wm = bsdf_w_metal(bs), wp = bsdf_w_plastic(bs);
 	p.e_metal = wm > 0.0f && !bsdf_smooth(bs) ? bsdf_metal_albedo(bs, cos_o) : 1.0f;
 	p.e_coat = wp > 0.0f && bs->specular > 0.0f ? bsdf_coat_albedo(bs, cos_o) : 0.0f; /* 0 without a coat */
@@ -400,6 +413,20 @@ INLINE float bsdf_tilt(const Bsdf *bs, V3 *x)
 	return atan2(l, fmax(nz, 0.0f));
 }
 
+/* Whether direction w keeps the own normal n: its mirror image about n lies
+ * at least thr = min(0.9 |w . ng|, 0.01) above the surface on w's side,
+ * 2 (w . n)(n . ng) - w . ng in w's side's sign (Cycles'
+ * ensure_valid_specular_reflection test). By dot products alone: surfaces
+ * with smooth normals ask it of every direction, and mostly keep n. */
+INLINE int bsdf_keeps_n(const Bsdf *bs, V3 w)
+{
+	float iz = v3_dot(w, bs->ng);
+	float sgn = iz < 0.0f ? -1.0f : 1.0f;
+	iz *= sgn;
+	float h = sgn * (2.0f * v3_dot(w, bs->n) * v3_dot(bs->n, bs->ng)) - iz;
+	return h >= fmin(0.9f * iz, 0.01f);
+}
+
 /* The angle from ng of the normal that direction w needs, on the arc from
  * n (angle tn, tilt direction x) to ng: tn where w's mirror image about n
  * lies at least thr = min(0.9 |w . ng|, 0.01) above the surface (w's own
@@ -416,7 +443,7 @@ INLINE float bsdf_bend_t(const Bsdf *bs, V3 x, float tn, V3 w)
 	iz *= sgn;
 	float ix = sgn * v3_dot(w, x);
 	float thr = fmin(0.9f * iz, 0.01f);
-	if (ix * sin(2.0f * tn) + iz * cos(2.0f * tn) >= thr)
+	if (bsdf_keeps_n(bs, w)) /* the height ix sin 2tn + iz cos 2tn >= thr */
 		return tn;
 	float a = sqrt(ix * ix + iz * iz);
 	if (!(a > 0.0f))
@@ -460,14 +487,20 @@ INLINE float bsdf_bend_ratio(const Bsdf *bs, V3 m, V3 wl)
 INLINE float bsdf_eta(const Bsdf *bs, float side) { return side > 0.0f ? bs->ior : 1.0f / bs->ior; }
 
 /* Non-delta f and pdf in the frame flipped to wo (wo.z > 0). wi.z > 0 is
- * reflection, wi.z < 0 transmission; the caller has checked the sides. */
-INLINE V3 bsdf_eval_local(const Bsdf *bs, V3 wo, V3 wi, float eta, int mode, float *pdf_w)
+ * reflection, wi.z < 0 transmission; the caller has checked the sides.
+ * Where the frame is a bent one (the top), the glossy lobes' f is scaled
+ * by gr (the light side's cosine ratio) and the diffuse base keeps the
+ * own normal n: its f is there where fz, the light side's cosine with n,
+ * is positive, and its density is that of cosine sampling about n at
+ * pz, wi's cosine with n. In the own frame gr = 1 and fz = pz = wi.z. */
+INLINE V3 bsdf_eval_lobes(const Bsdf *bs, V3 wo, V3 wi, float eta, int mode, float *pdf_w, float gr, float fz,
+			  float pz)
 {
 	V3 f = v3(0.0f, 0.0f, 0.0f);
 	float pdf = 0.0f;
 	if (bsdf_lambert(bs)) { /* the common case, exactly what the lobes below give */
-		*pdf_w = wi.z > 0.0f ? wi.z * AJAR_INV_PI : 0.0f;
-		return wi.z > 0.0f ? v3_scale(bs->base_color, AJAR_INV_PI) : f;
+		*pdf_w = pdf_cosine_hemisphere_w(pz);
+		return wi.z > 0.0f && fz > 0.0f ? v3_scale(bs->base_color, AJAR_INV_PI) : f;
 	}
 	BsdfLobes p = bsdf_lobes(bs, wo.z, eta);
 	int smooth = bsdf_smooth(bs);
@@ -478,22 +511,23 @@ INLINE V3 bsdf_eval_local(const Bsdf *bs, V3 wo, V3 wi, float eta, int mode, flo
 		float inv4 = 1.0f / (4.0f * wo.z * wi.z);
 		if (!smooth && bsdf_w_metal(bs) > 0.0f) {
 			float spec = ggx_d(h, bs->alpha) * ggx_g2(wo, wi, bs->alpha) * inv4;
-			f = v3_madd(f, bsdf_fresnel_metal(bs, cos_oh), bsdf_w_metal(bs) * spec);
-			f = v3_madd(f, bs->metal_fms, bsdf_w_metal(bs) * bsdf_ms_factor(bs, p.e_metal, wi.z));
+			f = v3_madd(f, bsdf_fresnel_metal(bs, cos_oh), bsdf_w_metal(bs) * spec * gr);
+			f = v3_madd(f, bs->metal_fms, bsdf_w_metal(bs) * bsdf_ms_factor(bs, p.e_metal, wi.z) * gr);
 			pdf += p.metal * ggx_pdf_visible(wo, h, bs->alpha) * jac + p.ms * pdf_cosine_hemisphere_w(wi.z);
 		}
 		float wp = bsdf_w_plastic(bs);
 		if (wp > 0.0f) {
 			float a = bsdf_coat_alpha(bs);
 			float spec = ggx_d(h, a) * ggx_g2(wo, wi, a) * inv4 * bsdf_fresnel_coat(bs, cos_oh);
-			float kd = bsdf_base_factor(bs, p.e_coat, wi.z);
-			f = v3_add(f, v3_madd(v3(wp * spec, wp * spec, wp * spec), bs->base_color, wp * kd));
-			pdf += p.coat * ggx_pdf_visible(wo, h, a) * jac + p.diffuse * pdf_cosine_hemisphere_w(wi.z);
+			float kd = fz > 0.0f ? bsdf_base_factor(bs, p.e_coat, wi.z) : 0.0f;
+			float ws = wp * spec * gr;
+			f = v3_add(f, v3_madd(v3(ws, ws, ws), bs->base_color, wp * kd));
+			pdf += p.coat * ggx_pdf_visible(wo, h, a) * jac + p.diffuse * pdf_cosine_hemisphere_w(pz);
 		}
 		if (!smooth && bsdf_w_glass(bs) > 0.0f) {
 			float fr = bsdf_fresnel_dielectric(cos_oh, eta);
 			float spec = ggx_d(h, bs->alpha) * ggx_g2(wo, wi, bs->alpha) * inv4 * fr;
-			float wg = bsdf_w_glass(bs) * (spec + bsdf_glass_ms(bs, eta > 1.0f, 1, p.e_glass, wi.z));
+			float wg = bsdf_w_glass(bs) * (spec + bsdf_glass_ms(bs, eta > 1.0f, 1, p.e_glass, wi.z)) * gr;
 			f = v3_add(f, v3(wg, wg, wg));
 			pdf += p.glass * fr * ggx_pdf_visible(wo, h, bs->alpha) * jac + p.glass_r * pdf_cosine_hemisphere_w(wi.z);
 		}
@@ -517,10 +551,16 @@ INLINE V3 bsdf_eval_local(const Bsdf *bs, V3 wo, V3 wi, float eta, int mode, flo
 		}
 		if (mode == BSDF_RADIANCE)
 			t /= eta * eta;
-		f = v3_scale(bs->base_color, bsdf_w_glass(bs) * t);
+		f = v3_scale(bs->base_color, bsdf_w_glass(bs) * t * gr);
 	}
 	*pdf_w = pdf;
 	return f;
+}
+
+/* bsdf_eval_lobes in the own frame. */
+INLINE V3 bsdf_eval_local(const Bsdf *bs, V3 wo, V3 wi, float eta, int mode, float *pdf_w)
+{
+	return bsdf_eval_lobes(bs, wo, wi, eta, mode, pdf_w, 1.0f, wi.z, wi.z);
 }
 
 /* Side of w as ng sees it: +1, -1, or 0 when w lies in the surface. */
@@ -545,33 +585,43 @@ INLINE int bsdf_pair(const Bsdf *bs, const BsdfFrame *fr, V3 wo, V3 wi, V3 *lo, 
 	return so == si ? li->z > 0.0f : li->z < 0.0f;
 }
 
-/* bsdf_eval where n differs from ng (the top): f in the camera side's
- * normal (wo's in radiance mode, wi's in importance mode) times the light
- * side's cosine ratio, pdf_w in wo's normal and, if `rev`, pdf_rev_w in
- * wi's. */
+/* bsdf_eval where n differs from ng (the top): the glossy lobes' f in the
+ * camera side's normal (wo's in radiance mode, wi's in importance mode)
+ * times the light side's cosine ratio, the diffuse base's in n; pdf_w
+ * from wo (its normal) and, if `rev`, pdf_rev_w from wi (its normal). */
 INLINE V3 bsdf_eval_bent(const Bsdf *bs, V3 wo, V3 wi, int mode, float *pdf_w, float *pdf_rev_w, int rev)
 {
 	V3 lo, li, x, f = v3(0.0f, 0.0f, 0.0f);
 	float eta, unused;
 	*pdf_w = *pdf_rev_w = 0.0f;
-	if (bsdf_side(bs, wo) == 0.0f || bsdf_side(bs, wi) == 0.0f)
+	float so = bsdf_side(bs, wo), si = bsdf_side(bs, wi);
+	if (so == 0.0f || si == 0.0f)
 		return f;
+	if (bsdf_keeps_n(bs, wo) && bsdf_keeps_n(bs, wi)) { /* no bend: the own frame, what the rest gives then */
+		BsdfFrame fr = bsdf_frame_own(bs);
+		if (bsdf_pair(bs, &fr, wo, wi, &lo, &li, &eta))
+			f = bsdf_eval_local(bs, lo, li, eta, mode, pdf_w);
+		if (rev && bsdf_pair(bs, &fr, wi, wo, &lo, &li, &eta))
+			bsdf_eval_local(bs, lo, li, eta, mode, pdf_rev_w);
+		return f;
+	}
 	float tn = bsdf_tilt(bs, &x);
 	float to = bsdf_bend_t(bs, x, tn, wo), ti = bsdf_bend_t(bs, x, tn, wi);
 	BsdfFrame fo = bsdf_frame_t(bs, x, tn, to), fi = ti == to ? fo : bsdf_frame_t(bs, x, tn, ti);
-	if (bsdf_pair(bs, &fo, wo, wi, &lo, &li, &eta))
-		f = bsdf_eval_local(bs, lo, li, eta, mode, pdf_w);
-	if (rev && bsdf_pair(bs, &fi, wi, wo, &lo, &li, &eta))
-		bsdf_eval_local(bs, lo, li, eta, mode, pdf_rev_w);
 	int radiance = mode == BSDF_RADIANCE;
 	float tf = radiance ? to : ti;
+	V3 wl = radiance ? wi : wo;
+	float gr = tf != tn ? bsdf_bend_ratio(bs, radiance ? fo.n : fi.n, wl) : 1.0f;
+	float fz = so * v3_dot(wl, bs->n), pzo = so * v3_dot(wi, bs->n), pzi = si * v3_dot(wo, bs->n);
+	if (bsdf_pair(bs, &fo, wo, wi, &lo, &li, &eta))
+		f = bsdf_eval_lobes(bs, lo, li, eta, mode, pdf_w, gr, fz, pzo);
+	if (rev && bsdf_pair(bs, &fi, wi, wo, &lo, &li, &eta))
+		bsdf_eval_lobes(bs, lo, li, eta, mode, pdf_rev_w, 1.0f, pzi, pzi);
 	if (!radiance && ti != to) { /* the camera side is wi: f in wi's normal */
 		f = v3(0.0f, 0.0f, 0.0f);
 		if (bsdf_pair(bs, &fi, wo, wi, &lo, &li, &eta))
-			f = bsdf_eval_local(bs, lo, li, eta, mode, &unused);
+			f = bsdf_eval_lobes(bs, lo, li, eta, mode, &unused, gr, fz, pzo);
 	}
-	if (tf != tn)
-		f = v3_scale(f, bsdf_bend_ratio(bs, radiance ? fo.n : fi.n, radiance ? wi : wo));
 	return f;
 }
 
@@ -612,7 +662,7 @@ CALLED V3 bsdf_eval(const Bsdf *bs, V3 wo, V3 wi, int mode, float *pdf_w, float 
 INLINE BsdfFrame bsdf_frame_for(const Bsdf *bs, V3 wo, int *bent)
 {
 	*bent = 0;
-	if (!BSDF_IS_TILTED(bs))
+	if (!BSDF_IS_TILTED(bs) || bsdf_keeps_n(bs, wo))
 		return bsdf_frame_own(bs);
 	V3 x;
 	float tn = bsdf_tilt(bs, &x), t = bsdf_bend_t(bs, x, tn, wo);
@@ -628,8 +678,10 @@ INLINE float bsdf_pdf_w(const Bsdf *bs, V3 wo, V3 wi)
 	float eta, pdf = 0.0f;
 	int bent;
 	BsdfFrame fr = bsdf_frame_for(bs, wo, &bent);
-	if (bsdf_pair(bs, &fr, wo, wi, &lo, &li, &eta))
-		bsdf_eval_local(bs, lo, li, eta, BSDF_RADIANCE, &pdf);
+	if (bsdf_pair(bs, &fr, wo, wi, &lo, &li, &eta)) {
+		float pz = bent ? bsdf_side(bs, wo) * v3_dot(wi, bs->n) : li.z; /* the diffuse base's, in n */
+		bsdf_eval_lobes(bs, lo, li, eta, BSDF_RADIANCE, &pdf, 1.0f, pz, pz);
+	}
 	return pdf;
 }
 
@@ -646,7 +698,7 @@ INLINE float bsdf_glass_delta_prob(const Bsdf *bs, V3 wo, float eta, int reflect
  * throughput (in a bent normal m, times |wl . m| / |wl . n| as every f, the
  * top); pdf_w and pdf_rev_w are then the probabilities of picking that delta
  * event from wo and from wi. */
-CALLED int bsdf_sample(const Bsdf *bs, V3 wo, float u0, float u1, float u2, int mode, BsdfSample *s)
+INLINE int bsdf_sample_in(const Bsdf *bs, V3 wo, float u0, float u1, float u2, int mode, BsdfSample *s, int rev)
 {
 	float so = bsdf_side(bs, wo);
 	if (so == 0.0f)
@@ -660,6 +712,8 @@ CALLED int bsdf_sample(const Bsdf *bs, V3 wo, float u0, float u1, float u2, int 
 	BsdfLobes p = bsdf_lobes(bs, lo.z, eta);
 	int smooth = bsdf_smooth(bs), reflect = 1;
 	V3 li;
+	BsdfFrame own;
+	const BsdfFrame *fl = &frame; /* the frame li is in */
 	/* Lobe by u0; u0 is then rescaled within the lobe and reused for the
 	 * glass reflect/refract choice. */
 	if (u0 < p.metal) {
@@ -680,8 +734,14 @@ CALLED int bsdf_sample(const Bsdf *bs, V3 wo, float u0, float u1, float u2, int 
 		li = bsdf_reflect(lo, ggx_sample_visible(lo, bs->alpha, u1, u2));
 	} else if (u0 < p.metal + p.coat) {
 		li = bsdf_reflect(lo, ggx_sample_visible(lo, bsdf_coat_alpha(bs), u1, u2));
+	} else if (u0 < p.metal + p.coat + p.diffuse) {
+		li = sample_cosine_hemisphere(u1, u2); /* the diffuse base, about n (bsdf_eval_lobes) */
+		if (bent) {
+			own = bsdf_frame_own(bs);
+			fl = &own;
+		}
 	} else if (u0 < p.metal + p.coat + p.diffuse + p.ms + p.glass_r) {
-		/* diffuse base, metal or glass multiple scattering (reflection) */
+		/* metal or glass multiple scattering (reflection) */
 		li = sample_cosine_hemisphere(u1, u2);
 	} else if (u0 < p.metal + p.coat + p.diffuse + p.ms + p.glass_r + p.glass_t) {
 		li = sample_cosine_hemisphere(u1, u2); /* glass multiple scattering, refraction */
@@ -725,10 +785,26 @@ CALLED int bsdf_sample(const Bsdf *bs, V3 wo, float u0, float u1, float u2, int 
 	 * of that direction belongs to the other event. */
 	if (reflect ? !(li.z > 0.0f) : !(li.z < 0.0f))
 		return 0;
-	s->wi = bsdf_world(&frame, li, so);
+	s->wi = bsdf_world(fl, li, so);
+	if (fl != &frame && bsdf_side(bs, s->wi) != so) /* about n, below the surface: lost too */
+		return 0;
 	s->delta = 0;
-	s->f = bsdf_eval(bs, wo, s->wi, mode, &s->pdf_w, &s->pdf_rev_w);
+	s->pdf_rev_w = 0.0f;
+	s->f = rev ? bsdf_eval(bs, wo, s->wi, mode, &s->pdf_w, &s->pdf_rev_w) : bsdf_eval_fwd(bs, wo, s->wi, mode, &s->pdf_w);
 	return s->pdf_w > 0.0f;
+}
+
+CALLED int bsdf_sample(const Bsdf *bs, V3 wo, float u0, float u1, float u2, int mode, BsdfSample *s)
+{
+	return bsdf_sample_in(bs, wo, u0, u1, u2, mode, s, 1);
+}
+
+/* bsdf_sample without pdf_rev_w of non-delta samples (left 0), which a
+ * path tracer never reads: f and pdf_w are the same bits, one evaluation
+ * of the lobes fewer. */
+CALLED int bsdf_sample_fwd(const Bsdf *bs, V3 wo, float u0, float u1, float u2, int mode, BsdfSample *s)
+{
+	return bsdf_sample_in(bs, wo, u0, u1, u2, mode, s, 0);
 }
 
 #endif

@@ -118,7 +118,7 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 		BsdfSample bsm;
 		float u0, u1, u2;
 		rng_f3(rng, &u0, &u1, &u2);
-		if (!bsdf_sample(&bs, wo, u0, u1, u2, BSDF_RADIANCE, &bsm) || !(bsm.pdf_w > 0.0f))
+		if (!bsdf_sample_fwd(&bs, wo, u0, u1, u2, BSDF_RADIANCE, &bsm) || !(bsm.pdf_w > 0.0f))
 			break;
 		beta = v3_mul(beta, v3_scale(bsm.f, fabs(v3_dot(s.ns, bsm.wi)) / bsm.pdf_w));
 		prev_pdf_w = bsm.pdf_w;

@@ -10,22 +10,28 @@ INLINE float srgb_to_linear(float c)
 	return c <= 0.04045f ? c * (1.0f / 12.92f) : pow((c + 0.055f) * (1.0f / 1.055f), 2.4f);
 }
 
-/* One texel's four channels in [0, 1], colour decoded from sRGB if asked. */
+/* Four channels in [0, 1]. */
 typedef struct {
 	V3 rgb;
 	float a;
 } Rgba;
 
-INLINE Rgba texel_rgba(uint t, int srgb)
+/* One texel's channels as stored (colour still sRGB-encoded). */
+INLINE Rgba texel_rgba(uint t)
 {
 	Rgba r;
-	float c[3];
-	for (int i = 0; i < 3; i++) {
-		float x = (float)((t >> (8 * i)) & 255u) * (1.0f / 255.0f);
-		c[i] = srgb ? srgb_to_linear(x) : x;
-	}
-	r.rgb = v3(c[0], c[1], c[2]);
+	r.rgb = v3((float)(t & 255u), (float)((t >> 8) & 255u), (float)((t >> 16) & 255u));
+	r.rgb = v3_scale(r.rgb, 1.0f / 255.0f);
 	r.a = (float)(t >> 24) * (1.0f / 255.0f);
+	return r;
+}
+
+/* The colour of a filtered value decoded from sRGB if asked (alpha is
+ * linear in glTF). */
+INLINE Rgba rgba_decode(Rgba r, int srgb)
+{
+	if (srgb)
+		r.rgb = v3(srgb_to_linear(r.rgb.x), srgb_to_linear(r.rgb.y), srgb_to_linear(r.rgb.z));
 	return r;
 }
 
@@ -63,7 +69,11 @@ INLINE Rgba rgba_lerp(Rgba a, Rgba b, float t)
 /* Texture `tex` at (u, v), the coordinates of its set before its
  * transform: wrap modes and filter as its sampler says; (0, 0) is the
  * image's first texel's corner, as glTF defines UVs. Bilinear filtering
- * blends decoded (linear) values. */
+ * blends the stored (sRGB-encoded) values and decodes the blend, as
+ * Cycles does with 8-bit sRGB images (NODE_IMAGE_COMPRESS_AS_SRGB:
+ * interpolate, then color_srgb_to_linear): Blender's importer is what
+ * users compare with (kernels/materials.md, "Texture coordinates and
+ * samplers"). */
 INLINE Rgba texture_rgba(const SceneView *sc, int tex, float u0, float v0, int srgb)
 {
 	GLOBAL const Texture *t = &sc->textures[tex];
@@ -74,16 +84,16 @@ INLINE Rgba texture_rgba(const SceneView *sc, int tex, float u0, float v0, int s
 	if (t->flags & TEX_NEAREST) {
 		int x = texture_wrap((int)floor(u * (float)t->width), t->width, ws);
 		int y = texture_wrap((int)floor(v * (float)t->height), t->height, wt);
-		return texel_rgba(px[y * t->width + x], srgb);
+		return rgba_decode(texel_rgba(px[y * t->width + x]), srgb);
 	}
 	float x = u * (float)t->width - 0.5f, y = v * (float)t->height - 0.5f;
 	float fx = floor(x), fy = floor(y);
 	float ax = x - fx, ay = y - fy;
 	int x0 = texture_wrap((int)fx, t->width, ws), x1 = texture_wrap((int)fx + 1, t->width, ws);
 	int y0 = texture_wrap((int)fy, t->height, wt), y1 = texture_wrap((int)fy + 1, t->height, wt);
-	Rgba c00 = texel_rgba(px[y0 * t->width + x0], srgb), c10 = texel_rgba(px[y0 * t->width + x1], srgb);
-	Rgba c01 = texel_rgba(px[y1 * t->width + x0], srgb), c11 = texel_rgba(px[y1 * t->width + x1], srgb);
-	return rgba_lerp(rgba_lerp(c00, c10, ax), rgba_lerp(c01, c11, ax), ay);
+	Rgba c00 = texel_rgba(px[y0 * t->width + x0]), c10 = texel_rgba(px[y0 * t->width + x1]);
+	Rgba c01 = texel_rgba(px[y1 * t->width + x0]), c11 = texel_rgba(px[y1 * t->width + x1]);
+	return rgba_decode(rgba_lerp(rgba_lerp(c00, c10, ax), rgba_lerp(c01, c11, ax), ay), srgb);
 }
 
 /* Barycentric coordinates (b1, b2) of p, a point in triangle t's plane,
