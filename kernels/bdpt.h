@@ -112,7 +112,7 @@ CALLED float bdpt_weight(const SceneView *sc, VCRef l, int s, VCRef e, int t)
 		PathRef P;
 		MisStrategy cur = {1, s, 0, 0};
 		path_ref(&P, l, s, 0, 0, 0, 0, e, t);
-		return path_union_weight(sc, &P, cur);
+		return path_bdpt_weight(sc, &P, cur);
 	}
 	MisVertex mv[2 * SUBPATH_MAX];
 	int k = bdpt_mis_path(sc, l, s, e, t, mv);
