@@ -204,7 +204,7 @@ INLINE float path_pair_logsum(const SceneView *sc, const PathRef *P, int i, floa
 #define PATH_WHOLE 0
 #define PATH_LIGHT_END 1 /* x_0..x_m, pf_{m+1} and edges 0..m only (path_light_end) */
 #define PATH_EYE_END 2   /* x_{m+1}.., pr_m and edges after m only (path_eye_end) */
-#define PATH_NO_PAIRS 3  /* the whole path's densities, no crossings (path_bdpt_weight) */
+#define PATH_NO_PAIRS 3  /* the whole path's densities, no crossings (path_unpaired_weight) */
 
 INLINE void path_records_part(const SceneView *sc, const PathRef *P, int heuristic, MisPortalSet set, int n,
 			      MisVertex *mv, int *cross, float *lpsum, float *lpair_cur, int part)
@@ -339,7 +339,7 @@ CALLED float path_union_weight(const SceneView *sc, const PathRef *P, MisStrateg
 	return mis_union_weight(mv, P->k, n, cross, lpsum, lpair_cur, cur, set, heuristic);
 }
 
-/* Whether edge i of a bdpt path P crosses a portal that intermediate
+/* Whether an edge of bdpt path P crosses a portal that intermediate
  * strategies in use could pair on: the tests path_records_part makes for
  * the crossings it counts (mis_pair_edges; a connection edge by geometry,
  * path_pair_logsum's, a walk's edge from its cache), over the edges
@@ -370,34 +370,17 @@ INLINE int path_bdpt_pairs(const SceneView *sc, const PathRef *P, MisPortalSet s
 	return 0;
 }
 
-/* The union weight of bdpt strategy cur.s for the bdpt path P (sp = 0).
- * Where no edge that an intermediate strategy in use pairs on crosses a
- * portal (path_bdpt_pairs), none of them produces the path and the union
- * sum holds only the bdpt strategies in use, with no crossings or pair
- * densities to find. With light subpaths (every s) that is bdpt's own
- * weight, by its ratios of the same records (mis_path_weight), without the
- * logs of up to 33 records and an exp per strategy: equal to the full
- * computation up to float rounding (test_portal, test_bdpt_weight_shortcut).
- * Without them (s <= 1) it is the full computation's sum, bit for bit. On
- * window-room-lamp every path from the lamp takes it, on the sun scenes
- * every path of 6 or more vertices (lo = k - 5 > 0 with the sky's set),
- * whose first edge, through the window, is then no pairing edge. */
-CALLED float path_bdpt_weight(const SceneView *sc, const PathRef *P, MisStrategy cur)
+/* The union weight of bdpt strategy cur.s (s <= 1) for the bdpt path P
+ * without light subpaths where path_bdpt_pairs finds no pairing edge: the
+ * union sum with no crossings or pair densities to find, bit for bit what
+ * path_union_weight gives (the records stop at the horizon, 5 with the
+ * sky's set, so the logs are few). bdpt_weight uses it. */
+INLINE float path_unpaired_weight(const SceneView *sc, const PathRef *P, MisPortalSet set, int n, MisStrategy cur)
 {
-	MisPortalSet set = path_portal_set(sc->params);
-	int n = mis_horizon(set, P->k);
-	if (path_bdpt_pairs(sc, P, set, n))
-		return path_union_weight(sc, P, cur);
 	MisVertex mv[4 * SUBPATH_MAX];
-	int heuristic = sc->params->mis;
-	path_records_part(sc, P, heuristic, set, n, mv, 0, 0, 0, PATH_NO_PAIRS);
-	if (set.light_paths)
-		return mis_path_weight(mv, P->k, cur.s, heuristic);
-	/* Without light subpaths the records stop at the horizon (5 with the
-	 * sky's set) and logs are few: the union sum itself, no edge pairing,
-	 * bit for bit what the full computation gives. */
-	int cross[4 * SUBPATH_MAX];
+	int cross[4 * SUBPATH_MAX], heuristic = sc->params->mis;
 	float lpsum[1] = {-AJAR_INF}; /* not read */
+	path_records_part(sc, P, heuristic, set, n, mv, 0, 0, 0, PATH_NO_PAIRS);
 	for (int i = 0; i < n; i++)
 		cross[i] = 0;
 	return mis_union_weight(mv, P->k, n, cross, lpsum, 0.0f, cur, set, heuristic);

@@ -166,7 +166,8 @@ static void check_path(const SceneView *sc, const PathRef *P, MisStats *st)
 				   : set.light_paths || P->s <= 1;
 		if (heur == prm->mis && in_use) {
 			MisStrategy cur = {P->sp ? 2 : 1, P->s, P->pair, P->tp};
-			float wk = P->sp ? path_union_weight(sc, P, cur) : path_bdpt_weight(sc, P, cur);
+			/* bdpt paths: bdpt_weight, the kernel's (l = x_0.., e = x_{k-1}..) */
+			float wk = P->sp ? path_union_weight(sc, P, cur) : bdpt_weight(sc, P->x[0], P->s, P->x[k - 1], P->t);
 			float wo = mis_union_weight(orc, k, k, ocross, lpsum, P->pair >= 0 ? lcur_o : 0, cur, set, heur);
 			st->weights++;
 			st->woff += fabs(wk - wo) > 1e-2;
@@ -477,8 +478,8 @@ static Scene *sun_window_room(int inside, int sky)
 	return punctual_scene(SCENE("window-room/window-room.gltf"), sun_in, inside, wr_p, wr_q, sky);
 }
 
-/* The bdpt strategies' weights in the portal integrator (path_bdpt_weight,
- * what bdpt_weight uses there) against the full union weight
+/* The bdpt strategies' weights in the portal integrator (bdpt_weight)
+ * against the full union weight
  * (path_union_weight) for every bdpt path of random samples: the same up to
  * float rounding (bit for bit without light subpaths), where the shortcut
  * (no pairing edge crosses a portal) is taken and where it is not. Adds to
@@ -524,7 +525,7 @@ static void check_bdpt_weights(HostScene *h, int nsamples, int *fast, int *full)
 				PathRef P;
 				path_ref(&P, lp, s, 0, 0, 0, 0, e, t);
 				MisStrategy cur = {1, s, 0, 0};
-				float want = path_union_weight(sc, &P, cur), got = path_bdpt_weight(sc, &P, cur);
+				float want = path_union_weight(sc, &P, cur), got = bdpt_weight(sc, lp, s, e, t);
 				/* without light subpaths the same sum, bit for bit */
 				if (!(fabs(got - want) <= 1e-5f + 1e-4f * want) || (!prm->light_paths && got != want))
 					fail_msg("bdpt path (s=%d, t=%d): weight %.9g, full union weight %.9g", s, t, got, want);
