@@ -1212,7 +1212,5 @@ int main(void)
 		cmocka_unit_test(test_mis_punctual),
 		cmocka_unit_test(test_portal_matches_pt_punctual),
 	};
-	if (getenv("TEST_ONLY"))
-		cmocka_set_test_filter(getenv("TEST_ONLY"));
 	return cmocka_run_group_tests_name("portal", tests, NULL, NULL);
 }
