@@ -196,7 +196,7 @@ INLINE float punctual_dir_pdf(GLOBAL const PunctualLight *l, V3 w)
 		return pdf_uniform_sphere_w();
 	if (!(v3_dot(w, l->dir) >= l->cos_outer))
 		return 0.0f;
-	return 1.0f / (2.0f * AJAR_PI * (1.0f - l->cos_outer));
+	return pdf_uniform_cone_w(l->cos_outer);
 }
 
 /* A light subpath's direction from point or spot light `l` (density
@@ -205,11 +205,9 @@ INLINE V3 punctual_dir_sample(GLOBAL const PunctualLight *l, float u1, float u2)
 {
 	if (l->type != LIGHT_SPOT)
 		return sample_uniform_sphere(u1, u2);
-	float c = 1.0f - u1 * (1.0f - l->cos_outer);
-	float sn = sqrt(fmax(0.0f, 1.0f - c * c)), phi = 2.0f * AJAR_PI * u2;
 	V3 t, b;
 	v3_basis(l->dir, &t, &b);
-	return v3_from_local(v3(sn * cos(phi), sn * sin(phi), c), t, b, l->dir);
+	return v3_from_local(sample_uniform_cone(u1, u2, l->cos_outer), t, b, l->dir);
 }
 
 /* A directional light's light subpaths are parallel rays along l->dir.
