@@ -36,8 +36,11 @@
 
 /* The MIS records of the path made of light vertices l[0..s-1] and eye
  * vertices e[t-1..0], with the densities next to the connection
- * recomputed: pr of l[s-1] and l[s-2], pf of e[t-1] and e[t-2]. */
-INLINE int bdpt_mis_path(const SceneView *sc, VCRef l, int s, VCRef e, int t, MisVertex *mv)
+ * recomputed: pr of l[s-1] and l[s-2], pf of e[t-1] and e[t-2]. With
+ * `nee_stored` (the portal integrator, bdpt_weight) a next-event light
+ * vertex (s = 1, t >= 2) brings its pn_0 and pr_0 (bdpt_nee), as
+ * path_records_part takes them, instead of a second sky lookup. */
+INLINE int bdpt_mis_path(const SceneView *sc, VCRef l, int s, VCRef e, int t, MisVertex *mv, int nee_stored)
 {
 	GLOBAL const Camera *cam = &sc->params->camera;
 	int k = s + t;
@@ -71,7 +74,13 @@ INLINE int bdpt_mis_path(const SceneView *sc, VCRef l, int s, VCRef e, int t, Mi
 	/* x_1 and x_2 (k >= 3 for the second): light vertices, then eye vertices. */
 	const PathVertex *x1 = VLOAD(s >= 2 ? VAT(l, 1) : (s == 1 ? VAT(e, t - 1) : VAT(e, t - 2)), t1);
 	const PathVertex *x2 = VLOAD(s >= 3 ? VAT(l, 2) : VAT(e, max(t + s - 3, 0)), t2);
-	bdpt_light_records(sc, mv, x0, x1, x2, k);
+	nee_stored = nee_stored && s == 1 && t >= 2;
+	if (nee_stored) {
+		mv[0].pf = bdpt_origin_pdf(sc, x0);
+		mv[0].pn = x0->pf;
+	} else {
+		bdpt_light_records(sc, mv, x0, x1, x2, k);
+	}
 	if (s == 0) {
 		/* e[t-1] is the light: its emission density. */
 		const PathVertex *lt = x0;
@@ -96,7 +105,7 @@ INLINE int bdpt_mis_path(const SceneView *sc, VCRef l, int s, VCRef e, int t, Mi
 		float d2 = v3_len2(d);
 		camera_raster(cam, v3_scale(d, 1.0f / sqrt(d2)), &px, &py, &cos_c);
 		mv[s - 1].pr = vertex_density_a(es, ls, camera_pdf_w(cam, cos_c));
-	} else {
+	} else if (!(nee_stored && ls->pr > 0.0f)) {
 		mv[s - 1].pr = bdpt_pdf_a(sc, es, VLOAD(VAT(e, t - 2), t3), ls, BSDF_RADIANCE);
 	}
 	if (s >= 2)
@@ -105,17 +114,37 @@ INLINE int bdpt_mis_path(const SceneView *sc, VCRef l, int s, VCRef e, int t, Mi
 }
 
 /* The weight of bdpt strategy (s, t): over the bdpt strategies alone, or,
- * in the portal integrator, over both families (path_mis.h). */
+ * in the portal integrator, over both families (path_mis.h). There, where
+ * no edge that an intermediate strategy in use pairs on crosses a portal
+ * (path_bdpt_pairs), none of them produces the path and the union sum
+ * holds only the bdpt strategies in use, with no crossings or pair
+ * densities to find. With light subpaths (every s) that is bdpt's own
+ * weight, from bdpt's records (the next-event vertex's stored densities,
+ * as path_records_part takes them) by its ratios, without the logs of up
+ * to 33 records and an exponential per strategy: equal to the full union
+ * weight up to float rounding. Without them (s <= 1) it is the full
+ * computation's sum, bit for bit (path_unpaired_weight). test_portal's
+ * test_bdpt_weight_shortcut checks both. On window-room-lamp every path
+ * from the lamp takes the shortcut; on the sun scenes every path of 6 or
+ * more vertices, whose first edge, through the window, is then no
+ * pairing edge (lo = k - 5 with the sky's set, mis_pair_edges). */
 CALLED float bdpt_weight(const SceneView *sc, VCRef l, int s, VCRef e, int t)
 {
+	MisVertex mv[2 * SUBPATH_MAX];
 	if (PARAMS_INTEGRATOR(sc->params) == INTEGRATOR_PORTAL) {
 		PathRef P;
 		MisStrategy cur = {1, s, 0, 0};
 		path_ref(&P, l, s, 0, 0, 0, 0, e, t);
-		return path_union_weight(sc, &P, cur);
+		MisPortalSet set = path_portal_set(sc->params);
+		int n = mis_horizon(set, P.k);
+		if (path_bdpt_pairs(sc, &P, set, n))
+			return path_union_weight(sc, &P, cur);
+		if (!set.light_paths)
+			return path_unpaired_weight(sc, &P, set, n, cur);
+		int k = bdpt_mis_path(sc, l, s, e, t, mv, 1);
+		return mis_path_weight(mv, k, s, sc->params->mis);
 	}
-	MisVertex mv[2 * SUBPATH_MAX];
-	int k = bdpt_mis_path(sc, l, s, e, t, mv);
+	int k = bdpt_mis_path(sc, l, s, e, t, mv, 0);
 	return mis_path_weight(mv, k, s, sc->params->mis);
 }
 

@@ -204,6 +204,7 @@ INLINE float path_pair_logsum(const SceneView *sc, const PathRef *P, int i, floa
 #define PATH_WHOLE 0
 #define PATH_LIGHT_END 1 /* x_0..x_m, pf_{m+1} and edges 0..m only (path_light_end) */
 #define PATH_EYE_END 2   /* x_{m+1}.., pr_m and edges after m only (path_eye_end) */
+#define PATH_NO_PAIRS 3  /* the whole path's densities, no crossings (path_unpaired_weight) */
 
 INLINE void path_records_part(const SceneView *sc, const PathRef *P, int heuristic, MisPortalSet set, int n,
 			      MisVertex *mv, int *cross, float *lpsum, float *lpair_cur, int part)
@@ -236,7 +237,10 @@ INLINE void path_records_part(const SceneView *sc, const PathRef *P, int heurist
 		VTMP(t1);
 		VTMP(t2);
 		const PathVertex *x0 = VLOAD(x[0], t0);
-		mv[0].pf = bdpt_origin_pdf(sc, x0);
+		/* pf_0 enters only strategies with s >= 2 light vertices (and pn_0
+		 * where k < 3): without light subpaths it cancels, and for the sky
+		 * it is an image lookup per weight. */
+		mv[0].pf = set.light_paths || set.s_max >= 2 || k < 3 ? bdpt_origin_pdf(sc, x0) : 0.0f;
 		mv[0].pn = k < 3 ? mv[0].pf : (nee ? x0->pf : bdpt_nee_pdf(sc, x0, VLOAD(x[1], t1), VLOAD(x[2], t2)));
 		if (need_pf && P->s == 0 && k > 2)
 			mv[1].pf = path_pf(sc, P, mv, 1);
@@ -260,6 +264,8 @@ INLINE void path_records_part(const SceneView *sc, const PathRef *P, int heurist
 		if (part != PATH_LIGHT_END)
 			mv[P->pair].pr = path_pr(sc, P, mv, P->pair);
 	}
+	if (part == PATH_NO_PAIRS)
+		return;
 	/* Crossings and pair densities of the edges intermediate strategies
 	 * can pair on (mis_pair_edges), and the current sample's own crossing
 	 * (its w_0, kept in the pair's vertices). Each subpath's vertices
@@ -331,6 +337,53 @@ CALLED float path_union_weight(const SceneView *sc, const PathRef *P, MisStrateg
 	int n = mis_horizon(set, P->k);
 	path_records(sc, P, heuristic, set, n, mv, cross, lpsum, &lpair_cur);
 	return mis_union_weight(mv, P->k, n, cross, lpsum, lpair_cur, cur, set, heuristic);
+}
+
+/* Whether an edge of bdpt path P crosses a portal that intermediate
+ * strategies in use could pair on: the tests path_records_part makes for
+ * the crossings it counts (mis_pair_edges; a connection edge by geometry,
+ * path_pair_logsum's, a walk's edge from its cache), over the edges
+ * mis_union_sum reads (m + 2 < k). */
+INLINE int path_bdpt_pairs(const SceneView *sc, const PathRef *P, MisPortalSet set, int n)
+{
+	int k = P->k, lo, hi;
+	mis_pair_edges(set, k, n, &lo, &hi);
+	for (int i = lo; i < hi && i + 2 < k; i++) {
+		if (i != P->c1) {
+			if (VGETI(P->x[i + 1 < P->s ? i + 1 : i], cross) != 0)
+				return 1;
+			continue;
+		}
+		VTMP(at);
+		VTMP(bt);
+		const PathVertex *a = VLOAD(P->x[i], at), *b = VLOAD(P->x[i + 1], bt);
+		V3 o = vertex_infinite(a) ? b->p : a->p;
+		V3 d = vertex_infinite(a) ? a->p : v3_sub(b->p, a->p);
+		float tmax = vertex_infinite(a) ? AJAR_INF : 1.0f;
+		for (int j = 0; j < sc->params->num_portals; j++) {
+			GLOBAL const PortalTri *pt = &sc->portals[j];
+			float t;
+			if (portal_tri_crossing(o, d, tmax, pt->p0, pt->p1, pt->p2, &t))
+				return 1;
+		}
+	}
+	return 0;
+}
+
+/* The union weight of bdpt strategy cur.s (s <= 1) for the bdpt path P
+ * without light subpaths where path_bdpt_pairs finds no pairing edge: the
+ * union sum with no crossings or pair densities to find, bit for bit what
+ * path_union_weight gives (the records stop at the horizon, 5 with the
+ * sky's set, so the logs are few). bdpt_weight uses it. */
+INLINE float path_unpaired_weight(const SceneView *sc, const PathRef *P, MisPortalSet set, int n, MisStrategy cur)
+{
+	MisVertex mv[4 * SUBPATH_MAX];
+	int cross[4 * SUBPATH_MAX], heuristic = sc->params->mis;
+	float lpsum[1] = {-AJAR_INF}; /* not read */
+	path_records_part(sc, P, heuristic, set, n, mv, 0, 0, 0, PATH_NO_PAIRS);
+	for (int i = 0; i < n; i++)
+		cross[i] = 0;
+	return mis_union_weight(mv, P->k, n, cross, lpsum, 0.0f, cur, set, heuristic);
 }
 
 /* ---- Portal paths that share an intermediate subpath ---------------------
@@ -574,20 +627,42 @@ INLINE float path_join_whole(const SceneView *sc, MisPortalSet set, const MisLig
 	return mis_union_sum(v, k, k, PF, PR, lpn, cross, lpsum, L->lpair_cur, cur, set, sc->params->mis);
 }
 
-/* The weight of portal strategy cur (L's s and s', E's t' and t) for the
- * path that joins light-side end L to eye-side end E, whose records are r;
- * x2 is the path's x_2, read when L->pn_from_x2. set is
- * path_portal_set(sc->params), which the caller makes once. */
-CALLED float path_join_weight(const SceneView *sc, MisPortalSet set, const MisLightEnd *L, const MisEyeEnd *E,
-			      const MisRecord *r, VCRef x2, VCRef R, MisStrategy cur)
+/* log pn_0 where the light-side end is the <- half's first vertex alone
+ * (L->pn_from_x2: s = 0, s' = 1): A = R[1] as a next-event sample from
+ * B = R[0], which reads the path's x_2 only for the side of B's normal that
+ * faces it (vertex_nee_normal, bdpt_nee_pdf). The two sides' logs are kept
+ * in *c, which the caller clears (have = 0) for each light-side end, so its
+ * eye-side ends share one sky lookup per side. */
+typedef struct {
+	float lpn[2];
+	int have; /* bit i: lpn[i] is set */
+} MisPnCache;
+
+INLINE float path_join_lpn(const SceneView *sc, VCRef R, VCRef x2, MisPnCache *c)
 {
-	int m = L->m;
 	VTMP(t0);
 	VTMP(t1);
 	VTMP(t2);
-	float lpn = L->pn_from_x2 ? fast_log(mis_remap0(bdpt_nee_pdf(sc, VLOAD(VAT(R, 1), t0), VLOAD(VAT(R, 0), t1),
-								       VLOAD(x2, t2))))
-				  : L->lpn;
+	const PathVertex *a = VLOAD(VAT(R, 1), t0), *b = VLOAD(VAT(R, 0), t1), *x = VLOAD(x2, t2);
+	V3 w = vertex_infinite(x) ? x->p : v3_sub(x->p, b->p);
+	int side = v3_dot(b->ns, w) < 0.0f; /* vertex_nee_normal's test */
+	if (!(c->have >> side & 1)) {
+		c->lpn[side] = fast_log(mis_remap0(bdpt_nee_pdf(sc, a, b, x)));
+		c->have |= 1 << side;
+	}
+	return c->lpn[side];
+}
+
+/* The weight of portal strategy cur (L's s and s', E's t' and t) for the
+ * path that joins light-side end L to eye-side end E, whose records are r;
+ * x2 is the path's x_2, read when L->pn_from_x2 (path_join_lpn, with the
+ * light-side end's cache pc). set is path_portal_set(sc->params), which the
+ * caller makes once. */
+CALLED float path_join_weight(const SceneView *sc, MisPortalSet set, const MisLightEnd *L, const MisEyeEnd *E,
+			      const MisRecord *r, VCRef x2, VCRef R, MisPnCache *pc, MisStrategy cur)
+{
+	int m = L->m;
+	float lpn = L->pn_from_x2 ? path_join_lpn(sc, R, x2, pc) : L->lpn;
 	if (L->other || E->first_cross < min(E->nr - 1, set.s_max + set.sp_max - m - 1))
 		return path_join_whole(sc, set, L, E, r, lpn, cur);
 	float beta = mis_beta(sc->params->mis);

@@ -282,6 +282,8 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, VRef l,
 				if (v3_is_zero(lcon))
 					continue;
 				MisLightEnd L;
+				MisPnCache pc;
+				pc.have = 0;
 				if (join) {
 					if (!logs) {
 						path_vertex_logs(F, nF, mis_needs_pf(set), lF);
@@ -301,7 +303,7 @@ INLINE void portal_sample_pixel(const SceneView *sc, float px, float py, VRef l,
 					float w;
 					if (join) {
 						w = path_join_weight(sc, set, &L, &rend[j], &rrec[r], b >= 2 ? VAT(F, 2) : VAT(e, t - 1),
-								     R, cur);
+								     R, &pc, cur);
 					} else {
 						PathRef P;
 						path_ref(&P, lp, s, R, a, F, b, e, t);

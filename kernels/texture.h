@@ -4,10 +4,13 @@
 #ifndef AJAR_TEXTURE_H
 #define AJAR_TEXTURE_H
 #include "types.h"
+#include "fastmath.h"
 
+/* sRGB's transfer function, the power by fastmath.h: the builtin pow is
+ * generic library code on PoCL and may round differently per device. */
 INLINE float srgb_to_linear(float c)
 {
-	return c <= 0.04045f ? c * (1.0f / 12.92f) : pow((c + 0.055f) * (1.0f / 1.055f), 2.4f);
+	return c <= 0.04045f ? c * (1.0f / 12.92f) : fast_exp(2.4f * fast_log((c + 0.055f) * (1.0f / 1.055f)));
 }
 
 /* Four channels in [0, 1]. */

@@ -78,7 +78,7 @@ static int check_mis(HostScene *h, int nsamples)
 				dl[0] = 0;
 				if (s == 0 && x[0].type != VERTEX_ENV)
 					x[0].type = VERTEX_LIGHT;
-				bdpt_mis_path(sc, l, s, e, t, rec);
+				bdpt_mis_path(sc, l, s, e, t, rec, 0);
 				oracle(sc, x, dl, k, orc);
 				for (int i = 0; i < k; i++) {
 					if (i == k - 1 || (i == 0 && t == k))

@@ -63,7 +63,8 @@ static void check_path(const SceneView *sc, const PathRef *P, MisStats *st)
 		if (i == k - 1)
 			continue; /* the camera's pf is never used */
 		double diff = rel_diff(rec[i].pr, orc[i].pr);
-		if (mis_needs_pf(set)) /* else no weight reads pf */
+		/* else no weight reads pf; pf_0 only strategies with s >= 2 */
+		if (mis_needs_pf(set) && (i > 0 || set.light_paths || set.s_max >= 2 || k < 3))
 			diff = fmax(diff, rel_diff(rec[i].pf, orc[i].pf));
 		if (i == 0)
 			diff = fmax(diff, rel_diff(rec[0].pn, orc[0].pn));
@@ -165,7 +166,8 @@ static void check_path(const SceneView *sc, const PathRef *P, MisStats *st)
 				   : set.light_paths || P->s <= 1;
 		if (heur == prm->mis && in_use) {
 			MisStrategy cur = {P->sp ? 2 : 1, P->s, P->pair, P->tp};
-			float wk = path_union_weight(sc, P, cur);
+			/* bdpt paths: bdpt_weight, the kernel's (l = x_0.., e = x_{k-1}..) */
+			float wk = P->sp ? path_union_weight(sc, P, cur) : bdpt_weight(sc, P->x[0], P->s, P->x[k - 1], P->t);
 			float wo = mis_union_weight(orc, k, k, ocross, lpsum, P->pair >= 0 ? lcur_o : 0, cur, set, heur);
 			st->weights++;
 			st->woff += fabs(wk - wo) > 1e-2;
@@ -223,6 +225,7 @@ static int check_join_weights(HostScene *h, int nsamples)
 					lp = &y;
 				}
 				MisLightEnd L;
+				MisPnCache pc = {{0, 0}, 0}; /* shared by the light end's joins, as in the kernel */
 				path_light_end(sc, set, lp, s, R, a, F, e, &L);
 				for (int b = 1; b < nF; b++)
 					for (int t = 1; t <= ne && t <= prm->portal_t_max && s + a + b + t - 1 <= depth; t++) {
@@ -233,7 +236,7 @@ static int check_join_weights(HostScene *h, int nsamples)
 						PathRef P;
 						path_ref(&P, lp, s, R, a, F, b, e, t);
 						float want = path_union_weight(sc, &P, cur);
-						float got = path_join_weight(sc, set, &L, &E, r, b >= 2 ? &F[2] : &e[t - 1], R, cur);
+						float got = path_join_weight(sc, set, &L, &E, r, b >= 2 ? &F[2] : &e[t - 1], R, &pc, cur);
 						if (!(fabs(got - want) <= 1e-5f + 1e-4f * want))
 							fail_msg("path (s=%d, s'=%d, t'=%d, t=%d): joined weight %.9g, whole path %.9g", s,
 								 a, b, t, got, want);
@@ -473,6 +476,96 @@ static void test_join_weights_sky(void **state)
 static Scene *sun_window_room(int inside, int sky)
 {
 	return punctual_scene(SCENE("window-room/window-room.gltf"), sun_in, inside, wr_p, wr_q, sky);
+}
+
+/* The bdpt strategies' weights in the portal integrator (bdpt_weight)
+ * against the full union weight
+ * (path_union_weight) for every bdpt path of random samples: the same up to
+ * float rounding (bit for bit without light subpaths), where the shortcut
+ * (no pairing edge crosses a portal) is taken and where it is not. Adds to
+ * *fast and *full how many paths took each. */
+static void check_bdpt_weights(HostScene *h, int nsamples, int *fast, int *full)
+{
+	SceneView *sc = &h->view;
+	Params *prm = h->data.params;
+	PathVertex l[SUBPATH_MAX], e[SUBPATH_MAX], R[SUBPATH_MAX], F[SUBPATH_MAX];
+	MisPortalSet set = path_portal_set(prm);
+	int depth = prm->max_depth;
+	double worst = 0;
+	for (int n = 0; n < nsamples; n++) {
+		int nl, ne, nR, nF;
+		trace_subpaths(sc, 93, n, l, &nl, e, &ne, R, &nR, F, &nF);
+		if (!prm->light_paths)
+			nl = 0; /* the kernel traces none */
+		Rng rng = rng_init(94, (uint)n, 0, 3);
+		for (int t = 1; t <= ne; t++) {
+			const PathVertex *z = &e[t - 1];
+			for (int s = 0; s <= max(nl, 1) && s + t - 1 <= depth; s++) {
+				PathVertex y;
+				const PathVertex *lp = l;
+				if (t == 1) { /* light tracing */
+					if (s == 0 || s > nl || vertex_infinite(&l[s - 1]) ||
+					    (s == 1 && vertex_delta_light(&l[0])) ||
+					    (s >= 2 &&
+					     v3_is_zero(bdpt_scatter(&l[s - 1], v3_norm(v3_sub(e[0].p, l[s - 1].p)), BSDF_IMPORTANCE))))
+						continue;
+				} else if (s == 0) {
+					if (!(z->type == VERTEX_ENV || sc->tris[z->tri].emitter >= 0) ||
+					    v3_is_zero(bdpt_emitted(sc, z, z->wo)))
+						continue;
+				} else if (z->type != VERTEX_SURFACE) {
+					continue;
+				} else if (s == 1) {
+					if (v3_is_zero(bdpt_nee(sc, z, &e[t - 2], &y, &rng)))
+						continue;
+					lp = &y;
+				} else if (s > nl || v3_is_zero(bdpt_connect(sc, &l[s - 1], z))) {
+					continue;
+				}
+				PathRef P;
+				path_ref(&P, lp, s, 0, 0, 0, 0, e, t);
+				MisStrategy cur = {1, s, 0, 0};
+				float want = path_union_weight(sc, &P, cur), got = bdpt_weight(sc, lp, s, e, t);
+				/* without light subpaths the same sum, bit for bit */
+				if (!(fabs(got - want) <= 1e-5f + 1e-4f * want) || (!prm->light_paths && got != want))
+					fail_msg("bdpt path (s=%d, t=%d): weight %.9g, full union weight %.9g", s, t, got, want);
+				worst = fmax(worst, fabs(got - want));
+				if (path_bdpt_pairs(sc, &P, set, mis_horizon(set, P.k)))
+					++*full;
+				else
+					++*fast;
+			}
+		}
+	}
+	print_message("bdpt weights: %d by the shortcut, %d in full; largest difference %.3g\n", *fast, *full, worst);
+}
+
+/* Lamp scenes (the default set: the sky's, with light subpaths), the sky's
+ * own (no light subpaths: s <= 1, a 2-term sum), the rich sky set, and a
+ * scene with emitters (every strategy); each branch is taken often. */
+static void test_bdpt_weight_shortcut(void **state)
+{
+	static const char *scenes[] = {SCENE("window-room-sun/window-room-sun.gltf"),
+				       SCENE("window-room-lamp/window-room-lamp.gltf"),
+				       SCENE("window-room-forest/window-room-forest.gltf"),
+				       SCENE("door-ajar/door-ajar.gltf")};
+	for (int i = 0; i < 4; i++) {
+		for (int heur = 0; heur < 2; heur++) {
+			HostScene h;
+			host_scene_open(&h, scenes[i], NULL, 24, 24, INTEGRATOR_PORTAL, 8);
+			h.data.params->mis = heur;
+			int fast = 0, full = 0;
+			check_bdpt_weights(&h, 150, &fast, &full);
+			if (i == 2) {
+				assert_false(h.data.params->light_paths);
+				set_portal_set(&h, 1, 2, 3, 4, 0, 1.0f);
+				check_bdpt_weights(&h, 150, &fast, &full);
+			}
+			assert_true(fast > 100);
+			assert_true(full > 20);
+			host_scene_close(&h);
+		}
+	}
 }
 
 /* The window room with the sun through its window (light subpaths start
@@ -1104,6 +1197,7 @@ int main(void)
 		cmocka_unit_test(test_mis_window_room_sun),
 		cmocka_unit_test(test_join_weights),
 		cmocka_unit_test(test_join_weights_sky),
+		cmocka_unit_test(test_bdpt_weight_shortcut),
 		cmocka_unit_test(test_groups_unbiased_window_room),
 		cmocka_unit_test(test_groups_unbiased_window_room_sun),
 		cmocka_unit_test(test_groups_unbiased_round_trip),
