@@ -10,15 +10,23 @@
  *           energy single scattering loses, and colours it as the light
  *           bouncing between coloured microfacets;
  *   plastic weight (1 - metallic)(1 - transmission): a GGX dielectric coat
- *           with Fs(c) = specular * Schlick(F0 = ((ior-1)/(ior+1))^2, c), over
- *           a diffuse base that receives what the coat does not reflect:
- *           base_color (1 - Es(mu_o)) (1 - Es(mu_i)) / (pi (1 - Esavg)), Es the
- *           coat's directional albedo (Fresnel included) and Esavg its
+ *           with Fs(c) = specular * Schlick(F0 = ((ior-1)/(ior+1))^2, c), plus
+ *           the coat's own multiple-scattering lobe, Kulla and Conty's form
+ *           as the metal's, Fc (1 - E1(mu_o)) (1 - E1(mu_i)) / (pi (1 - E1avg))
+ *           with E1 at the coat's alpha and Fc = Fms at the coat's Fresnel
+ *           mean Favg = specular (F0 + (1 - F0)/21): light that meets a second
+ *           microfacet is reflected with Favg and otherwise enters the base,
+ *           so the geometric series is the conductor's with Favg < 1 (what
+ *           the series leaves is the base's share below); over a diffuse
+ *           base that receives what the coat does not reflect:
+ *           base_color (1 - Et(mu_o)) (1 - Et(mu_i)) / (pi (1 - Etavg)),
+ *           Et = Es + Fc (1 - E1) the coat's directional albedo, single
+ *           scattering (Es, Fresnel included) and multiple, and Etavg its
  *           cosine-weighted mean. Reciprocal, and a white base gives a
- *           directional albedo Es + (1 - Es) = 1 at every angle and roughness
- *           (the energy the coat's single scattering loses goes to the base);
- *           specular = 0 gives exactly base_color / pi (KHR_materials_specular
- *           scales the whole Fresnel term, as glTF does);
+ *           directional albedo Et + (1 - Et) = 1 at every angle and roughness,
+ *           a black one Et; specular = 0 gives exactly base_color / pi
+ *           (KHR_materials_specular scales the whole Fresnel term, as glTF
+ *           does);
  *   glass   weight (1 - metallic) transmission: rough dielectric (Walter et
  *           al. 2007) with exact Fresnel, transmission tinted by base_color,
  *           plus Kulla and Conty's multiple scattering for dielectrics: four
@@ -66,7 +74,7 @@
  * Where n equals ng (flat shading) none of this runs.
  * Delta lobes reflect about wo's normal in both modes.
  *
- * E1, Es and G come from bsdf_tables.h (src/tools/bsdf_tables.c integrates
+ * E1, Es (and Et) and G come from bsdf_tables.h (src/tools/bsdf_tables.c integrates
  * them from microfacet.h at build time), bilinear in sqrt(alpha) and
  * sqrt(mu) (glass: trilinear, with (ior - 1) / (ior + 1));
  * the averages are those of the interpolated tables, so the compensation
@@ -74,7 +82,8 @@
  *
  * Lobe selection for sampling is proportional to weight x albedo estimate at
  * the outgoing direction (the cosine-shaped lobes, diffuse base and the
- * metal's and glass's multiple-scattering reflection, are sampled alike;
+ * metal's, coat's and glass's multiple-scattering reflection, are sampled
+ * alike, the metal's and coat's as one lobe;
  * the glass's multiple-scattering refraction by a cosine on the far side);
  * pdf_w is the mixture over all non-delta lobes, so sampling and bsdf_eval
  * agree, and integrates to 1 - P(delta lobes). */
@@ -109,10 +118,12 @@ typedef struct {
 	V3 base_color;   /* linear, in [0, 1] */
 	float metallic, alpha, transmission, ior, specular;
 	int flags;       /* the Material's MATERIAL_* flags */
-	/* Energy compensation, set by bsdf_setup: the coat's albedo is
-	 * coat_s1 E1 + coat_sw Ew, its mean coat_eavg; metal_eavg is E1avg at
-	 * alpha and metal_fms the multiple-scattering colour Fms. */
-	float coat_s1, coat_sw, coat_eavg, metal_eavg;
+	/* Energy compensation, set by bsdf_setup: the coat's single-scattering
+	 * albedo is Es = coat_s1 E1 + coat_sw Ew, its multiple scattering's
+	 * coat_fms (1 - E1) (E1 at the coat's alpha, mean coat_e1avg), the
+	 * mean of both coat_eavg (Etavg); metal_eavg is E1avg at alpha and
+	 * metal_fms the multiple-scattering colour Fms. */
+	float coat_s1, coat_sw, coat_eavg, coat_fms, coat_e1avg, metal_eavg;
 	V3 metal_fms;
 	/* Rough glass: where (ior, alpha) falls in the glass tables, the share
 	 * of the lost energy that multiple scattering transmits from outside
@@ -132,11 +143,12 @@ typedef struct {
 } BsdfSample;
 
 /* Selection probabilities of the seven sampled lobes for one outgoing
- * direction (ms: the metal's multiple scattering; glass_r, glass_t: the
- * glass's), and the albedos at it that bsdf_eval_local reuses. */
+ * direction (ms: the metal's and the coat's multiple scattering, both
+ * cosine-shaped in the glossy normal; glass_r, glass_t: the glass's), and
+ * the albedos at it that bsdf_eval_local reuses. */
 typedef struct {
 	float metal, coat, diffuse, glass, ms, glass_r, glass_t;
-	float e_metal, e_coat, e_glass; /* E1 at alpha, Es, Go or Gi */
+	float e_metal, e_coat, e_coat1, e_glass; /* E1 at alpha, Es, E1 at the coat's alpha, Go or Gi */
 } BsdfLobes;
 
 /* Where (alpha, mu) falls in bsdf_tables.h's grid: the lower row and column
@@ -224,14 +236,18 @@ INLINE void bsdf_setup_mr(Bsdf *bs, GLOBAL const Material *m, V3 base_color, flo
 #ifndef AJAR_NO_BENT_NORMALS
 	bs->flags |= fabs(cn) < BSDF_TILT_COS ? BSDF_TILTED : 0;
 #endif
-	bs->coat_s1 = bs->coat_sw = bs->coat_eavg = bs->metal_eavg = 0.0f;
+	bs->coat_s1 = bs->coat_sw = bs->coat_eavg = bs->coat_fms = bs->coat_e1avg = bs->metal_eavg = 0.0f;
 	bs->metal_fms = v3(0.0f, 0.0f, 0.0f);
 	if (bsdf_w_plastic(bs) > 0.0f && bs->specular > 0.0f) {
 		float q = (bs->ior - 1.0f) / (bs->ior + 1.0f);
 		BsdfTabAt a = bsdf_tab_at(bsdf_coat_alpha(bs), 1.0f);
 		bs->coat_s1 = bs->specular * q * q;
 		bs->coat_sw = bs->specular - bs->coat_s1;
-		bs->coat_eavg = bs->coat_s1 * bsdf_tab1(bsdf_tab_e1avg, a) + bs->coat_sw * bsdf_tab1(bsdf_tab_ewavg, a);
+		float e1 = bsdf_tab1(bsdf_tab_e1avg, a);
+		float fa = bs->coat_s1 + bs->coat_sw * (1.0f / 21.0f); /* specular (F0 + (1 - F0) / 21) */
+		bs->coat_e1avg = e1;
+		bs->coat_fms = fa * fa * e1 / (1.0f - fa * (1.0f - e1));
+		bs->coat_eavg = bs->coat_s1 * e1 + bs->coat_sw * bsdf_tab1(bsdf_tab_ewavg, a) + bs->coat_fms * (1.0f - e1);
 	}
 	bs->glass_k = bs->glass_i = 0;
 	bs->glass_wk = bs->glass_wr = bs->glass_x = bs->glass_y = 0.0f;
@@ -301,28 +317,40 @@ INLINE float bsdf_fresnel_coat(const Bsdf *bs, float c)
 	return bs->specular * (f0 + (1.0f - f0) * bsdf_schlick_w(c));
 }
 
-/* The coat's directional albedo Es(mu), Fresnel included. */
-INLINE float bsdf_coat_albedo(const Bsdf *bs, float mu)
+/* The coat's single-scattering albedo Es(mu), Fresnel included; *e1 is E1(mu)
+ * at the coat's alpha, which its multiple scattering needs. */
+INLINE float bsdf_coat_albedo(const Bsdf *bs, float mu, float *e1)
 {
 	BsdfTabAt a = bsdf_tab_at(bsdf_coat_alpha(bs), mu);
-	return bs->coat_s1 * bsdf_tab2(bsdf_tab_e1, a) + bs->coat_sw * bsdf_tab2(bsdf_tab_ew, a);
+	*e1 = bsdf_tab2(bsdf_tab_e1, a);
+	return bs->coat_s1 * *e1 + bs->coat_sw * bsdf_tab2(bsdf_tab_ew, a);
 }
+
+/* The coat's whole albedo Et = Es + coat_fms (1 - E1), from Es and E1. */
+INLINE float bsdf_coat_total(const Bsdf *bs, float es, float e1) { return es + bs->coat_fms * (1.0f - e1); }
 
 /* The metal's single-scattering albedo with Fresnel 1, E1(mu). */
 INLINE float bsdf_metal_albedo(const Bsdf *bs, float mu) { return bsdf_tab2(bsdf_tab_e1, bsdf_tab_at(bs->alpha, mu)); }
 
-/* The diffuse base's factor (1 - Es(mu_o)) (1 - Es(mu_i)) / (pi (1 - Esavg)). */
-INLINE float bsdf_base_factor(const Bsdf *bs, float e_o, float mu_i)
+/* The diffuse base's factor (1 - Et(mu_o)) (1 - Et(mu_i)) / (pi (1 - Etavg)),
+ * from Et(mu_o) and Et(mu_i). */
+INLINE float bsdf_base_factor(const Bsdf *bs, float et_o, float et_i)
 {
 	if (!(bs->specular > 0.0f))
 		return AJAR_INV_PI; /* no coat: exactly Lambertian */
-	return (1.0f - e_o) * (1.0f - bsdf_coat_albedo(bs, mu_i)) * AJAR_INV_PI / (1.0f - bs->coat_eavg);
+	return (1.0f - et_o) * (1.0f - et_i) * AJAR_INV_PI / (1.0f - bs->coat_eavg);
+}
+
+/* Kulla and Conty's (1 - E1(mu_o)) (1 - E1(mu_i)) / (pi (1 - E1avg)), without its colour. */
+INLINE float bsdf_kc_factor(float e_o, float e_i, float eavg)
+{
+	return (1.0f - e_o) * (1.0f - e_i) * AJAR_INV_PI / fmax(1.0f - eavg, 1e-7f);
 }
 
 /* Multiple scattering of the metal without its colour Fms. */
 INLINE float bsdf_ms_factor(const Bsdf *bs, float e_o, float mu_i)
 {
-	return (1.0f - e_o) * (1.0f - bsdf_metal_albedo(bs, mu_i)) * AJAR_INV_PI / fmax(1.0f - bs->metal_eavg, 1e-7f);
+	return bsdf_kc_factor(e_o, bsdf_metal_albedo(bs, mu_i), bs->metal_eavg);
 }
 
 /* Single-scattering albedo of rough glass at mu, reflection and
@@ -359,15 +387,18 @@ INLINE BsdfLobes bsdf_lobes(const Bsdf *bs, float cos_o, float eta)
 		p.diffuse = d * (1.0f / d);
 		p.e_metal = p.e_glass = 1.0f;
 		p.e_coat = 0.0f;
+		p.e_coat1 = 1.0f;
 		return p;
 	}
 	float wm = bsdf_w_metal(bs), wp = bsdf_w_plastic(bs);
 	p.e_metal = wm > 0.0f && !bsdf_smooth(bs) ? bsdf_metal_albedo(bs, cos_o) : 1.0f;
-	p.e_coat = wp > 0.0f && bs->specular > 0.0f ? bsdf_coat_albedo(bs, cos_o) : 0.0f; /* 0 without a coat */
+	p.e_coat1 = 1.0f;
+	p.e_coat = wp > 0.0f && bs->specular > 0.0f ? bsdf_coat_albedo(bs, cos_o, &p.e_coat1) : 0.0f; /* 0 without a coat */
 	p.metal = wm * v3_avg(bsdf_fresnel_metal(bs, cos_o)) * p.e_metal;
-	p.ms = wm * v3_avg(bs->metal_fms) * (1.0f - p.e_metal);
+	float cms = bs->coat_fms * (1.0f - p.e_coat1); /* the coat's multiple scattering */
+	p.ms = wm * v3_avg(bs->metal_fms) * (1.0f - p.e_metal) + wp * cms;
 	p.coat = wp * p.e_coat;
-	p.diffuse = wp * (1.0f - p.e_coat) * v3_avg(bs->base_color);
+	p.diffuse = wp * (1.0f - (p.e_coat + cms)) * v3_avg(bs->base_color);
 	float wg = bsdf_w_glass(bs);
 	p.e_glass = wg > 0.0f && !bsdf_smooth(bs) ? bsdf_glass_albedo(bs, eta > 1.0f, cos_o) : 1.0f;
 	float xs = eta > 1.0f ? bs->glass_x : bs->glass_y;
@@ -513,13 +544,20 @@ INLINE V3 bsdf_eval_lobes(const Bsdf *bs, V3 wo, V3 wi, float eta, int mode, flo
 			float spec = ggx_d(h, bs->alpha) * ggx_g2(wo, wi, bs->alpha) * inv4;
 			f = v3_madd(f, bsdf_fresnel_metal(bs, cos_oh), bsdf_w_metal(bs) * spec * gr);
 			f = v3_madd(f, bs->metal_fms, bsdf_w_metal(bs) * bsdf_ms_factor(bs, p.e_metal, wi.z) * gr);
-			pdf += p.metal * ggx_pdf_visible(wo, h, bs->alpha) * jac + p.ms * pdf_cosine_hemisphere_w(wi.z);
+			pdf += p.metal * ggx_pdf_visible(wo, h, bs->alpha) * jac;
 		}
+		pdf += p.ms * pdf_cosine_hemisphere_w(wi.z); /* metal and coat multiple scattering */
 		float wp = bsdf_w_plastic(bs);
 		if (wp > 0.0f) {
 			float a = bsdf_coat_alpha(bs);
 			float spec = ggx_d(h, a) * ggx_g2(wo, wi, a) * inv4 * bsdf_fresnel_coat(bs, cos_oh);
-			float kd = fz > 0.0f ? bsdf_base_factor(bs, p.e_coat, wi.z) : 0.0f;
+			float kd = AJAR_INV_PI;
+			if (bs->specular > 0.0f) {
+				float e1_i, es_i = bsdf_coat_albedo(bs, wi.z, &e1_i);
+				spec += bs->coat_fms * bsdf_kc_factor(p.e_coat1, e1_i, bs->coat_e1avg);
+				kd = bsdf_base_factor(bs, bsdf_coat_total(bs, p.e_coat, p.e_coat1), bsdf_coat_total(bs, es_i, e1_i));
+			}
+			kd = fz > 0.0f ? kd : 0.0f;
 			float ws = wp * spec * gr;
 			f = v3_add(f, v3_madd(v3(ws, ws, ws), bs->base_color, wp * kd));
 			pdf += p.coat * ggx_pdf_visible(wo, h, a) * jac + p.diffuse * pdf_cosine_hemisphere_w(pz);
