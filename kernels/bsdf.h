@@ -441,7 +441,7 @@ INLINE float bsdf_tilt(const Bsdf *bs, V3 *x)
 	V3 d = v3_madd(bs->n, bs->ng, -nz);
 	float l = v3_len(d);
 	*x = l > 0.0f ? v3_scale(d, 1.0f / l) : bs->t;
-	return atan2(l, fmax(nz, 0.0f));
+	return fast_atan2(l, fmax(nz, 0.0f));
 }
 
 /* Whether direction w keeps the own normal n: its mirror image about n lies
@@ -479,7 +479,9 @@ INLINE float bsdf_bend_t(const Bsdf *bs, V3 x, float tn, V3 w)
 	float a = sqrt(ix * ix + iz * iz);
 	if (!(a > 0.0f))
 		return 0.0f;
-	float t = 0.5f * (atan2(ix, iz) + acos(fmin(thr / a, 1.0f)));
+	/* acos c = atan2(sqrt((1 - c)(1 + c)), c), exact near c = 1 too. */
+	float c = fmin(thr / a, 1.0f);
+	float t = 0.5f * (fast_atan2(ix, iz) + fast_atan2(sqrt((1.0f - c) * (1.0f + c)), c));
 	return fmin(fmax(t, 0.0f), tn);
 }
 
@@ -489,7 +491,9 @@ INLINE BsdfFrame bsdf_frame_t(const Bsdf *bs, V3 x, float tn, float t)
 	if (t == tn)
 		return bsdf_frame_own(bs);
 	BsdfFrame f;
-	f.n = v3_norm(v3_add(v3_scale(x, sin(t)), v3_scale(bs->ng, cos(t))));
+	float st, ct;
+	fast_sincos(t, &st, &ct); /* t in [0, pi / 2] */
+	f.n = v3_norm(v3_add(v3_scale(x, st), v3_scale(bs->ng, ct)));
 	v3_basis(f.n, &f.t, &f.b);
 	return f;
 }
