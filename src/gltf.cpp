@@ -473,6 +473,29 @@ ajar_status ext_number(const Loader &L, int mi, const tg::ExtensionMap &exts, co
 	return AJAR_OK;
 }
 
+/* A member of extensions[ext] that Ajar does not read (a texture, a tint):
+ * one warning naming it and what is used instead. */
+void ext_unread(const Loader &L, int mi, const tg::ExtensionMap &exts, const char *ext, const char *key,
+		const char *instead)
+{
+	auto it = exts.find(ext);
+	if (it != exts.end() && value_member(it->second, key))
+		log_msg(AJAR_LOG_WARNING, "%s: materials[%d]: %s.%s is not supported; %s", L.file, mi, ext, key, instead);
+}
+
+/* KHR_materials_specular's specularColorFactor, if it is not white. */
+bool specular_tinted(const tg::ExtensionMap &exts)
+{
+	auto it = exts.find("KHR_materials_specular");
+	const tg::Value *c = it == exts.end() ? nullptr : value_member(it->second, "specularColorFactor");
+	if (!c || !c->IsArray())
+		return false;
+	for (size_t i = 0; i < c->ArrayLen(); i++)
+		if (!c->Get((int)i).IsNumber() || c->Get((int)i).GetNumberAsDouble() != 1.0)
+			return true;
+	return false;
+}
+
 /* "resolution": [w, h] in an extras object, if there. */
 ajar_status read_resolution(Loader &L, const tg::Value &extras, const char *where)
 {
@@ -723,6 +746,13 @@ ajar_status load_material(Loader &L, int mi, uint32_t *id)
 	    (st = ext_number(L, mi, gm.extensions, "KHR_materials_specular", "specularFactor", 1.0, 0.0, 1.0,
 			     &specular)))
 		return st;
+	ext_unread(L, mi, gm.extensions, "KHR_materials_transmission", "transmissionTexture",
+		   "transmissionFactor alone is used");
+	ext_unread(L, mi, gm.extensions, "KHR_materials_specular", "specularTexture", "specularFactor alone is used");
+	ext_unread(L, mi, gm.extensions, "KHR_materials_specular", "specularColorTexture", "ignored");
+	if (specular_tinted(gm.extensions))
+		log_msg(AJAR_LOG_WARNING, "%s: materials[%d]: KHR_materials_specular.specularColorFactor is not supported; white is used",
+			L.file, mi);
 	if (!gm.emissiveFactor.empty()) {
 		if (gm.emissiveFactor.size() != 3)
 			return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d]: emissiveFactor has %zu numbers, expected 3", mi,

@@ -571,6 +571,47 @@ static void test_non_indexed_and_materials(void **state)
 	ajar_scene_destroy(&s);
 }
 
+static void test_unread_extension_members(void **state)
+{
+	(void)state;
+	/* Members of the extensions we read that we do not use: one warning
+	 * each, naming it; the factors still apply. */
+	const float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+	write_bytes("unread.bin", pos, sizeof pos);
+	const char *head = "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+			   "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":0}]}],"
+			   "\"materials\":[{\"extensions\":{";
+	const char *tail = "}}],\"buffers\":[{\"uri\":\"unread.bin\",\"byteLength\":36}],"
+			   "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+			   "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]}";
+	const struct {
+		const char *ext, *want;
+		int warnings;
+	} cases[] = {
+		{"\"KHR_materials_transmission\":{\"transmissionFactor\":0.5,\"transmissionTexture\":{\"index\":0}}",
+		 "KHR_materials_transmission.transmissionTexture is not supported", 1},
+		{"\"KHR_materials_specular\":{\"specularFactor\":0.5,\"specularColorFactor\":[1,0.5,1],"
+		 "\"specularTexture\":{\"index\":0}}",
+		 "specularColorFactor is not supported", 2},
+		{"\"KHR_materials_specular\":{\"specularFactor\":0.5,\"specularColorFactor\":[1,1,1]}", "", 0},
+	};
+	for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+		char json[2048];
+		snprintf(json, sizeof json, "%s%s%s", head, cases[k].ext, tail);
+		write_text("unread.gltf", json);
+		warnings = 0;
+		last_warning[0] = '\0';
+		ajar_set_log_callback(count_warnings, NULL);
+		Scene *s = load_ok("unread.gltf");
+		ajar_set_log_callback(NULL, NULL);
+		assert_int_equal(warnings, cases[k].warnings);
+		if (!strstr(last_warning, cases[k].want) || (cases[k].warnings && !strstr(last_warning, "materials[0]")))
+			fail_msg("case %zu: warning \"%s\"", k, last_warning);
+		assert_float_equal(k == 0 ? s->materials[0].transmission : s->materials[0].specular, 0.5f, 0.0);
+		ajar_scene_destroy(&s);
+	}
+}
+
 static void test_interleaved_strip_fan(void **state)
 {
 	/* Four vertices interleaved (position, normal, normalized u16 uv;
@@ -1475,6 +1516,7 @@ int main(void)
 		cmocka_unit_test(test_hierarchy_matrix),
 		cmocka_unit_test(test_no_scenes_all_roots),
 		cmocka_unit_test(test_non_indexed_and_materials),
+		cmocka_unit_test(test_unread_extension_members),
 		cmocka_unit_test(test_interleaved_strip_fan),
 		cmocka_unit_test(test_sparse),
 		cmocka_unit_test(test_data_uri),
