@@ -161,6 +161,16 @@ INLINE float portal_pair_log(const SceneView *sc, GLOBAL const PortalTri *pt, co
 	return fast_log(fmax(pa * portal_direction_psa(sc, pt, a, w) * g, 1e-30f));
 }
 
+/* The edge a -> b as a ray for the portal crossing test: from b toward a
+ * sky vertex a (a direction, t up to infinity), else from a to b (t in
+ * [0, 1]); returns tmax. */
+INLINE float path_edge_ray(const PathVertex *a, const PathVertex *b, V3 *o, V3 *d)
+{
+	*o = vertex_infinite(a) ? b->p : a->p;
+	*d = vertex_infinite(a) ? a->p : v3_sub(b->p, a->p);
+	return vertex_infinite(a) ? AJAR_INF : 1.0f;
+}
+
 /* For edge (x_i, x_{i+1}): log of the sum over its portal crossings of
  * p_pair^beta, and in *found how many the geometric test finds. With `w0`
  * (the pair edge of the current portal strategy), its own crossing is
@@ -174,9 +184,8 @@ INLINE float path_pair_logsum(const SceneView *sc, const PathRef *P, int i, floa
 	VTMP(at);
 	VTMP(bt);
 	const PathVertex *a = VLOAD(P->x[i], at), *b = VLOAD(P->x[i + 1], bt);
-	V3 o = vertex_infinite(a) ? b->p : a->p;
-	V3 d = vertex_infinite(a) ? a->p : v3_sub(b->p, a->p);
-	float tmax = vertex_infinite(a) ? AJAR_INF : 1.0f;
+	V3 o, d;
+	float tmax = path_edge_ray(a, b, &o, &d);
 	float sum = -AJAR_INF, hair2 = 1e-8f * sc->params->scene_radius * sc->params->scene_radius;
 	*found = 0;
 	if (w0) {
@@ -357,9 +366,8 @@ INLINE int path_bdpt_pairs(const SceneView *sc, const PathRef *P, MisPortalSet s
 		VTMP(at);
 		VTMP(bt);
 		const PathVertex *a = VLOAD(P->x[i], at), *b = VLOAD(P->x[i + 1], bt);
-		V3 o = vertex_infinite(a) ? b->p : a->p;
-		V3 d = vertex_infinite(a) ? a->p : v3_sub(b->p, a->p);
-		float tmax = vertex_infinite(a) ? AJAR_INF : 1.0f;
+		V3 o, d;
+		float tmax = path_edge_ray(a, b, &o, &d);
 		for (int j = 0; j < sc->params->num_portals; j++) {
 			GLOBAL const PortalTri *pt = &sc->portals[j];
 			float t;
