@@ -221,7 +221,7 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	 * subpaths carry the indirect light on both sides of it, with halves
 	 * and eye parts as long as the depth allows. AJAR_PORTAL_SET="s,s',t'[,t[,light paths]]"
 	 * overrides it for experiments, e.g. "32,32,32,33,1" for all of them. */
-	/* Punctual lights without emitters (kernels/lights.md, "Punctual
+	/* Punctual lights without emitters (kernels/punctual.md, "Punctual
 	 * lights"): their light subpaths are kept (a sun's start on the
 	 * portals and find its patch), but the intermediate subpaths, which
 	 * reach a delta light only by next-event estimation, carry the sky, so
