@@ -27,6 +27,9 @@ __kernel void render_pass(AJAR_SCENE_BUFFERS(AJAR_KERNEL_ARG) __global long *acc
 {
 	SceneView sc;
 	AJAR_SCENE_BUFFERS(AJAR_VIEW_INIT)
+	SkyMemo sky_memo;
+	sky_memo_clear(&sky_memo);
+	sc.sky_memo = &sky_memo;
 	GLOBAL const Camera *cam = &params->camera;
 	uint npix = (uint)(cam->width * cam->height);
 	uint unit = unit_first + (uint)get_global_id(0);
@@ -102,6 +105,7 @@ __kernel void trace_closest(AJAR_SCENE_BUFFERS(AJAR_KERNEL_ARG) __global const f
 {
 	SceneView sc;
 	AJAR_SCENE_BUFFERS(AJAR_VIEW_INIT)
+	sc.sky_memo = 0;
 	uint i = (uint)get_global_id(0);
 	if (i >= count)
 		return;

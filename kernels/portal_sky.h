@@ -66,14 +66,18 @@ INLINE int sky_split(float c, float *f)
 	return i;
 }
 
-/* x's rectangle on plane P; 0 unless x is on its room side. */
-INLINE int sky_rect(GLOBAL const PortalPlane *P, V3 x, SkyRect *r)
+/* x's rectangle on plane P; 0 unless x is on its room side. Also x's
+ * coordinates in P's frame, *xt and *xb, and its height *h below P. */
+INLINE int sky_rect_at(GLOBAL const PortalPlane *P, V3 x, SkyRect *r, float *pxt, float *pxb, float *ph)
 {
 	V3 d = v3_sub(x, P->o);
 	float h = -v3_dot(d, P->n);
+	*ph = h;
 	if (!(h > 0.0f))
 		return 0;
 	float xt = v3_dot(d, P->t), xb = v3_dot(d, P->b);
+	*pxt = xt;
+	*pxb = xb;
 	r->U0 = sky_coord(fast_atan2(P->a0 - xt, h));
 	r->U1 = sky_coord(fast_atan2(P->a1 - xt, h));
 	r->V0 = sky_coord(fast_atan2(P->b0 - xb, h));
@@ -82,6 +86,12 @@ INLINE int sky_rect(GLOBAL const PortalPlane *P, V3 x, SkyRect *r)
 	r->j1 = sky_split(r->V1, &r->f1);
 	sky_rect_rows(r);
 	return r->U1 > r->U0 && r->V1 > r->V0;
+}
+
+INLINE int sky_rect(GLOBAL const PortalPlane *P, V3 x, SkyRect *r)
+{
+	float xt, xb, h;
+	return sky_rect_at(P, x, r, &xt, &xb, &h);
 }
 
 /* B(i): the integral over [0, i] x [V0, V1], (S(i, j1) - S(i, j0)) +
