@@ -201,10 +201,11 @@ INLINE void sky_plane_view(const SceneView *sc, GLOBAL const PortalPlane *P, V3 
 		return;
 	v->d = v3_sub(sky_plane_centre(P), x);
 	v->len = sqrt(v3_len2(v->d));
-	v->X0 = (P->a0 - xt) / h;
-	v->X1 = (P->a1 - xt) / h;
-	v->Y0 = (P->b0 - xb) / h;
-	v->Y1 = (P->b1 - xb) / h;
+	float ih = 1.0f / h;
+	v->X0 = (P->a0 - xt) * ih;
+	v->X1 = (P->a1 - xt) * ih;
+	v->Y0 = (P->b0 - xb) * ih;
+	v->Y1 = (P->b1 - xb) * ih;
 	v->ok = 1;
 }
 
@@ -222,9 +223,11 @@ INLINE float sky_view_weight(const SkyPlaneView *v, V3 n)
  * sky_pdf_uv would find (U, V) outside it. The test is in tangents, without
  * the two atan2 of sky_coords: X below X0 by more than SKY_TAN_MARGIN (1 +
  * max(X^2, X0^2)), which bounds the gap of their atans from below, puts U
- * below U0 by far more than fast_atan2's error (3e-7) and sky_coord's
- * rounding (4e-7 rad at the far end): so the directions it drops are ones
- * whose density term was 0, and the sum is the same bits. Infinite or NaN
+ * below U0 by far more than fast_atan2's error (3e-7), sky_coord's
+ * rounding (4e-7 rad at the far end) and the tangents' own (a few ulps,
+ * by reciprocals): so the directions it drops are ones whose density term
+ * was 0, and the sum is the same bits (test_lights,
+ * test_sky_pdf_views_memo, fails with a margin of 0). Infinite or NaN
  * tangents compare false and are kept. */
 #define SKY_TAN_MARGIN 1e-5f
 INLINE int sky_tan_outside(float X, float lo, float hi)
@@ -235,8 +238,8 @@ INLINE int sky_tan_outside(float X, float lo, float hi)
 
 INLINE int sky_view_may_contain(GLOBAL const PortalPlane *P, const SkyPlaneView *v, V3 wi)
 {
-	float wn = v3_dot(wi, P->n);
-	float X = v3_dot(wi, P->t) / wn, Y = v3_dot(wi, P->b) / wn;
+	float iw = 1.0f / v3_dot(wi, P->n);
+	float X = v3_dot(wi, P->t) * iw, Y = v3_dot(wi, P->b) * iw;
 	return !(sky_tan_outside(X, v->X0, v->X1) || sky_tan_outside(Y, v->Y0, v->Y1));
 }
 

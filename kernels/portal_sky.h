@@ -158,16 +158,23 @@ INLINE int sky_sample_uv(GLOBAL const float *S, const SkyRect *r, float total, f
 	int i0 = sky_split(r->U0, &fu0), i1 = sky_split(r->U1, &fu1);
 	float b0 = sky_band(S, r, i0);
 	float target = b0 + fu0 * (sky_band(S, r, i0 + 1) - b0) + u1 * total;
-	/* The last column whose left knot is at most the target. */
-	int lo = i0, hi = i1;
+	/* The last column whose left knot is at most the target. The knots
+	 * B(lo) and, once hi has moved, B(hi + 1) are kept from the search. */
+	int lo = i0, hi = i1, moved = 0;
+	float bl = b0, bh = 0.0f;
 	while (lo < hi) {
 		int mid = (lo + hi + 1) >> 1;
-		if (sky_band(S, r, mid) <= target)
+		float bm = sky_band(S, r, mid);
+		if (bm <= target) {
 			lo = mid;
-		else
+			bl = bm;
+		} else {
 			hi = mid - 1;
+			bh = bm;
+			moved = 1;
+		}
 	}
-	float bl = sky_band(S, r, lo), slope = sky_band(S, r, lo + 1) - bl;
+	float slope = (moved ? bh : sky_band(S, r, lo + 1)) - bl;
 	if (!(slope > 0.0f))
 		return 0;
 	*U = fmin(fmax((float)lo + (target - bl) / slope, fmax((float)lo, r->U0)), fmin((float)(lo + 1), r->U1));
@@ -176,14 +183,21 @@ INLINE int sky_sample_uv(GLOBAL const float *S, const SkyRect *r, float total, f
 		return 0;
 	float t2 = h0 + u2 * (h1 - h0);
 	int jl = r->j0, jh = r->j1;
+	float cl = sky_col(S, lo, jl), ch = 0.0f;
+	moved = 0;
 	while (jl < jh) {
 		int mid = (jl + jh + 1) >> 1;
-		if (sky_col(S, lo, mid) <= t2)
+		float cm = sky_col(S, lo, mid);
+		if (cm <= t2) {
 			jl = mid;
-		else
+			cl = cm;
+		} else {
 			jh = mid - 1;
+			ch = cm;
+			moved = 1;
+		}
 	}
-	float cl = sky_col(S, lo, jl), cs = sky_col(S, lo, jl + 1) - cl;
+	float cs = (moved ? ch : sky_col(S, lo, jl + 1)) - cl;
 	if (!(cs > 0.0f))
 		return 0;
 	*V = fmin(fmax((float)jl + (t2 - cl) / cs, fmax((float)jl, r->V0)), fmin((float)(jl + 1), r->V1));
