@@ -345,8 +345,11 @@ INLINE float sky_weight_of(const SceneView *sc, const SkyWeights *sw, int k, V3 
 	return sw->w[k];
 }
 
-/* The portal part of the density of unit wi from x (sw->W > 0). */
-INLINE float sky_portal_pdf_w(const SceneView *sc, const SkyWeights *sw, V3 x, V3 n, V3 wi)
+/* The portal part of the density of unit wi from x (sw->W > 0); kn, if
+ * not NULL, holds the knots of plane kn_plane's cell that wi was drawn
+ * from (sky_nee_sample). */
+INLINE float sky_portal_pdf_w_knots(const SceneView *sc, const SkyWeights *sw, V3 x, V3 n, V3 wi, int kn_plane,
+				    const SkyKnots *kn)
 {
 	float p = 0.0f;
 	for (int k = 0; k < sc->params->num_portal_planes; k++) {
@@ -360,19 +363,32 @@ INLINE float sky_portal_pdf_w(const SceneView *sc, const SkyWeights *sw, V3 x, V
 		if (!(w > 0.0f) || !sky_view_may_contain(P, v, wi))
 			continue;
 		sky_coords(P, wi, &U, &V, &jac);
-		float puv = sky_pdf_uv(sc->portal_sky + P->table, &v->r, v->mass, U, V);
+		float puv = sky_pdf_uv_knots(sc->portal_sky + P->table, &v->r, v->mass, U, V, k == kn_plane ? kn : 0);
 		if (puv > 0.0f && jac > 0.0f)
 			p += w / sw->W * puv / jac;
 	}
 	return p;
 }
 
-/* The whole density of wi, given pe = env_pdf_w(sc, wi). */
-INLINE float sky_mix_pdf_w(const SceneView *sc, const SkyWeights *sw, V3 x, V3 n, V3 wi, float pe)
+INLINE float sky_portal_pdf_w(const SceneView *sc, const SkyWeights *sw, V3 x, V3 n, V3 wi)
+{
+	return sky_portal_pdf_w_knots(sc, sw, x, n, wi, -1, 0);
+}
+
+/* The whole density of wi, given pe = env_pdf_w(sc, wi) (kn_plane, kn as
+ * in sky_portal_pdf_w_knots). */
+INLINE float sky_mix_pdf_w_knots(const SceneView *sc, const SkyWeights *sw, V3 x, V3 n, V3 wi, float pe,
+				 int kn_plane, const SkyKnots *kn)
 {
 	if (!(sw->W > 0.0f))
 		return pe;
-	return PORTAL_SKY_NEE_MIX * sky_portal_pdf_w(sc, sw, x, n, wi) + (1.0f - PORTAL_SKY_NEE_MIX) * pe;
+	return PORTAL_SKY_NEE_MIX * sky_portal_pdf_w_knots(sc, sw, x, n, wi, kn_plane, kn) +
+	       (1.0f - PORTAL_SKY_NEE_MIX) * pe;
+}
+
+INLINE float sky_mix_pdf_w(const SceneView *sc, const SkyWeights *sw, V3 x, V3 n, V3 wi, float pe)
+{
+	return sky_mix_pdf_w_knots(sc, sw, x, n, wi, pe, -1, 0);
 }
 
 INLINE float sky_nee_pdf_w(const SceneView *sc, V3 x, V3 n, V3 wi, float pe)
@@ -416,12 +432,15 @@ INLINE V3 sky_nee_sample(const SceneView *sc, V3 x, V3 n, float u_mix, float u1,
 		return v3(0.0f, 0.0f, 0.0f);
 	GLOBAL const PortalPlane *P = &sc->portal_planes[pick];
 	float U, V, jac;
-	if (!sky_sample_uv(sc->portal_sky + P->table, &r, mass, u1, u2, &U, &V))
+	SkyKnots kn;
+	if (!sky_sample_uv_knots(sc->portal_sky + P->table, &r, mass, u1, u2, &U, &V, &kn))
 		return v3(0.0f, 0.0f, 0.0f);
 	*wi = sky_dir(P, U, V, &jac);
 	float pe;
 	V3 Le = env_radiance_pdf(sc, *wi, &pe);
-	*pdf_w = sky_mix_pdf_w(sc, &sw, x, n, *wi, pe);
+	/* The density from the final direction, with the drawn cell's knots
+	 * where the direction's (U, V) falls back in that cell. */
+	*pdf_w = sky_mix_pdf_w_knots(sc, &sw, x, n, *wi, pe, pick, &kn);
 	return *pdf_w > 0.0f ? Le : v3(0.0f, 0.0f, 0.0f);
 }
 

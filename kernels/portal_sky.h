@@ -135,24 +135,50 @@ INLINE float sky_rect_integral(GLOBAL const float *S, const SkyRect *r)
 	return sky_band_at(S, r, r->U1) - sky_band_at(S, r, r->U0);
 }
 
+/* The knots of the cell (i, j) that sky_sample_uv drew from: column i's
+ * mass B(i + 1) - B(i), its integrals H(V0), H(V1) at the rectangle's v
+ * bounds and cell (i, j)'s C(j + 1) - C(j), for sky_pdf_uv_knots. */
+typedef struct {
+	int i, j;
+	float colmass, h0, h1, cell;
+} SkyKnots;
+
 /* Density per unit U and V (cell units) of (U, V) within r, whose integral
- * is `total`; 0 outside r. */
-INLINE float sky_pdf_uv(GLOBAL const float *S, const SkyRect *r, float total, float U, float V)
+ * is `total`; 0 outside r. Where (U, V) falls in kn's cell (kn not NULL),
+ * the knots are kn's, which are the same numbers read again. */
+INLINE float sky_pdf_uv_knots(GLOBAL const float *S, const SkyRect *r, float total, float U, float V,
+			      const SkyKnots *kn)
 {
 	if (!(U >= r->U0 && U <= r->U1 && V >= r->V0 && V <= r->V1) || !(total > 0.0f))
 		return 0.0f;
 	float fu, fv;
 	int i = sky_split(U, &fu), j = sky_split(V, &fv);
-	float colmass = sky_band(S, r, i + 1) - sky_band(S, r, i);
-	float h0 = sky_col_at(S, i, r->V0), h1 = sky_col_at(S, i, r->V1);
-	float cell = sky_col(S, i, j + 1) - sky_col(S, i, j);
+	float colmass, h0, h1, cell;
+	if (kn && kn->i == i && kn->j == j) {
+		colmass = kn->colmass;
+		h0 = kn->h0;
+		h1 = kn->h1;
+		cell = kn->cell;
+	} else {
+		colmass = sky_band(S, r, i + 1) - sky_band(S, r, i);
+		h0 = sky_col_at(S, i, r->V0);
+		h1 = sky_col_at(S, i, r->V1);
+		cell = sky_col(S, i, j + 1) - sky_col(S, i, j);
+	}
 	if (!(colmass > 0.0f) || !(h1 > h0) || !(cell > 0.0f))
 		return 0.0f;
 	return colmass / total * (cell / (h1 - h0));
 }
 
-/* Samples (U, V) within r (integral `total`) from u1, u2; 0 if none. */
-INLINE int sky_sample_uv(GLOBAL const float *S, const SkyRect *r, float total, float u1, float u2, float *U, float *V)
+INLINE float sky_pdf_uv(GLOBAL const float *S, const SkyRect *r, float total, float U, float V)
+{
+	return sky_pdf_uv_knots(S, r, total, U, V, 0);
+}
+
+/* Samples (U, V) within r (integral `total`) from u1, u2; 0 if none. The
+ * drawn cell's knots go to *kn. */
+INLINE int sky_sample_uv_knots(GLOBAL const float *S, const SkyRect *r, float total, float u1, float u2, float *U,
+			       float *V, SkyKnots *kn)
 {
 	float fu0, fu1;
 	int i0 = sky_split(r->U0, &fu0), i1 = sky_split(r->U1, &fu1);
@@ -201,7 +227,19 @@ INLINE int sky_sample_uv(GLOBAL const float *S, const SkyRect *r, float total, f
 	if (!(cs > 0.0f))
 		return 0;
 	*V = fmin(fmax((float)jl + (t2 - cl) / cs, fmax((float)jl, r->V0)), fmin((float)(jl + 1), r->V1));
+	kn->i = lo;
+	kn->j = jl;
+	kn->colmass = slope;
+	kn->h0 = h0;
+	kn->h1 = h1;
+	kn->cell = cs;
 	return 1;
+}
+
+INLINE int sky_sample_uv(GLOBAL const float *S, const SkyRect *r, float total, float u1, float u2, float *U, float *V)
+{
+	SkyKnots kn;
+	return sky_sample_uv_knots(S, r, total, u1, u2, U, V, &kn);
 }
 
 /* The tangent of the angle at coordinate c. */

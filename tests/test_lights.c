@@ -1157,7 +1157,7 @@ static void test_sky_pdf_views_memo(void **state)
 	sky_memo_clear(&memo);
 	SceneView with = l.sc;
 	with.sky_memo = &memo;
-	int checked = 0, edge = 0, nonzero = 0;
+	int checked = 0, edge = 0, nonzero = 0, sampled = 0;
 	for (int it = 0; it < 4000; it++) {
 		V3 x = xs[(it * 5 + it / 7) % NX];
 		V3 n = v3_norm(v3(rnd() - 0.5f, rnd() - 0.5f, rnd() - 0.5f));
@@ -1211,9 +1211,16 @@ static void test_sky_pdf_views_memo(void **state)
 		V3 Lb = sky_nee_sample(&with, x, n, um, u1, u2, &wb, &pb);
 		assert_true(same_bits(pa, pb));
 		assert_true(same_bits(La.x, Lb.x) && same_bits(wa.x, wb.x) && same_bits(wa.y, wb.y) && same_bits(wa.z, wb.z));
+		/* through a plane: the density with the drawn cell's knots is the
+		 * one computed afresh from the direction */
+		if (um < PORTAL_SKY_NEE_MIX && pa > 0.0f) {
+			assert_true(same_bits(pa, sky_nee_pdf_w(&l.sc, x, n, wa, env_pdf_w(&l.sc, wa))));
+			sampled++;
+		}
 	}
-	printf("  %d densities (%d nonzero, %d toward rectangle edges) the same bits\n", checked, nonzero, edge);
-	assert_true(checked > 1000 && nonzero > 300 && edge > 1000);
+	printf("  %d densities (%d nonzero, %d toward rectangle edges) and %d samples' the same bits\n", checked,
+	       nonzero, edge, sampled);
+	assert_true(checked > 1000 && nonzero > 300 && edge > 1000 && sampled > 500);
 	lit_free(&l);
 }
 
