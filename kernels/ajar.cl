@@ -27,9 +27,11 @@ __kernel void render_pass(AJAR_SCENE_BUFFERS(AJAR_KERNEL_ARG) __global long *acc
 {
 	SceneView sc;
 	AJAR_SCENE_BUFFERS(AJAR_VIEW_INIT)
+	/* pt reads a point's sky density again only where its next ray
+	 * escapes (1% of its lookups on window-room-forest): no memo. */
 	SkyMemo sky_memo;
 	sky_memo_clear(&sky_memo);
-	sc.sky_memo = &sky_memo;
+	sc.sky_memo = PARAMS_INTEGRATOR(params) == INTEGRATOR_PT ? 0 : &sky_memo;
 	GLOBAL const Camera *cam = &params->camera;
 	uint npix = (uint)(cam->width * cam->height);
 	uint unit = unit_first + (uint)get_global_id(0);

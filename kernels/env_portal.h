@@ -276,32 +276,28 @@ INLINE void sky_memo_clear(SkyMemo *m)
 	m->next = 0;
 }
 
-INLINE void sky_at_fill(const SceneView *sc, V3 x, SkyAt *a)
-{
-	int np = min(sc->params->num_portal_planes, SKY_KEPT);
-	for (int k = 0; k < np; k++)
-		sky_plane_view(sc, &sc->portal_planes[k], x, &a->v[k]);
-}
-
-/* x's views: from the memo (or filled into it), else into *own. */
-INLINE const SkyAt *sky_at(const SceneView *sc, V3 x, SkyAt *own)
+/* x's views: the memo's slot that holds them, else a slot (or *own,
+ * without a memo) that the caller fills (*fill). */
+INLINE const SkyAt *sky_at(const SceneView *sc, V3 x, SkyAt *own, SkyAt **fill)
 {
 	SkyMemo *m = sc->sky_memo;
 	if (!m) {
-		sky_at_fill(sc, x, own);
+		*fill = own;
 		return own;
 	}
 	uint kx = f2u(x.x), ky = f2u(x.y), kz = f2u(x.z);
 	for (int i = 0; i < m->used; i++)
-		if (m->key[i][0] == kx && m->key[i][1] == ky && m->key[i][2] == kz)
+		if (m->key[i][0] == kx && m->key[i][1] == ky && m->key[i][2] == kz) {
+			*fill = 0;
 			return &m->at[i];
+		}
 	int i = m->next;
 	m->next = i + 1 < SKY_MEMO_SLOTS ? i + 1 : 0;
 	m->used = max(m->used, i + 1);
 	m->key[i][0] = kx;
 	m->key[i][1] = ky;
 	m->key[i][2] = kz;
-	sky_at_fill(sc, x, &m->at[i]);
+	*fill = &m->at[i];
 	return &m->at[i];
 }
 
@@ -316,11 +312,14 @@ typedef struct {
 
 INLINE void sky_weights(const SceneView *sc, V3 x, V3 n, SkyWeights *sw)
 {
-	sw->at = sky_at(sc, x, &sw->own);
+	SkyAt *fill;
+	sw->at = sky_at(sc, x, &sw->own, &fill);
 	sw->W = 0.0f;
 	for (int k = 0; k < sc->params->num_portal_planes; k++) {
 		float w;
 		if (k < SKY_KEPT) {
+			if (fill)
+				sky_plane_view(sc, &sc->portal_planes[k], x, &fill->v[k]);
 			w = sw->w[k] = sky_view_weight(&sw->at->v[k], n);
 		} else {
 			SkyPlaneView v;
