@@ -310,7 +310,7 @@ typedef struct {
 	float W;
 } SkyWeights;
 
-INLINE void sky_weights(const SceneView *sc, V3 x, V3 n, SkyWeights *sw)
+HOT_INLINE void sky_weights(const SceneView *sc, V3 x, V3 n, SkyWeights *sw)
 {
 	SkyAt *fill;
 	sw->at = sky_at(sc, x, &sw->own, &fill);
