@@ -13,12 +13,14 @@
  * the four densities next to the connection recomputed (bdpt_mis_path).
  *
  * Light subpaths leave an emitter by power, a uniform point on it and a
- * cosine direction, or the environment by its importance, from a disk of
- * the scene's bounding radius perpendicular to the direction, or a
+ * cosine direction, or the environment by its importance, along a line on
+ * a disk of the scene's bounding radius perpendicular to the direction (a
+ * sky image with portals: through the portals or the disk, as a
+ * directional light's, lights.h line_sample), or a
  * punctual light (KHR_lights_punctual, chosen in the emitters' table):
  * a point or spot light in a direction on the sphere or in the outer
  * cone, a directional light along a line through the portals or the disk
- * (lights.h, sun_line_sample). A punctual light is a delta in position or
+ * (lights.h, line_sample). A punctual light is a delta in position or
  * direction: no ray hits it (no s = 0), the camera does not see it (no
  * s = 1, t = 1, as in pt), and next-event estimation (s = 1) and light
  * subpaths (s >= 2) both reach it with the probability of its choice,
