@@ -252,7 +252,7 @@ INLINE float line_portal_area(const SceneView *sc, V3 w)
 	return s;
 }
 
-INLINE float line_pdf(const SceneView *sc, V3 w, float R, V3 x)
+INLINE float line_pdf_perp(const SceneView *sc, V3 w, float R, V3 x)
 {
 	int np = sc->params->num_portals;
 	float r = sc->params->scene_radius, t;
@@ -278,7 +278,7 @@ INLINE float line_pdf(const SceneView *sc, V3 w, float R, V3 x)
 /* Samples a line along w (u_sel: disk or portal, and which triangle; u1,
  * u2: the point): *o, a point on it behind the scene's bounding sphere (the
  * ray o + t w, t > 0, meets everything the light reaches along it), and its
- * density *pdf_perp (line_pdf). Returns 0 if there is none. */
+ * density *pdf_perp (line_pdf_perp). Returns 0 if there is none. */
 INLINE int line_sample(const SceneView *sc, V3 w, float R, float u_sel, float u1, float u2, V3 *o, float *pdf_perp)
 {
 	GLOBAL const Params *prm = sc->params;
@@ -308,7 +308,7 @@ INLINE int line_sample(const SceneView *sc, V3 w, float R, float u_sel, float u1
 		V3 n;
 		sample_triangle_point(pt->p0, pt->p1, pt->p2, u1, u2, &x, &n);
 	}
-	*pdf_perp = line_pdf(sc, w, R, x);
+	*pdf_perp = line_pdf_perp(sc, w, R, x);
 	*o = v3_sub(x, v3_scale(w, v3_dot(v3_sub(x, prm->scene_center), w) + 1.001f * r));
 	return *pdf_perp > 0.0f;
 }

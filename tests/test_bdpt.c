@@ -296,7 +296,7 @@ static void test_mis_sun_portal(void **state)
 
 /* window-room under a sky image with a sun high behind the window: the
  * environment's light subpaths start on the portal (lights.h,
- * line_sample), and their pf_1 (line_pdf) is checked against the oracle's
+ * line_sample), and their pf_1 (line_pdf_perp) is checked against the oracle's
  * own crossing count. */
 static void test_mis_sky_image_portal(void **state)
 {

@@ -313,7 +313,7 @@ static void test_emission_directions(void **state)
 /* The lines along w of disk radius R (line_sample: a directional light's,
  * or the environment's for a sampled direction) where they cross the plane
  * through the scene's centre perpendicular to w, in cells of a grid over
- * [lo, hi]^2 (basis t, b of w), against line_pdf integrated over each
+ * [lo, hi]^2 (basis t, b of w), against line_pdf_perp integrated over each
  * cell. */
 #define GN 12
 static void check_lines(const char *what, const SceneView *sc, V3 w, float R, double lo, double hi)
@@ -352,7 +352,7 @@ static void check_lines(const char *what, const SceneView *sc, V3 w, float R, do
 				for (int k = 0; k < sub; k++) {
 					double x = lo + cell * (ix + (k + 0.5) / sub), y = lo + cell * (iy + (a + 0.5) / sub);
 					V3 p = v3_add(c, v3_add(v3_scale(t, (float)x), v3_scale(b, (float)y)));
-					sum += line_pdf(sc, w, R, p);
+					sum += line_pdf_perp(sc, w, R, p);
 				}
 			expct[iy * GN + ix] = N_EMIT * sum / (sub * sub) * cell * cell;
 			total += expct[iy * GN + ix];
@@ -405,7 +405,7 @@ static void test_sun_lines(void **state)
 				obs[iy * GN + ix]++;
 		}
 		for (int i = 0; i < GN * GN; i++)
-			expct[i] = N_EMIT * line_pdf(&h.view, pl->dir, pl->disk_radius, c) * cell * cell;
+			expct[i] = N_EMIT * line_pdf_perp(&h.view, pl->dir, pl->disk_radius, c) * cell * cell;
 		check_chi2("directional light, disk", obs, expct, GN * GN);
 	}
 	h.scene = NULL;
@@ -450,7 +450,7 @@ static void test_sun_lines(void **state)
 		V3 x = v3(0.4f, 1.0f, 0.05f);
 		double both = 0.9 * 2 / (double)line_portal_area(&h.view, dirs[i]) + 0.1 / (M_PI * r * r);
 		if (i == 0)
-			assert_true(fabs(line_pdf(&h.view, dirs[i], r, x) / both - 1) < 1e-4);
+			assert_true(fabs(line_pdf_perp(&h.view, dirs[i], r, x) / both - 1) < 1e-4);
 		check_lines(i ? "environment lines, slanted through the wall window" : "environment lines, two windows",
 			    &h.view, dirs[i], r, -1.01 * r, 1.01 * r);
 	}
