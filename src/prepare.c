@@ -217,7 +217,7 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	 * and living-room-forest, worse on window-room-sunset
 	 * (kernels/lights.md, "Sky light subpaths through the portals"), so on
 	 * for sky images. */
-	int sky_image_lines = s->env_type == ENV_IMAGE && s->nportal_tris > 0;
+	int sky_image_lines = p->integrator == INTEGRATOR_PORTAL && s->env_type == ENV_IMAGE && s->nportal_tris > 0;
 	p->light_paths = p->integrator != INTEGRATOR_PORTAL || p->num_emitters > 0 || p->num_lights > 0 || sky_image_lines;
 	/* The intermediate strategies in use (kernels/portal.h), chosen by
 	 * measurement (kernels/README.md, "portal"). Where the sky is the only
@@ -234,7 +234,7 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	 * the sky's set and rate: on window-room-sun the long halves at rate 1
 	 * cost 3x in time for no less noise. A sky image's light subpaths
 	 * take the same set and rate. */
-	int long_set = p->light_paths && p->num_emitters > 0;
+	int long_set = p->light_paths && !(p->num_emitters == 0 && (p->num_lights > 0 || sky_image_lines));
 	p->portal_s_max = 1;
 	p->portal_sp_max = long_set ? AJAR_BIDIR_MAX_DEPTH : 2;
 	p->portal_tp_max = long_set ? AJAR_BIDIR_MAX_DEPTH : 1;
