@@ -13,12 +13,14 @@
  * the four densities next to the connection recomputed (bdpt_mis_path).
  *
  * Light subpaths leave an emitter by power, a uniform point on it and a
- * cosine direction, or the environment by its importance, from a disk of
- * the scene's bounding radius perpendicular to the direction, or a
+ * cosine direction, or the environment by its importance, along a line on
+ * a disk of the scene's bounding radius perpendicular to the direction (a
+ * sky image with portals: through the portals or the disk, as a
+ * directional light's, lights.h line_sample), or a
  * punctual light (KHR_lights_punctual, chosen in the emitters' table):
  * a point or spot light in a direction on the sphere or in the outer
  * cone, a directional light along a line through the portals or the disk
- * (lights.h, sun_line_sample). A punctual light is a delta in position or
+ * (lights.h, line_sample). A punctual light is a delta in position or
  * direction: no ray hits it (no s = 0), the camera does not see it (no
  * s = 1, t = 1, as in pt), and next-event estimation (s = 1) and light
  * subpaths (s >= 2) both reach it with the probability of its choice,
@@ -186,7 +188,7 @@ INLINE V3 bdpt_scatter(const PathVertex *v, V3 wi, int mode)
 /* A light subpath from punctual light i (chosen with probability pf):
  * from a point or spot light in a direction by punctual_dir_sample (u3,
  * u4), its intensity windowed by the first hit's distance; from a
- * directional light along a line by sun_line_sample (u1, u3, u4), parallel
+ * directional light along a line by line_sample (u1, u3, u4), parallel
  * rays whose density is per perpendicular area. */
 INLINE int bdpt_punctual_subpath(const SceneView *sc, VRef l, int i, float pf, float u1, float u3, float u4,
 				 int max_verts, Rng *rng)
@@ -206,7 +208,7 @@ INLINE int bdpt_punctual_subpath(const SceneView *sc, VRef l, int i, float pf, f
 		y->p = v3_neg(pl->dir);
 		y->ng = y->ns = y->wo = pl->dir;
 		VCOMMIT(VAT(l, 0), y);
-		if (!sun_line_sample(sc, pl, u1, u3, u4, &o, &pdf_perp))
+		if (!line_sample(sc, pl->dir, pl->disk_radius, u1, u3, u4, &o, &pdf_perp))
 			return 1;
 		V3 beta = v3_scale(pl->intensity, 1.0f / (pf * pdf_perp));
 		return vertex_walk(sc, l, 1, max_verts, o, pl->dir, beta, pdf_perp, 1, 1, 0, rng);
@@ -250,22 +252,33 @@ CALLED int bdpt_light_subpath(const SceneView *sc, VRef l, int max_verts, Rng *r
 		V3 Le = env_sample(sc, u1, u2, &dir, &pdf_w);
 		if (!(pdf_w > 0.0f))
 			return 0;
-		float r = prm->scene_radius, dx, dy;
-		V3 t, b;
-		v3_basis(dir, &t, &b);
-		sample_concentric_disk(u3, u4, &dx, &dy);
-		V3 o = v3_add(v3_add(prm->scene_center, v3_scale(dir, r)),
-			      v3_add(v3_scale(t, dx * r), v3_scale(b, dy * r)));
 		y->type = VERTEX_ENV;
 		y->p = dir;
 		y->ng = y->ns = y->wo = v3_neg(dir);
 		y->tri = -1;
 		y->pf = ps * pdf_w;
-		float pdf_disk = 1.0f / (AJAR_PI * r * r);
 		y->beta = v3(1.0f / y->pf, 1.0f / y->pf, 1.0f / y->pf);
-		V3 beta = v3_scale(Le, 1.0f / (y->pf * pdf_disk));
-		VCOMMIT(VAT(l, 0), y);
-		return vertex_walk(sc, l, 1, max_verts, o, v3_neg(dir), beta, pdf_disk, 1, 1, 0, rng);
+		V3 o;
+		float pdf_perp;
+		if (env_lines_through_portals(sc)) {
+			/* A sky image's line along -dir as a directional light's (lights.h,
+			 * line_sample), u_sel's rest choosing the disk or a portal. */
+			VCOMMIT(VAT(l, 0), y);
+			if (!line_sample(sc, v3_neg(dir), prm->scene_radius, u_sel / ps, u3, u4, &o, &pdf_perp))
+				return 1;
+		} else {
+			/* Uniform on the disk of the scene's radius. */
+			float r = prm->scene_radius, dx, dy;
+			V3 t, b;
+			v3_basis(dir, &t, &b);
+			sample_concentric_disk(u3, u4, &dx, &dy);
+			o = v3_add(v3_add(prm->scene_center, v3_scale(dir, r)),
+				   v3_add(v3_scale(t, dx * r), v3_scale(b, dy * r)));
+			pdf_perp = 1.0f / (AJAR_PI * r * r);
+			VCOMMIT(VAT(l, 0), y);
+		}
+		V3 beta = v3_scale(Le, 1.0f / (y->pf * pdf_perp));
+		return vertex_walk(sc, l, 1, max_verts, o, v3_neg(dir), beta, pdf_perp, 1, 1, 0, rng);
 	}
 	float u = fmin((u_sel - ps) / (1.0f - ps), 0.99999994f), pdf_a;
 	V3 p, n;

@@ -53,18 +53,24 @@ INLINE void bdpt_light_records(const SceneView *sc, MisVertex *mv, const PathVer
 }
 
 /* Density with which the light vertex's emission sampling produces `to`
- * (pf_1): cosine-weighted directions from emitters, a disk of radius R
- * for the environment (parallel rays: per perpendicular area), a point or
- * spot light's directions, a directional light's lines (lights.h). */
+ * (pf_1): cosine-weighted directions from emitters; for a directional
+ * light and a sky image seen through portals, parallel lines on a disk of
+ * radius R or through the portals (lights.h, line_pdf_perp: per perpendicular
+ * area), for a constant sky (or none) on the disk alone; a point or spot
+ * light's directions. */
 INLINE float bdpt_emission_pdf(const SceneView *sc, const PathVertex *l, const PathVertex *to)
 {
-	if (l->type == VERTEX_SUN) /* parallel lines, per perpendicular area (lights.h) */
-		return sun_line_pdf(sc, &sc->punctual[l->tri], to->p) * fabs(v3_dot(to->ng, l->p));
+	if (l->type == VERTEX_SUN) { /* parallel lines, per perpendicular area (lights.h) */
+		GLOBAL const PunctualLight *pl = &sc->punctual[l->tri];
+		return line_pdf_perp(sc, pl->dir, pl->disk_radius, to->p) * fabs(v3_dot(to->ng, l->p));
+	}
 	if (l->type == VERTEX_PUNCTUAL) {
 		V3 d = v3_sub(to->p, l->p);
 		return vertex_density_a(l, to, punctual_dir_pdf(&sc->punctual[l->tri], v3_norm(d)));
 	}
 	if (l->type == VERTEX_ENV) {
+		if (env_lines_through_portals(sc)) /* a sky image: the same lines along -l->p */
+			return line_pdf_perp(sc, v3_neg(l->p), sc->params->scene_radius, to->p) * fabs(v3_dot(to->ng, l->p));
 		float r = sc->params->scene_radius;
 		return fabs(v3_dot(to->ng, l->p)) / (AJAR_PI * r * r);
 	}

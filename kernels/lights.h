@@ -210,71 +210,106 @@ INLINE V3 punctual_dir_sample(GLOBAL const PunctualLight *l, float u1, float u2)
 	return v3_from_local(sample_uniform_cone(u1, u2, l->cos_outer), t, b, l->dir);
 }
 
-/* A directional light's light subpaths are parallel rays along l->dir.
- * Without portals their lines cross a disk of the scene's radius
- * perpendicular to it uniformly. With portals, all but SUN_DISK_SHARE of
- * them pass through a point on a portal triangle (picked by portal_cdf,
- * uniform on it), so that light subpaths go where an opening lets the
- * light in; the share on the disk keeps every line the light sends into
- * the scene at a positive density (a sunlit outside wall, an opening
- * without a portal), so a zero density always means a zero contribution,
- * as the MIS weights assume. The density per unit area perpendicular to
- * l->dir of the line through x: SUN_DISK_SHARE / (pi R^2) within the disk
- * (all of it without portals), plus (1 - SUN_DISK_SHARE) times the sum
- * over the portal triangles the whole line crosses of p_A / |cos| (p_A =
- * pdf_select / area, cos between its normal and the light). */
+/* Light subpaths from a light at infinity (a directional light, or the
+ * environment in a sampled direction) are parallel rays along a unit
+ * travel direction w. Without portals their lines cross a disk of radius R
+ * (the scene's) perpendicular to w uniformly. With portals, all but
+ * SUN_DISK_SHARE of them pass through a point on a portal triangle, the
+ * triangle picked in proportion to its area projected toward w, A_j |n_j.w|
+ * (a scan: portals are few), the point uniform on it, so that light
+ * subpaths go where an opening lets the light in; the share on the disk
+ * keeps every line the light sends into the scene at a positive density (a
+ * sunlit outside wall, an opening without a portal), so a zero density
+ * always means a zero contribution, as the MIS weights assume. The density
+ * per unit area perpendicular to w of the line through x: SUN_DISK_SHARE /
+ * (pi R^2) within the disk (all of it without portals, or if every portal
+ * is edge-on to w), plus (1 - SUN_DISK_SHARE) times the number of portal
+ * triangles (with |n.w| > 0) the whole line crosses over S = sum_k A_k
+ * |n_k.w| (each crossed triangle j contributes A_j |n_j.w| / S for its
+ * choice times 1 / (A_j |n_j.w|) per perpendicular area). The same
+ * function at sampling and in every MIS record (densities.h,
+ * bdpt_emission_pdf; kernels/lights.md, "Sky light subpaths through the
+ * portals"). */
 #define SUN_DISK_SHARE 0.1f
 
-INLINE float sun_line_pdf(const SceneView *sc, GLOBAL const PunctualLight *l, V3 x)
+/* Whether an environment's light subpaths take these lines through the
+ * portals: a sky image's (its sun finds the way in); a constant sky keeps
+ * the disk, where its next-event estimation through the portals already
+ * takes the direct light and the light subpaths that come in only added
+ * variance and time (kernels/lights.md, "Sky light subpaths through the
+ * portals"). */
+INLINE int env_lines_through_portals(const SceneView *sc)
 {
-	int np = sc->params->num_portals;
-	float r = sc->params->scene_radius, R = l->disk_radius, t;
-	V3 q = v3_sub(x, sc->params->scene_center);
-	V3 perp = v3_sub(q, v3_scale(l->dir, v3_dot(q, l->dir)));
-	float disk = v3_len2(perp) <= R * R ? 1.0f / (AJAR_PI * R * R) : 0.0f;
-	if (np == 0)
-		return disk;
-	/* The line from behind the scene's bounding sphere, as a segment. */
-	V3 o = v3_sub(x, v3_scale(l->dir, v3_dot(q, l->dir) + 2.0f * r));
-	V3 d = v3_scale(l->dir, 4.0f * r);
-	float p = 0.0f;
-	for (int i = 0; i < np; i++) {
-		GLOBAL const PortalTri *pt = &sc->portals[i];
-		float c = fabs(v3_dot(pt->n, l->dir));
-		if (c > 0.0f && pt->area > 0.0f && portal_tri_crossing(o, d, 1.0f, pt->p0, pt->p1, pt->p2, &t))
-			p += pt->pdf_select / (pt->area * c);
-	}
-	return SUN_DISK_SHARE * disk + (1.0f - SUN_DISK_SHARE) * p;
+	return sc->params->env_type == ENV_IMAGE && sc->params->num_portals > 0;
 }
 
-/* Samples a line of directional light `l`: *o, a point on it behind the
- * scene's bounding sphere (the ray o + t l->dir, t > 0, meets everything
- * the light reaches along it), and its density *pdf_perp (sun_line_pdf).
- * Returns 0 if there is none. */
-INLINE int sun_line_sample(const SceneView *sc, GLOBAL const PunctualLight *l, float u_sel, float u1, float u2, V3 *o,
-			   float *pdf_perp)
+/* S = sum_k A_k |n_k.w| over the portal triangles. */
+INLINE float line_portal_area(const SceneView *sc, V3 w)
+{
+	float s = 0.0f;
+	for (int i = 0; i < sc->params->num_portals; i++)
+		s += sc->portals[i].area * fabs(v3_dot(sc->portals[i].n, w));
+	return s;
+}
+
+INLINE float line_pdf_perp(const SceneView *sc, V3 w, float R, V3 x)
+{
+	int np = sc->params->num_portals;
+	float r = sc->params->scene_radius, t;
+	V3 q = v3_sub(x, sc->params->scene_center);
+	V3 perp = v3_sub(q, v3_scale(w, v3_dot(q, w)));
+	float disk = v3_len2(perp) <= R * R ? 1.0f / (AJAR_PI * R * R) : 0.0f;
+	float s = np > 0 ? line_portal_area(sc, w) : 0.0f;
+	if (!(s > 0.0f))
+		return disk;
+	/* The line from behind the scene's bounding sphere, as a segment. */
+	V3 o = v3_sub(x, v3_scale(w, v3_dot(q, w) + 2.0f * r));
+	V3 d = v3_scale(w, 4.0f * r);
+	int n = 0;
+	for (int i = 0; i < np; i++) {
+		GLOBAL const PortalTri *pt = &sc->portals[i];
+		if (pt->area * fabs(v3_dot(pt->n, w)) > 0.0f &&
+		    portal_tri_crossing(o, d, 1.0f, pt->p0, pt->p1, pt->p2, &t))
+			n++;
+	}
+	return SUN_DISK_SHARE * disk + (1.0f - SUN_DISK_SHARE) * (float)n / s;
+}
+
+/* Samples a line along w (u_sel: disk or portal, and which triangle; u1,
+ * u2: the point): *o, a point on it behind the scene's bounding sphere (the
+ * ray o + t w, t > 0, meets everything the light reaches along it), and its
+ * density *pdf_perp (line_pdf_perp). Returns 0 if there is none. */
+INLINE int line_sample(const SceneView *sc, V3 w, float R, float u_sel, float u1, float u2, V3 *o, float *pdf_perp)
 {
 	GLOBAL const Params *prm = sc->params;
+	int np = prm->num_portals;
 	float r = prm->scene_radius;
+	float s = np > 0 && u_sel >= SUN_DISK_SHARE ? line_portal_area(sc, w) : 0.0f;
 	V3 x;
-	if (prm->num_portals == 0 || u_sel < SUN_DISK_SHARE) {
+	if (!(s > 0.0f)) {
 		float dx, dy;
 		V3 t, b;
-		v3_basis(l->dir, &t, &b);
+		v3_basis(w, &t, &b);
 		sample_concentric_disk(u1, u2, &dx, &dy);
-		x = v3_add(prm->scene_center, v3_add(v3_scale(t, dx * l->disk_radius), v3_scale(b, dy * l->disk_radius)));
+		x = v3_add(prm->scene_center, v3_add(v3_scale(t, dx * R), v3_scale(b, dy * R)));
 	} else {
-		float p_sel, u_rest;
-		float u = fmin((u_sel - SUN_DISK_SHARE) / (1.0f - SUN_DISK_SHARE), 0.99999994f);
-		int k = sample_cdf(sc->portal_cdf, prm->num_portals, u, &p_sel, &u_rest);
-		if (k < 0)
-			return 0;
+		float target = (u_sel - SUN_DISK_SHARE) / (1.0f - SUN_DISK_SHARE) * s, acc = 0.0f;
+		int k = -1;
+		for (int i = 0; i < np; i++) {
+			float a = sc->portals[i].area * fabs(v3_dot(sc->portals[i].n, w));
+			if (!(a > 0.0f))
+				continue;
+			k = i; /* the last one with a projected area, if rounding runs past the end */
+			acc += a;
+			if (target < acc)
+				break;
+		}
 		GLOBAL const PortalTri *pt = &sc->portals[k];
 		V3 n;
 		sample_triangle_point(pt->p0, pt->p1, pt->p2, u1, u2, &x, &n);
 	}
-	*pdf_perp = sun_line_pdf(sc, l, x);
-	*o = v3_sub(x, v3_scale(l->dir, v3_dot(v3_sub(x, prm->scene_center), l->dir) + 1.001f * r));
+	*pdf_perp = line_pdf_perp(sc, w, R, x);
+	*o = v3_sub(x, v3_scale(w, v3_dot(v3_sub(x, prm->scene_center), w) + 1.001f * r));
 	return *pdf_perp > 0.0f;
 }
 

@@ -208,11 +208,17 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	p->min_depth = (int)o->min_depth;
 	p->strategy_len = (int)o->strategy_len;
 	p->strategy_unweighted = o->strategy_unweighted;
-	/* Light subpaths from an environment start on a disk as wide as the
-	 * scene and rarely find the way in through an opening; where the sky
-	 * is the only light, the intermediate subpaths (which start on the
-	 * portals) do their work, and the portal integrator leaves them out. */
-	p->light_paths = p->integrator != INTEGRATOR_PORTAL || p->num_emitters > 0 || p->num_lights > 0;
+	/* Light subpaths from a constant sky start on a disk as wide as the
+	 * scene and rarely find the way in through an opening; where such a
+	 * sky is the only light, the intermediate subpaths (which start on the
+	 * portals) do their work, and the portal integrator leaves them out.
+	 * A sky image's light subpaths start on the portals (kernels/lights.h,
+	 * line_sample): measured better per CPU second on window-room-forest
+	 * and living-room-forest, worse on window-room-sunset
+	 * (kernels/lights.md, "Sky light subpaths through the portals"), so on
+	 * for sky images. */
+	int sky_image_lines = p->integrator == INTEGRATOR_PORTAL && s->env_type == ENV_IMAGE && s->nportal_tris > 0;
+	p->light_paths = p->integrator != INTEGRATOR_PORTAL || p->num_emitters > 0 || p->num_lights > 0 || sky_image_lines;
 	/* The intermediate strategies in use (kernels/portal.h), chosen by
 	 * measurement (kernels/README.md, "portal"). Where the sky is the only
 	 * light, next-event estimation through the portals takes the direct
@@ -226,8 +232,9 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	 * portals and find its patch), but the intermediate subpaths, which
 	 * reach a delta light only by next-event estimation, carry the sky, so
 	 * the sky's set and rate: on window-room-sun the long halves at rate 1
-	 * cost 3x in time for no less noise. */
-	int long_set = p->light_paths && !(p->num_lights > 0 && p->num_emitters == 0);
+	 * cost 3x in time for no less noise. A sky image's light subpaths
+	 * take the same set and rate. */
+	int long_set = p->light_paths && !(p->num_emitters == 0 && (p->num_lights > 0 || sky_image_lines));
 	p->portal_s_max = 1;
 	p->portal_sp_max = long_set ? AJAR_BIDIR_MAX_DEPTH : 2;
 	p->portal_tp_max = long_set ? AJAR_BIDIR_MAX_DEPTH : 1;
@@ -281,7 +288,9 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	float rate = long_set ? PORTAL_RATE_EMITTERS : PORTAL_RATE_SKY;
 	/* Under a sky image (with a sun), sampled through planar portals, the
 	 * <- halves guided by the sky's importance find the sun and the ->
-	 * halves the patch it lights: worth a higher rate than a constant sky. */
+	 * halves the patch it lights: worth a higher rate than a constant sky,
+	 * without light subpaths (AJAR_PORTAL_SET=1,2,1,3,0, the default
+	 * before they started on the portals). */
 	if (!p->light_paths && p->num_portal_planes > 0)
 		rate = PORTAL_RATE_SKY_IMAGE;
 	p->portal_rate = p->strategy_unweighted ? 1.0f : env_rate("AJAR_PORTAL_RATE", rate);

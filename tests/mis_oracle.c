@@ -11,30 +11,42 @@ static int punctual(const PathVertex *v) { return v->type == VERTEX_PUNCTUAL || 
 
 static int crosses(const double *o, const double *d, double tmax, V3 a, V3 b, V3 c, double *th);
 
+/* pf_1 of a light at infinity (a directional light, or the environment in
+ * its direction) whose parallel lines travel along unit w toward x1: lines
+ * uniform on the disk of radius R, or through a uniform point of a portal
+ * triangle chosen by its area projected toward w, A_j |n_j.w| / S, which
+ * over the cosine is 1 / S for each triangle the line crosses. */
+static double line_pf1(const SceneView *sc, const double *w, double R, const PathVertex *x1)
+{
+	double c1 = fabs(x1->ng.x * w[0] + x1->ng.y * w[1] + x1->ng.z * w[2]);
+	/* Scene points lie within the disk. */
+	double disk = 1 / (M_PI * R * R), S = 0;
+	for (int i = 0; i < sc->params->num_portals; i++) {
+		GLOBAL const PortalTri *t = &sc->portals[i];
+		S += t->area * fabs(t->n.x * w[0] + t->n.y * w[1] + t->n.z * w[2]);
+	}
+	if (!(S > 0))
+		return c1 * disk;
+	double o[3] = {x1->p.x - 1e3 * w[0], x1->p.y - 1e3 * w[1], x1->p.z - 1e3 * w[2]}, th;
+	int n = 0;
+	for (int i = 0; i < sc->params->num_portals; i++) {
+		GLOBAL const PortalTri *t = &sc->portals[i];
+		double c = fabs(t->n.x * w[0] + t->n.y * w[1] + t->n.z * w[2]);
+		if (c * t->area > 0 && crosses(o, w, 2e3, t->p0, t->p1, t->p2, &th))
+			n++;
+	}
+	return (SUN_DISK_SHARE * disk + (1 - SUN_DISK_SHARE) * n / S) * c1;
+}
+
 /* pf_1 of a punctual light x0 toward x1, from the light's definition:
  * directions uniform on the sphere or in the spot's outer cone; lines of a
- * directional light uniform on the disk of the scene's radius, or through
- * a point of a portal triangle (p_A over the cosine, summed over the
- * triangles the line crosses). */
+ * directional light as line_pf1's. */
 static double punctual_pf1(const SceneView *sc, const PathVertex *x0, const PathVertex *x1)
 {
 	GLOBAL const PunctualLight *l = &sc->punctual[x0->tri];
 	double dir[3] = {l->dir.x, l->dir.y, l->dir.z};
-	if (x0->type == VERTEX_SUN) {
-		double c1 = fabs(x1->ng.x * dir[0] + x1->ng.y * dir[1] + x1->ng.z * dir[2]);
-		/* Scene points lie within the disk. */
-		double disk = 1 / (M_PI * (double)l->disk_radius * l->disk_radius);
-		if (sc->params->num_portals == 0)
-			return c1 * disk;
-		double o[3] = {x1->p.x - 1e3 * dir[0], x1->p.y - 1e3 * dir[1], x1->p.z - 1e3 * dir[2]}, p = 0, th;
-		for (int i = 0; i < sc->params->num_portals; i++) {
-			GLOBAL const PortalTri *t = &sc->portals[i];
-			double c = fabs(t->n.x * dir[0] + t->n.y * dir[1] + t->n.z * dir[2]);
-			if (crosses(o, dir, 2e3, t->p0, t->p1, t->p2, &th))
-				p += t->pdf_select / (t->area * c);
-		}
-		return (SUN_DISK_SHARE * disk + (1 - SUN_DISK_SHARE) * p) * c1;
-	}
+	if (x0->type == VERTEX_SUN)
+		return line_pf1(sc, dir, l->disk_radius, x1);
 	double d[3] = {x1->p.x - x0->p.x, x1->p.y - x0->p.y, x1->p.z - x0->p.z};
 	double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
 	double pw = 1 / (4 * M_PI);
@@ -90,8 +102,12 @@ void oracle(const SceneView *sc, const PathVertex *x, const int *delta, int k, M
 			mv[i].pf = x[0].type == VERTEX_ENV ? ps * env_pdf_w(sc, x[0].p)
 							   : (1 - ps) * emitter_pdf_a(sc, x[0].tri, x[0].p);
 		else if (i == 1 && x[0].type == VERTEX_ENV)
-			mv[i].pf = fabs(v3_dot(x[1].ng, x[0].p)) /
-				   (AJAR_PI * prm->scene_radius * prm->scene_radius);
+			/* A sky image's lines come through the portals, a constant sky's
+			 * cross the disk alone. */
+			mv[i].pf = prm->env_type == ENV_IMAGE && prm->num_portals > 0
+					   ? (float)line_pf1(sc, (const double[3]){-x[0].p.x, -x[0].p.y, -x[0].p.z},
+							     prm->scene_radius, &x[1])
+					   : fabs(v3_dot(x[1].ng, x[0].p)) / (AJAR_PI * prm->scene_radius * prm->scene_radius);
 		else if (i == 1) {
 			V3 d = v3_norm(v3_sub(x[1].p, x[0].p));
 			float c = v3_dot(v3_norm(tri_normal(&sc->tris[x[0].tri])), d);

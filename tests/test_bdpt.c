@@ -294,6 +294,24 @@ static void test_mis_sun_portal(void **state)
 	host_scene_close(&h);
 }
 
+/* window-room under a sky image with a sun high behind the window: the
+ * environment's light subpaths start on the portal (lights.h,
+ * line_sample), and their pf_1 (line_pdf_perp) is checked against the oracle's
+ * own crossing count. */
+static void test_mis_sky_image_portal(void **state)
+{
+	ajar_scene *s;
+	if (ajar_scene_load(SCENE("window-room/window-room.gltf"), &s) != AJAR_OK)
+		fail_msg("%s", ajar_last_error());
+	float *sky = test_sun_sky(256, 128, 0.1f, sinf(0.84f), -cosf(0.84f), 0.03f, 3000.0f);
+	assert_int_equal(scene_set_env_image(s, 256, 128, sky, 1.0f), AJAR_OK);
+	HostScene h;
+	host_scene_open(&h, NULL, s, 32, 32, INTEGRATOR_BDPT, 8);
+	assert_true(h.data.params->num_portals > 0 && h.data.params->env_type == ENV_IMAGE);
+	assert_true(check_mis(&h, 400) > 1000);
+	host_scene_close(&h);
+}
+
 /* ---- Convergence ------------------------------------------------------- */
 
 #define BATCHES 32
@@ -456,6 +474,7 @@ int main(void)
 		cmocka_unit_test(test_bdpt_matches_pt_glossy),
 		cmocka_unit_test(test_mis_punctual),
 		cmocka_unit_test(test_mis_sun_portal),
+		cmocka_unit_test(test_mis_sky_image_portal),
 		cmocka_unit_test(test_strategies_unbiased_punctual),
 		cmocka_unit_test(test_bdpt_matches_pt_punctual),
 		cmocka_unit_test(test_bdpt_matches_pt_sun_portal),

@@ -443,8 +443,10 @@ static const float wr_p[3] = {1.0f, 2.2f, 2.0f}, wr_q[3] = {3.0f, 2.5f, 1.5f};
 /* Scenes lit only by the sky (no light subpaths, bdpt strategies s <= 1,
  * short eye parts, records within a horizon): the constant-sky window room
  * and window-room-forest (a sky image with a sun, portal planes), with the
- * default set and rate, the longer -> halves of set 1,2,3,4 at rate 1, and
- * light subpaths with short eye parts (1,2,3,4,1). */
+ * sky's set without light subpaths (the constant sky's default; the sky
+ * image's before its light subpaths started on the portals), the longer ->
+ * halves of set 1,2,3,4 at rate 1, and light subpaths with short eye parts
+ * (1,2,3,4,1). */
 static void set_portal_set(HostScene *h, int s_max, int sp_max, int tp_max, int t_max, int light_paths, float rate)
 {
 	Params *prm = h->data.params;
@@ -463,7 +465,10 @@ static void test_join_weights_sky(void **state)
 	for (int i = 0; i < 2; i++) {
 		HostScene h;
 		host_scene_open(&h, scenes[i], NULL, 24, 24, INTEGRATOR_PORTAL, 8);
-		assert_false(h.data.params->light_paths);
+		/* The sky image's default has light subpaths (they start on the
+		 * portals); its set without them is the old default's. */
+		assert_int_equal(h.data.params->light_paths, i == 1);
+		set_portal_set(&h, 1, 2, 1, 3, 0, i == 1 ? 0.3f : 0.1f);
 		assert_true(check_join_weights(&h, 300) > 300);
 		set_portal_set(&h, 1, 2, 3, 4, 0, 1.0f);
 		assert_true(check_join_weights(&h, 200) > 1000);
@@ -540,8 +545,9 @@ static void check_bdpt_weights(HostScene *h, int nsamples, int *fast, int *full)
 	print_message("bdpt weights: %d by the shortcut, %d in full; largest difference %.3g\n", *fast, *full, worst);
 }
 
-/* Lamp scenes (the default set: the sky's, with light subpaths), the sky's
- * own (no light subpaths: s <= 1, a 2-term sum), the rich sky set, and a
+/* Lamp scenes (the default set: the sky's, with light subpaths), a sky
+ * image (the same default) and the sky's set without light subpaths (s <=
+ * 1, a 2-term sum), the rich sky set, and a
  * scene with emitters (every strategy); each branch is taken often. */
 static void test_bdpt_weight_shortcut(void **state)
 {
@@ -557,7 +563,9 @@ static void test_bdpt_weight_shortcut(void **state)
 			int fast = 0, full = 0;
 			check_bdpt_weights(&h, 150, &fast, &full);
 			if (i == 2) {
-				assert_false(h.data.params->light_paths);
+				assert_true(h.data.params->light_paths); /* a sky image's (src/prepare.c) */
+				set_portal_set(&h, 1, 2, 1, 3, 0, 0.3f);
+				check_bdpt_weights(&h, 150, &fast, &full);
 				set_portal_set(&h, 1, 2, 3, 4, 0, 1.0f);
 				check_bdpt_weights(&h, 150, &fast, &full);
 			}
@@ -1064,6 +1072,8 @@ static void test_portal_set(void **state)
 		int expect[5]; /* s, s', t', t, light paths */
 	} cases[] = {
 		{"window-room/window-room.gltf", NULL, {1, 2, 1, 3, 0}},
+		{"window-room-forest/window-room-forest.gltf", NULL, {1, 2, 1, 3, 1}}, /* a sky image: light subpaths */
+		{"window-room-forest/window-room-forest.gltf", "1,2,1,3,0", {1, 2, 1, 3, 0}},
 		{"door-ajar/door-ajar.gltf", NULL, {1, AJAR_BIDIR_MAX_DEPTH, AJAR_BIDIR_MAX_DEPTH, 1 << 20, 1}},
 		{"door-ajar/door-ajar.gltf", "2,4,5", {2, 4, 5, 1 << 20, 1}},
 		{"door-ajar/door-ajar.gltf", "1,2,2,4,0", {1, 2, 2, 4, 0}},
@@ -1091,9 +1101,10 @@ static void test_portal_set(void **state)
 }
 
 /* The rate of intermediate subpaths: 0.1 where a constant sky is the only
- * light, 0.3 where a sky image is (sampled through planar portals), 1 with
- * emitters, AJAR_PORTAL_RATE in (0, 1] overriding it, anything
- * else ignored with a warning. */
+ * light and where a sky image is (with its light subpaths), 0.3 under a
+ * sky image (sampled through planar portals) without light subpaths, 1
+ * with emitters, AJAR_PORTAL_RATE in (0, 1] overriding it, anything else
+ * ignored with a warning. */
 static void test_portal_rate(void **state)
 {
 	HostScene h;
@@ -1104,8 +1115,13 @@ static void test_portal_rate(void **state)
 	assert_float_equal(h.data.params->portal_rate, 1.0f, 0.0f);
 	host_scene_close(&h);
 	host_scene_open(&h, NULL, sun_room(0, 300.0f), 8, 8, INTEGRATOR_PORTAL, 8); /* a sky image */
+	assert_float_equal(h.data.params->portal_rate, 0.1f, 0.0f);
+	host_scene_close(&h);
+	setenv("AJAR_PORTAL_SET", "1,2,1,3,0", 1); /* without its light subpaths */
+	host_scene_open(&h, NULL, sun_room(0, 300.0f), 8, 8, INTEGRATOR_PORTAL, 8);
 	assert_float_equal(h.data.params->portal_rate, 0.3f, 0.0f);
 	host_scene_close(&h);
+	unsetenv("AJAR_PORTAL_SET");
 	const char *rates[] = {"0.25", "1", "0", "1.5", "0.3x", ""};
 	const float expect[] = {0.25f, 1.0f, 0.1f, 0.1f, 0.1f, 0.1f};
 	for (int i = 0; i < 6; i++) {

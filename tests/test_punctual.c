@@ -310,29 +310,30 @@ static void test_emission_directions(void **state)
 	check_directions("spot light directions", &l);
 }
 
-/* The lines of directional light l (sun_line_sample) where they cross the
- * plane through the scene's centre perpendicular to the light, in cells of
- * a grid over [lo, hi]^2 (basis t, b of l->dir), against sun_line_pdf
- * integrated over each cell. */
+/* The lines along w of disk radius R (line_sample: a directional light's,
+ * or the environment's for a sampled direction) where they cross the plane
+ * through the scene's centre perpendicular to w, in cells of a grid over
+ * [lo, hi]^2 (basis t, b of w), against line_pdf_perp integrated over each
+ * cell. */
 #define GN 12
-static void check_lines(const char *what, const SceneView *sc, GLOBAL const PunctualLight *l, double lo, double hi)
+static void check_lines(const char *what, const SceneView *sc, V3 w, float R, double lo, double hi)
 {
 	static double obs[GN * GN], expct[GN * GN];
 	memset(obs, 0, sizeof obs);
 	V3 t, b, c = sc->params->scene_center;
-	v3_basis(l->dir, &t, &b);
+	v3_basis(w, &t, &b);
 	Rng rng = rng_init(7, 8, 9, 10);
 	double cell = (hi - lo) / GN;
 	int outside = 0;
 	for (int i = 0; i < N_EMIT; i++) {
 		V3 o;
 		float pdf;
-		if (!sun_line_sample(sc, l, rng_f(&rng), rng_f(&rng), rng_f(&rng), &o, &pdf))
+		if (!line_sample(sc, w, R, rng_f(&rng), rng_f(&rng), rng_f(&rng), &o, &pdf))
 			fail_msg("%s: no line sampled", what);
 		V3 q = v3_sub(o, c);
 		double x = v3_dot(q, t), y = v3_dot(q, b);
 		/* The line starts behind the scene's bounding sphere. */
-		if (!(v3_dot(q, l->dir) < -sc->params->scene_radius))
+		if (!(v3_dot(q, w) < -sc->params->scene_radius))
 			fail_msg("%s: a line starts inside the scene", what);
 		int ix = (int)floor((x - lo) / cell), iy = (int)floor((y - lo) / cell);
 		if (ix < 0 || ix >= GN || iy < 0 || iy >= GN) {
@@ -351,7 +352,7 @@ static void check_lines(const char *what, const SceneView *sc, GLOBAL const Punc
 				for (int k = 0; k < sub; k++) {
 					double x = lo + cell * (ix + (k + 0.5) / sub), y = lo + cell * (iy + (a + 0.5) / sub);
 					V3 p = v3_add(c, v3_add(v3_scale(t, (float)x), v3_scale(b, (float)y)));
-					sum += sun_line_pdf(sc, l, p);
+					sum += line_pdf_perp(sc, w, R, p);
 				}
 			expct[iy * GN + ix] = N_EMIT * sum / (sub * sub) * cell * cell;
 			total += expct[iy * GN + ix];
@@ -395,7 +396,7 @@ static void test_sun_lines(void **state)
 		for (int i = 0; i < N_EMIT; i++) {
 			V3 o;
 			float pdf;
-			assert_true(sun_line_sample(&h.view, pl, rng_f(&rng), rng_f(&rng), rng_f(&rng), &o, &pdf));
+			assert_true(line_sample(&h.view, pl->dir, pl->disk_radius, rng_f(&rng), rng_f(&rng), rng_f(&rng), &o, &pdf));
 			V3 q = v3_sub(o, c);
 			double x = v3_dot(q, t), y = v3_dot(q, b);
 			assert_true(x * x + y * y <= r * r * (1 + 1e-5));
@@ -404,7 +405,7 @@ static void test_sun_lines(void **state)
 				obs[iy * GN + ix]++;
 		}
 		for (int i = 0; i < GN * GN; i++)
-			expct[i] = N_EMIT * sun_line_pdf(&h.view, pl, c) * cell * cell;
+			expct[i] = N_EMIT * line_pdf_perp(&h.view, pl->dir, pl->disk_radius, c) * cell * cell;
 		check_chi2("directional light, disk", obs, expct, GN * GN);
 	}
 	h.scene = NULL;
@@ -424,7 +425,35 @@ static void test_sun_lines(void **state)
 	host_scene_open(&h, NULL, s, 1, 1, INTEGRATOR_PT, 8);
 	assert_int_equal(h.view.params->num_portals, 4);
 	float R = h.view.punctual[0].disk_radius * 1.01f;
-	check_lines("directional light through two portals", &h.view, &h.view.punctual[0], -R, R);
+	check_lines("directional light through two portals", &h.view, h.view.punctual[0].dir,
+		    h.view.punctual[0].disk_radius, -R, R);
+	h.scene = NULL;
+	host_scene_close(&h);
+	ajar_scene_destroy(&s);
+
+	/* The environment's lines (bdpt_light_subpath: along -dir, on the
+	 * scene's radius) through a horizontal and a vertical window, for two
+	 * directions: the first has lines through both (down through the
+	 * roof window, then out of the wall one), the second meets the wall
+	 * window from its back at a slant. */
+	s = plane_scene_sized(1.0f);
+	const float w3[12] = {0.9f, 0.1f, -0.5f, 0.9f, 1.1f, -0.5f, 0.9f, 1.1f, 0.5f, 0.9f, 0.1f, 0.5f};
+	ajar_mesh m3 = {w3, NULL, NULL, 4, quad, 2, 0, NULL};
+	assert_int_equal(ajar_scene_add_portal(s, &m1), AJAR_OK);
+	assert_int_equal(ajar_scene_add_portal(s, &m3), AJAR_OK);
+	host_scene_open(&h, NULL, s, 1, 1, INTEGRATOR_BDPT, 8);
+	assert_int_equal(h.view.params->num_portals, 4);
+	float r = h.view.params->scene_radius;
+	const V3 dirs[2] = {v3_norm(v3(0.6f, -0.8f, 0.1f)), v3_norm(v3(-0.3f, -0.9f, -0.3f))};
+	for (int i = 0; i < 2; i++) {
+		/* A line through both windows has twice the portal share. */
+		V3 x = v3(0.4f, 1.0f, 0.05f);
+		double both = 0.9 * 2 / (double)line_portal_area(&h.view, dirs[i]) + 0.1 / (M_PI * r * r);
+		if (i == 0)
+			assert_true(fabs(line_pdf_perp(&h.view, dirs[i], r, x) / both - 1) < 1e-4);
+		check_lines(i ? "environment lines, slanted through the wall window" : "environment lines, two windows",
+			    &h.view, dirs[i], r, -1.01 * r, 1.01 * r);
+	}
 	h.scene = NULL;
 	host_scene_close(&h);
 	ajar_scene_destroy(&s);
