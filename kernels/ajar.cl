@@ -27,15 +27,6 @@ __kernel void render_pass(AJAR_SCENE_BUFFERS(AJAR_KERNEL_ARG) __global long *acc
 {
 	SceneView sc;
 	AJAR_SCENE_BUFFERS(AJAR_VIEW_INIT)
-	/* The sky memo pays in bdpt, whose weights read the next-event density
-	 * of the vertex just sampled and the pn_0 of a light subpath's first
-	 * vertex again (29% of its plane views on window-room-forest); pt
-	 * reads one again only where its next ray escapes (1%) and portal's
-	 * records 8%, less than the memo's lookups cost (kernels/lights.md,
-	 * "Cheaper sky next-event estimation"). */
-	SkyMemo sky_memo;
-	sky_memo_clear(&sky_memo);
-	sc.sky_memo = PARAMS_INTEGRATOR(params) == INTEGRATOR_BDPT ? &sky_memo : 0;
 	GLOBAL const Camera *cam = &params->camera;
 	uint npix = (uint)(cam->width * cam->height);
 	uint unit = unit_first + (uint)get_global_id(0);
@@ -111,7 +102,6 @@ __kernel void trace_closest(AJAR_SCENE_BUFFERS(AJAR_KERNEL_ARG) __global const f
 {
 	SceneView sc;
 	AJAR_SCENE_BUFFERS(AJAR_VIEW_INIT)
-	sc.sky_memo = 0;
 	uint i = (uint)get_global_id(0);
 	if (i >= count)
 		return;

@@ -227,7 +227,7 @@ INLINE float sky_view_weight(const SkyPlaneView *v, V3 n)
  * rounding (4e-7 rad at the far end) and the tangents' own (a few ulps,
  * by reciprocals): so the directions it drops are ones whose density term
  * was 0, and the sum is the same bits (test_lights,
- * test_sky_pdf_views_memo, fails with a margin of 0). Infinite or NaN
+ * test_sky_pdf_views, fails with a margin of 0). Infinite or NaN
  * tangents compare false and are kept. */
 #define SKY_TAN_MARGIN 1e-5f
 INLINE int sky_tan_outside(float X, float lo, float hi)
@@ -243,84 +243,25 @@ INLINE int sky_view_may_contain(GLOBAL const PortalPlane *P, const SkyPlaneView 
 	return !(sky_tan_outside(X, v->X0, v->X1) || sky_tan_outside(Y, v->Y0, v->Y1));
 }
 
-/* The planes' views from one x, computed once per next-event sample or
- * density and, in the kernels, kept for the next ones from the same x
- * (SkyMemo): the first SKY_KEPT planes' views are kept, the rest computed
- * again where needed. */
+/* The planes' views and weights from one x and n, computed once per
+ * next-event sample or density: the first SKY_KEPT planes' views and
+ * weights are kept, the rest computed again where needed; W is the sum of
+ * the weights. */
 #define SKY_KEPT 4
 typedef struct {
 	SkyPlaneView v[SKY_KEPT];
-} SkyAt;
-
-/* The last SKY_MEMO_SLOTS points' views, per work-item (the kernel entry
- * points hang one on SceneView.sky_memo; NULL, as on the host, computes
- * every time). A density of x's next-event sample is needed many times:
- * pt reads it at x's sample and again where the next ray escapes; bdpt at
- * the sample and in its weight, and the pn_0 of a light subpath from the
- * sky at its first vertex in every strategy that connects it; the
- * records of portal paths again. The views are a function of x alone,
- * compared by bits, so a kept one is what would be computed: the same
- * bits. Slots are reused round robin; a SkyWeights that points at one
- * stays valid while fewer than SKY_MEMO_SLOTS other points are looked up
- * (sky_weights' callers look none up while they hold it). */
-#define SKY_MEMO_SLOTS 3
-typedef struct SkyMemo {
-	uint key[SKY_MEMO_SLOTS][3];
-	SkyAt at[SKY_MEMO_SLOTS];
-	int used, next;
-} SkyMemo;
-
-INLINE void sky_memo_clear(SkyMemo *m)
-{
-	m->used = 0;
-	m->next = 0;
-}
-
-/* x's views: the memo's slot that holds them, else a slot (or *own,
- * without a memo) that the caller fills (*fill). */
-INLINE const SkyAt *sky_at(const SceneView *sc, V3 x, SkyAt *own, SkyAt **fill)
-{
-	SkyMemo *m = sc->sky_memo;
-	if (!m) {
-		*fill = own;
-		return own;
-	}
-	uint kx = f2u(x.x), ky = f2u(x.y), kz = f2u(x.z);
-	for (int i = 0; i < m->used; i++)
-		if (m->key[i][0] == kx && m->key[i][1] == ky && m->key[i][2] == kz) {
-			*fill = 0;
-			return &m->at[i];
-		}
-	int i = m->next;
-	m->next = i + 1 < SKY_MEMO_SLOTS ? i + 1 : 0;
-	m->used = max(m->used, i + 1);
-	m->key[i][0] = kx;
-	m->key[i][1] = ky;
-	m->key[i][2] = kz;
-	*fill = &m->at[i];
-	return &m->at[i];
-}
-
-/* The planes' weights from one x and n: the kept planes' views (at) and
- * weights, and their sum W. */
-typedef struct {
-	SkyAt own; /* at's storage without a memo */
-	const SkyAt *at;
 	float w[SKY_KEPT];
 	float W;
 } SkyWeights;
 
 HOT_INLINE void sky_weights(const SceneView *sc, V3 x, V3 n, SkyWeights *sw)
 {
-	SkyAt *fill;
-	sw->at = sky_at(sc, x, &sw->own, &fill);
 	sw->W = 0.0f;
 	for (int k = 0; k < sc->params->num_portal_planes; k++) {
 		float w;
 		if (k < SKY_KEPT) {
-			if (fill)
-				sky_plane_view(sc, &sc->portal_planes[k], x, &fill->v[k]);
-			w = sw->w[k] = sky_view_weight(&sw->at->v[k], n);
+			sky_plane_view(sc, &sc->portal_planes[k], x, &sw->v[k]);
+			w = sw->w[k] = sky_view_weight(&sw->v[k], n);
 		} else {
 			SkyPlaneView v;
 			sky_plane_view(sc, &sc->portal_planes[k], x, &v);
@@ -340,7 +281,7 @@ INLINE float sky_weight_of(const SceneView *sc, const SkyWeights *sw, int k, V3 
 		sky_plane_view(sc, &sc->portal_planes[k], x, tmp);
 		return sky_view_weight(tmp, n);
 	}
-	*v = &sw->at->v[k];
+	*v = &sw->v[k];
 	return sw->w[k];
 }
 

@@ -265,15 +265,11 @@ typedef struct {
 	X(float, portal_sky)      \
 	X(Params, params)
 
-/* What device code sees of the scene: one pointer per array, and the
- * work-item's memo of the sky's next-event densities (env_portal.h,
- * SkyMemo; NULL computes them every time, as host code does). */
-struct SkyMemo;
+/* What device code sees of the scene: one pointer per array. */
 typedef struct {
 #define AJAR_VIEW_FIELD(type, name) GLOBAL const type *name;
 	AJAR_SCENE_BUFFERS(AJAR_VIEW_FIELD)
 #undef AJAR_VIEW_FIELD
-	struct SkyMemo *sky_memo;
 } SceneView;
 
 #endif

@@ -263,7 +263,6 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 #define PREPARE_VIEW(type, name) view.name = d->name;
 	AJAR_SCENE_BUFFERS(PREPARE_VIEW)
 #undef PREPARE_VIEW
-	view.sky_memo = NULL;
 	if ((st = portal_flux_build(&view, d->portals, (uint32_t)d->n_portals, d->portal_cdf)) != AJAR_OK) {
 		prepare_free(d);
 		return st;

@@ -23,7 +23,6 @@ void host_scene_open(HostScene *h, const char *path, Scene *built, uint32_t w, u
 #define HOST_VIEW(type, name) h->view.name = h->data.name;
 	AJAR_SCENE_BUFFERS(HOST_VIEW)
 #undef HOST_VIEW
-	h->view.sky_memo = NULL;
 }
 
 void host_scene_close(HostScene *h)

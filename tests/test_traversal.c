@@ -141,7 +141,6 @@ static void test_closed_mesh_has_no_cracks(void **state)
 #define VIEW(type, name) sc.name = sd.name;
 	AJAR_SCENE_BUFFERS(VIEW)
 #undef VIEW
-	sc.sky_memo = NULL;
 	uint32_t misses = 0, host_misses = 0;
 	for (uint32_t i = 0; i < nrays; i++) {
 		const float *ray = rays + 6 * i;
