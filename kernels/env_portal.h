@@ -176,85 +176,159 @@ CALLED float env_portal_pdf_w(const SceneView *sc, V3 x, V3 n, V3 wi, float tota
  * rectangle x sees (not the portal's solid angle) times the receiver's
  * cosine toward the rectangle's centre c_P, floored as above. */
 
-/* Plane P's selection weight from x with normal n; r and *total (I_P) are
- * filled in when it is positive. */
-INLINE float sky_plane_weight(const SceneView *sc, GLOBAL const PortalPlane *P, V3 x, V3 n, SkyRect *r, float *total)
+/* What x sees of plane P, apart from the receiver's normal: its
+ * rectangle r, the sky's integral I_P over it (mass), the way d and
+ * distance len to the rectangle's centre, and the rectangle's bounds in
+ * tangents, (X0, X1) x (Y0, Y1) of X = w.t / w.n and Y = w.b / w.n
+ * (sky_view_may_contain); ok = 0 where P shows x no sky (then its weight
+ * is 0 and nothing else is read). */
+typedef struct {
+	SkyRect r;
+	float mass, len;
+	V3 d;
+	float X0, X1, Y0, Y1;
+	int ok;
+} SkyPlaneView;
+
+INLINE void sky_plane_view(const SceneView *sc, GLOBAL const PortalPlane *P, V3 x, SkyPlaneView *v)
 {
-	if (!sky_rect(P, x, r))
-		return 0.0f;
-	*total = sky_rect_integral(sc->portal_sky + P->table, r);
-	if (!(*total > 0.0f))
-		return 0.0f;
-	V3 d = v3_sub(sky_plane_centre(P), x);
-	float cr = fmax(PORTAL_COS_MIN, v3_dot(d, n) / sqrt(v3_len2(d)));
-	return *total * cr;
+	v->ok = 0;
+	float xt, xb, h;
+	if (!sky_rect_at(P, x, &v->r, &xt, &xb, &h))
+		return;
+	v->mass = sky_rect_integral(sc->portal_sky + P->table, &v->r);
+	if (!(v->mass > 0.0f))
+		return;
+	v->d = v3_sub(sky_plane_centre(P), x);
+	v->len = sqrt(v3_len2(v->d));
+	float ih = 1.0f / h;
+	v->X0 = (P->a0 - xt) * ih;
+	v->X1 = (P->a1 - xt) * ih;
+	v->Y0 = (P->b0 - xb) * ih;
+	v->Y1 = (P->b1 - xb) * ih;
+	v->ok = 1;
 }
 
-/* The planes' weights from one x and n, computed once per next-event
- * sample or density: the first SKY_KEPT planes' rectangles, integrals and
- * weights are kept, the rest computed again where needed. */
+/* Plane P's selection weight from x with normal n, w_P = I_P max(
+ * PORTAL_COS_MIN, n . d / |d|). */
+INLINE float sky_view_weight(const SkyPlaneView *v, V3 n)
+{
+	if (!v->ok)
+		return 0.0f;
+	float cr = fmax(PORTAL_COS_MIN, v3_dot(v->d, n) / v->len);
+	return v->mass * cr;
+}
+
+/* Whether unit wi (w.n > 0) may lie in v's rectangle: 0 only where
+ * sky_pdf_uv would find (U, V) outside it. The test is in tangents, without
+ * the two atan2 of sky_coords: X below X0 by more than SKY_TAN_MARGIN (1 +
+ * max(X^2, X0^2)), which bounds the gap of their atans from below, puts U
+ * below U0 by far more than fast_atan2's error (3e-7), sky_coord's
+ * rounding (4e-7 rad at the far end) and the tangents' own (a few ulps,
+ * by reciprocals): so the directions it drops are ones whose density term
+ * was 0, and the sum is the same bits (test_lights,
+ * test_sky_pdf_views, fails with a margin of 0). Infinite or NaN
+ * tangents compare false and are kept. */
+#define SKY_TAN_MARGIN 1e-5f
+INLINE int sky_tan_outside(float X, float lo, float hi)
+{
+	float m = SKY_TAN_MARGIN * (1.0f + fmax(X * X, fmax(lo * lo, hi * hi)));
+	return lo - X > m || X - hi > m;
+}
+
+INLINE int sky_view_may_contain(GLOBAL const PortalPlane *P, const SkyPlaneView *v, V3 wi)
+{
+	float iw = 1.0f / v3_dot(wi, P->n);
+	float X = v3_dot(wi, P->t) * iw, Y = v3_dot(wi, P->b) * iw;
+	return !(sky_tan_outside(X, v->X0, v->X1) || sky_tan_outside(Y, v->Y0, v->Y1));
+}
+
+/* The planes' views and weights from one x and n, computed once per
+ * next-event sample or density: the first SKY_KEPT planes' views and
+ * weights are kept, the rest computed again where needed; W is the sum of
+ * the weights. */
 #define SKY_KEPT 4
 typedef struct {
-	SkyRect r[SKY_KEPT];
-	float mass[SKY_KEPT], w[SKY_KEPT];
+	SkyPlaneView v[SKY_KEPT];
+	float w[SKY_KEPT];
 	float W;
 } SkyWeights;
 
-INLINE void sky_weights(const SceneView *sc, V3 x, V3 n, SkyWeights *sw)
+HOT_INLINE void sky_weights(const SceneView *sc, V3 x, V3 n, SkyWeights *sw)
 {
-	SkyRect r;
-	float mass;
 	sw->W = 0.0f;
 	for (int k = 0; k < sc->params->num_portal_planes; k++) {
-		GLOBAL const PortalPlane *P = &sc->portal_planes[k];
-		float w = k < SKY_KEPT ? (sw->w[k] = sky_plane_weight(sc, P, x, n, &sw->r[k], &sw->mass[k]))
-				       : sky_plane_weight(sc, P, x, n, &r, &mass);
+		float w;
+		if (k < SKY_KEPT) {
+			sky_plane_view(sc, &sc->portal_planes[k], x, &sw->v[k]);
+			w = sw->w[k] = sky_view_weight(&sw->v[k], n);
+		} else {
+			SkyPlaneView v;
+			sky_plane_view(sc, &sc->portal_planes[k], x, &v);
+			w = sky_view_weight(&v, n);
+		}
 		sw->W += w;
 	}
 }
 
-/* Plane k's weight; *r points at its rectangle (kept in sw, or computed
- * into *tmp) and *mass is its integral. */
-INLINE float sky_weight_of(const SceneView *sc, const SkyWeights *sw, int k, V3 x, V3 n, SkyRect *tmp,
-			   const SkyRect **r, float *mass)
+/* Plane k's weight; *v points at its view (kept in sw, or computed into
+ * *tmp). */
+INLINE float sky_weight_of(const SceneView *sc, const SkyWeights *sw, int k, V3 x, V3 n, SkyPlaneView *tmp,
+			   const SkyPlaneView **v)
 {
 	if (k >= SKY_KEPT) {
-		*r = tmp;
-		return sky_plane_weight(sc, &sc->portal_planes[k], x, n, tmp, mass);
+		*v = tmp;
+		sky_plane_view(sc, &sc->portal_planes[k], x, tmp);
+		return sky_view_weight(tmp, n);
 	}
-	*r = &sw->r[k];
-	*mass = sw->mass[k];
+	*v = &sw->v[k];
 	return sw->w[k];
 }
 
-/* The portal part of the density of unit wi from x (sw->W > 0). */
-INLINE float sky_portal_pdf_w(const SceneView *sc, const SkyWeights *sw, V3 x, V3 n, V3 wi)
+/* The portal part of the density of unit wi from x (sw->W > 0); kn, if
+ * not NULL, holds the knots of plane kn_plane's cell that wi was drawn
+ * from (sky_nee_sample). */
+INLINE float sky_portal_pdf_w_knots(const SceneView *sc, const SkyWeights *sw, V3 x, V3 n, V3 wi, int kn_plane,
+				    const SkyKnots *kn)
 {
 	float p = 0.0f;
 	for (int k = 0; k < sc->params->num_portal_planes; k++) {
 		GLOBAL const PortalPlane *P = &sc->portal_planes[k];
-		SkyRect tmp;
-		const SkyRect *r;
-		float mass, U, V, jac;
+		SkyPlaneView tmp;
+		const SkyPlaneView *v;
+		float U, V, jac;
 		if (!(v3_dot(wi, P->n) > 0.0f))
 			continue;
-		float w = sky_weight_of(sc, sw, k, x, n, &tmp, &r, &mass);
-		if (!(w > 0.0f))
+		float w = sky_weight_of(sc, sw, k, x, n, &tmp, &v);
+		if (!(w > 0.0f) || !sky_view_may_contain(P, v, wi))
 			continue;
 		sky_coords(P, wi, &U, &V, &jac);
-		float puv = sky_pdf_uv(sc->portal_sky + P->table, r, mass, U, V);
+		float puv = sky_pdf_uv_knots(sc->portal_sky + P->table, &v->r, v->mass, U, V, k == kn_plane ? kn : 0);
 		if (puv > 0.0f && jac > 0.0f)
 			p += w / sw->W * puv / jac;
 	}
 	return p;
 }
 
-/* The whole density of wi, given pe = env_pdf_w(sc, wi). */
-INLINE float sky_mix_pdf_w(const SceneView *sc, const SkyWeights *sw, V3 x, V3 n, V3 wi, float pe)
+INLINE float sky_portal_pdf_w(const SceneView *sc, const SkyWeights *sw, V3 x, V3 n, V3 wi)
+{
+	return sky_portal_pdf_w_knots(sc, sw, x, n, wi, -1, 0);
+}
+
+/* The whole density of wi, given pe = env_pdf_w(sc, wi) (kn_plane, kn as
+ * in sky_portal_pdf_w_knots). */
+INLINE float sky_mix_pdf_w_knots(const SceneView *sc, const SkyWeights *sw, V3 x, V3 n, V3 wi, float pe,
+				 int kn_plane, const SkyKnots *kn)
 {
 	if (!(sw->W > 0.0f))
 		return pe;
-	return PORTAL_SKY_NEE_MIX * sky_portal_pdf_w(sc, sw, x, n, wi) + (1.0f - PORTAL_SKY_NEE_MIX) * pe;
+	return PORTAL_SKY_NEE_MIX * sky_portal_pdf_w_knots(sc, sw, x, n, wi, kn_plane, kn) +
+	       (1.0f - PORTAL_SKY_NEE_MIX) * pe;
+}
+
+INLINE float sky_mix_pdf_w(const SceneView *sc, const SkyWeights *sw, V3 x, V3 n, V3 wi, float pe)
+{
+	return sky_mix_pdf_w_knots(sc, sw, x, n, wi, pe, -1, 0);
 }
 
 INLINE float sky_nee_pdf_w(const SceneView *sc, V3 x, V3 n, V3 wi, float pe)
@@ -281,15 +355,16 @@ INLINE V3 sky_nee_sample(const SceneView *sc, V3 x, V3 n, float u_mix, float u1,
 	}
 	float target = u_mix / PORTAL_SKY_NEE_MIX * sw.W, cum = 0.0f;
 	int pick = -1;
-	SkyRect r, rk;
-	const SkyRect *rp;
-	float mass = 0.0f, mass_k;
+	SkyRect r;
+	float mass = 0.0f;
 	for (int k = 0; k < sc->params->num_portal_planes && cum <= target; k++) {
-		float wk = sky_weight_of(sc, &sw, k, x, n, &rk, &rp, &mass_k);
+		SkyPlaneView tmp;
+		const SkyPlaneView *v;
+		float wk = sky_weight_of(sc, &sw, k, x, n, &tmp, &v);
 		if (wk > 0.0f) { /* the last positive one if rounding leaves target >= the sum */
 			pick = k;
-			r = *rp;
-			mass = mass_k;
+			r = v->r;
+			mass = v->mass;
 			cum += wk;
 		}
 	}
@@ -297,12 +372,15 @@ INLINE V3 sky_nee_sample(const SceneView *sc, V3 x, V3 n, float u_mix, float u1,
 		return v3(0.0f, 0.0f, 0.0f);
 	GLOBAL const PortalPlane *P = &sc->portal_planes[pick];
 	float U, V, jac;
-	if (!sky_sample_uv(sc->portal_sky + P->table, &r, mass, u1, u2, &U, &V))
+	SkyKnots kn;
+	if (!sky_sample_uv_knots(sc->portal_sky + P->table, &r, mass, u1, u2, &U, &V, &kn))
 		return v3(0.0f, 0.0f, 0.0f);
 	*wi = sky_dir(P, U, V, &jac);
 	float pe;
 	V3 Le = env_radiance_pdf(sc, *wi, &pe);
-	*pdf_w = sky_mix_pdf_w(sc, &sw, x, n, *wi, pe);
+	/* The density from the final direction, with the drawn cell's knots
+	 * where the direction's (U, V) falls back in that cell. */
+	*pdf_w = sky_mix_pdf_w_knots(sc, &sw, x, n, *wi, pe, pick, &kn);
 	return *pdf_w > 0.0f ? Le : v3(0.0f, 0.0f, 0.0f);
 }
 

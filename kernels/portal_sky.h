@@ -66,14 +66,18 @@ INLINE int sky_split(float c, float *f)
 	return i;
 }
 
-/* x's rectangle on plane P; 0 unless x is on its room side. */
-INLINE int sky_rect(GLOBAL const PortalPlane *P, V3 x, SkyRect *r)
+/* x's rectangle on plane P; 0 unless x is on its room side. Also x's
+ * coordinates in P's frame, *xt and *xb, and its height *h below P. */
+INLINE int sky_rect_at(GLOBAL const PortalPlane *P, V3 x, SkyRect *r, float *pxt, float *pxb, float *ph)
 {
 	V3 d = v3_sub(x, P->o);
 	float h = -v3_dot(d, P->n);
+	*ph = h;
 	if (!(h > 0.0f))
 		return 0;
 	float xt = v3_dot(d, P->t), xb = v3_dot(d, P->b);
+	*pxt = xt;
+	*pxb = xb;
 	r->U0 = sky_coord(fast_atan2(P->a0 - xt, h));
 	r->U1 = sky_coord(fast_atan2(P->a1 - xt, h));
 	r->V0 = sky_coord(fast_atan2(P->b0 - xb, h));
@@ -82,6 +86,12 @@ INLINE int sky_rect(GLOBAL const PortalPlane *P, V3 x, SkyRect *r)
 	r->j1 = sky_split(r->V1, &r->f1);
 	sky_rect_rows(r);
 	return r->U1 > r->U0 && r->V1 > r->V0;
+}
+
+INLINE int sky_rect(GLOBAL const PortalPlane *P, V3 x, SkyRect *r)
+{
+	float xt, xb, h;
+	return sky_rect_at(P, x, r, &xt, &xb, &h);
 }
 
 /* B(i): the integral over [0, i] x [V0, V1], (S(i, j1) - S(i, j0)) +
@@ -125,39 +135,72 @@ INLINE float sky_rect_integral(GLOBAL const float *S, const SkyRect *r)
 	return sky_band_at(S, r, r->U1) - sky_band_at(S, r, r->U0);
 }
 
+/* The knots of the cell (i, j) that sky_sample_uv drew from: column i's
+ * mass B(i + 1) - B(i), its integrals H(V0), H(V1) at the rectangle's v
+ * bounds and cell (i, j)'s C(j + 1) - C(j), for sky_pdf_uv_knots. */
+typedef struct {
+	int i, j;
+	float colmass, h0, h1, cell;
+} SkyKnots;
+
 /* Density per unit U and V (cell units) of (U, V) within r, whose integral
- * is `total`; 0 outside r. */
-INLINE float sky_pdf_uv(GLOBAL const float *S, const SkyRect *r, float total, float U, float V)
+ * is `total`; 0 outside r. Where (U, V) falls in kn's cell (kn not NULL),
+ * the knots are kn's, which are the same numbers read again. */
+INLINE float sky_pdf_uv_knots(GLOBAL const float *S, const SkyRect *r, float total, float U, float V,
+			      const SkyKnots *kn)
 {
 	if (!(U >= r->U0 && U <= r->U1 && V >= r->V0 && V <= r->V1) || !(total > 0.0f))
 		return 0.0f;
 	float fu, fv;
 	int i = sky_split(U, &fu), j = sky_split(V, &fv);
-	float colmass = sky_band(S, r, i + 1) - sky_band(S, r, i);
-	float h0 = sky_col_at(S, i, r->V0), h1 = sky_col_at(S, i, r->V1);
-	float cell = sky_col(S, i, j + 1) - sky_col(S, i, j);
+	float colmass, h0, h1, cell;
+	if (kn && kn->i == i && kn->j == j) {
+		colmass = kn->colmass;
+		h0 = kn->h0;
+		h1 = kn->h1;
+		cell = kn->cell;
+	} else {
+		colmass = sky_band(S, r, i + 1) - sky_band(S, r, i);
+		h0 = sky_col_at(S, i, r->V0);
+		h1 = sky_col_at(S, i, r->V1);
+		cell = sky_col(S, i, j + 1) - sky_col(S, i, j);
+	}
 	if (!(colmass > 0.0f) || !(h1 > h0) || !(cell > 0.0f))
 		return 0.0f;
 	return colmass / total * (cell / (h1 - h0));
 }
 
-/* Samples (U, V) within r (integral `total`) from u1, u2; 0 if none. */
-INLINE int sky_sample_uv(GLOBAL const float *S, const SkyRect *r, float total, float u1, float u2, float *U, float *V)
+INLINE float sky_pdf_uv(GLOBAL const float *S, const SkyRect *r, float total, float U, float V)
+{
+	return sky_pdf_uv_knots(S, r, total, U, V, 0);
+}
+
+/* Samples (U, V) within r (integral `total`) from u1, u2; 0 if none. The
+ * drawn cell's knots go to *kn. */
+INLINE int sky_sample_uv_knots(GLOBAL const float *S, const SkyRect *r, float total, float u1, float u2, float *U,
+			       float *V, SkyKnots *kn)
 {
 	float fu0, fu1;
 	int i0 = sky_split(r->U0, &fu0), i1 = sky_split(r->U1, &fu1);
 	float b0 = sky_band(S, r, i0);
 	float target = b0 + fu0 * (sky_band(S, r, i0 + 1) - b0) + u1 * total;
-	/* The last column whose left knot is at most the target. */
-	int lo = i0, hi = i1;
+	/* The last column whose left knot is at most the target. The knots
+	 * B(lo) and, once hi has moved, B(hi + 1) are kept from the search. */
+	int lo = i0, hi = i1, moved = 0;
+	float bl = b0, bh = 0.0f;
 	while (lo < hi) {
 		int mid = (lo + hi + 1) >> 1;
-		if (sky_band(S, r, mid) <= target)
+		float bm = sky_band(S, r, mid);
+		if (bm <= target) {
 			lo = mid;
-		else
+			bl = bm;
+		} else {
 			hi = mid - 1;
+			bh = bm;
+			moved = 1;
+		}
 	}
-	float bl = sky_band(S, r, lo), slope = sky_band(S, r, lo + 1) - bl;
+	float slope = (moved ? bh : sky_band(S, r, lo + 1)) - bl;
 	if (!(slope > 0.0f))
 		return 0;
 	*U = fmin(fmax((float)lo + (target - bl) / slope, fmax((float)lo, r->U0)), fmin((float)(lo + 1), r->U1));
@@ -166,18 +209,37 @@ INLINE int sky_sample_uv(GLOBAL const float *S, const SkyRect *r, float total, f
 		return 0;
 	float t2 = h0 + u2 * (h1 - h0);
 	int jl = r->j0, jh = r->j1;
+	float cl = sky_col(S, lo, jl), ch = 0.0f;
+	moved = 0;
 	while (jl < jh) {
 		int mid = (jl + jh + 1) >> 1;
-		if (sky_col(S, lo, mid) <= t2)
+		float cm = sky_col(S, lo, mid);
+		if (cm <= t2) {
 			jl = mid;
-		else
+			cl = cm;
+		} else {
 			jh = mid - 1;
+			ch = cm;
+			moved = 1;
+		}
 	}
-	float cl = sky_col(S, lo, jl), cs = sky_col(S, lo, jl + 1) - cl;
+	float cs = (moved ? ch : sky_col(S, lo, jl + 1)) - cl;
 	if (!(cs > 0.0f))
 		return 0;
 	*V = fmin(fmax((float)jl + (t2 - cl) / cs, fmax((float)jl, r->V0)), fmin((float)(jl + 1), r->V1));
+	kn->i = lo;
+	kn->j = jl;
+	kn->colmass = slope;
+	kn->h0 = h0;
+	kn->h1 = h1;
+	kn->cell = cs;
 	return 1;
+}
+
+INLINE int sky_sample_uv(GLOBAL const float *S, const SkyRect *r, float total, float u1, float u2, float *U, float *V)
+{
+	SkyKnots kn;
+	return sky_sample_uv_knots(S, r, total, u1, u2, U, V, &kn);
 }
 
 /* The tangent of the angle at coordinate c. */

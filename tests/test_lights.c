@@ -1086,6 +1086,130 @@ static void test_light_sample_sky_portals(void **state)
 	lit_free(&l);
 }
 
+/* The portal part of the sky's next-event density as env_portal.h
+ * computed it before the views and the tangent test (session 22): every plane's rectangle, integral and weight again, and sky_coords
+ * and sky_pdf_uv for every plane that faces wi. */
+static float sky_portal_pdf_ref(const Lit *l, V3 x, V3 n, V3 wi)
+{
+	int np = l->prm.num_portal_planes;
+	SkyRect r[8];
+	float mass[8], w[8], W = 0.0f, p = 0.0f;
+	assert_true(np <= 8);
+	for (int k = 0; k < np; k++) {
+		const PortalPlane *P = &l->planes[k];
+		w[k] = 0.0f;
+		if (!sky_rect(P, x, &r[k]))
+			continue;
+		mass[k] = sky_rect_integral(l->sky + P->table, &r[k]);
+		if (!(mass[k] > 0.0f))
+			continue;
+		V3 d = v3_sub(sky_plane_centre(P), x);
+		float cr = fmaxf(PORTAL_COS_MIN, v3_dot(d, n) / sqrtf(v3_len2(d)));
+		w[k] = mass[k] * cr;
+		W += w[k];
+	}
+	if (!(W > 0.0f))
+		return -1.0f;
+	for (int k = 0; k < np; k++) {
+		const PortalPlane *P = &l->planes[k];
+		float U, V, jac;
+		if (!(v3_dot(wi, P->n) > 0.0f) || !(w[k] > 0.0f))
+			continue;
+		sky_coords(P, wi, &U, &V, &jac);
+		float puv = sky_pdf_uv(l->sky + P->table, &r[k], mass[k], U, V);
+		if (puv > 0.0f && jac > 0.0f)
+			p += w[k] / W * puv / jac;
+	}
+	return p;
+}
+
+static int same_bits(float a, float b) { return memcmp(&a, &b, sizeof a) == 0; }
+
+/* The sky's next-event density is the same bits with the planes' views
+ * and their tangent test (env_portal.h) as computed from scratch
+ * (sky_portal_pdf_ref): from points all about the window, toward
+ * directions at random and just inside and outside every rectangle's
+ * edges (where the tangent test must keep what sky_pdf_uv keeps), with
+ * both sides' normals at one point; and a next-event sample's density,
+ * which reuses its drawn cell's knots, is the one computed afresh. */
+static void test_sky_pdf_views(void **state)
+{
+	rng_state = 41;
+	Lit l;
+	build_light_scene(&l);
+	V3 sun = v3_norm(v3(0.15f, 0.5f, 1.0f));
+	assert_int_equal(scene_set_env_image(l.s, 128, 64, test_sun_sky(128, 64, sun.x, sun.y, sun.z, 0.06f, 300.0f), 0.05f), AJAR_OK);
+	add_window_portals(&l);
+	V3 x0 = v3(0.1f, 0.2f, 0.05f);
+	for (int j = 0; j < 5; j++) {
+		PortalTri *pt = &l.s->portals[j];
+		float dn = v3_dot(v3_sub(x0, pt->p0), pt->n);
+		pt->env_side = j == 4 ? (dn > 0 ? 1 : -1) : (dn > 0 ? -1 : 1);
+	}
+	l.s->portals[5].env_side = 0;
+	assert_int_equal(lit_planes(&l), 4);
+	enum { NX = 7 };
+	V3 xs[NX];
+	for (int i = 0; i < NX; i++)
+		xs[i] = v3(4.0f * rnd() - 2.0f, 4.0f * rnd() - 2.0f, 2.5f * rnd() - 1.5f);
+	int checked = 0, edge = 0, nonzero = 0, sampled = 0;
+	for (int it = 0; it < 4000; it++) {
+		V3 x = xs[(it * 5 + it / 7) % NX];
+		V3 n = v3_norm(v3(rnd() - 0.5f, rnd() - 0.5f, rnd() - 0.5f));
+		if (it % 3 == 1)
+			n = v3_neg(n);
+		V3 wi;
+		int k = (int)(rnd() * 4.0f) & 3;
+		SkyRect r;
+		if (it % 2 == 0 && sky_rect(&l.planes[k], x, &r)) {
+			/* just inside or outside an edge of plane k's rectangle */
+			float e = (rnd() - 0.5f) * 2e-3f, U = r.U0 + (r.U1 - r.U0) * rnd(), V = r.V0 + (r.V1 - r.V0) * rnd();
+			int side = (int)(rnd() * 4.0f) & 3;
+			if (side == 0)
+				U = r.U0 + e;
+			else if (side == 1)
+				U = r.U1 + e;
+			else if (side == 2)
+				V = r.V0 + e;
+			else
+				V = r.V1 + e;
+			float jac;
+			wi = sky_dir(&l.planes[k], fminf(fmaxf(U, 1e-3f), PORTAL_SKY_RES - 1e-3f),
+				     fminf(fmaxf(V, 1e-3f), PORTAL_SKY_RES - 1e-3f), &jac);
+			edge++;
+		} else {
+			wi = v3_norm(v3(rnd() - 0.5f, rnd() - 0.5f, rnd() - 0.5f));
+		}
+		float ref = sky_portal_pdf_ref(&l, x, n, wi);
+		SkyWeights a;
+		sky_weights(&l.sc, x, n, &a);
+		if (ref < 0.0f) {
+			assert_false(a.W > 0.0f);
+			continue;
+		}
+		assert_true(same_bits(sky_portal_pdf_w(&l.sc, &a, x, n, wi), ref));
+		checked++;
+		nonzero += ref > 0.0f;
+	}
+	/* next-event samples */
+	for (int it = 0; it < 2000; it++) {
+		V3 x = xs[(it * 3 + it / 5) % NX], n = v3_norm(v3(rnd() - 0.5f, rnd() - 0.5f, rnd() - 0.5f));
+		float um = rnd(), u1 = rnd(), u2 = rnd(), pa;
+		V3 wa = v3(0, 0, 0);
+		sky_nee_sample(&l.sc, x, n, um, u1, u2, &wa, &pa);
+		/* through a plane: the density with the drawn cell's knots is the
+		 * one computed afresh from the direction */
+		if (um < PORTAL_SKY_NEE_MIX && pa > 0.0f) {
+			assert_true(same_bits(pa, sky_nee_pdf_w(&l.sc, x, n, wa, env_pdf_w(&l.sc, wa))));
+			sampled++;
+		}
+	}
+	printf("  %d densities (%d nonzero, %d toward rectangle edges) and %d samples' the same bits\n", checked,
+	       nonzero, edge, sampled);
+	assert_true(checked > 1000 && nonzero > 300 && edge > 1000 && sampled > 500);
+	lit_free(&l);
+}
+
 /* A window in a grid of 24 triangles (one plane), seen from close by and
  * off its centre, and single-triangle portals (directions in their
  * bounding rectangles but outside them are valid samples of the plane). */
@@ -1145,6 +1269,7 @@ int main(void)
 		cmocka_unit_test(test_light_sample_env_portal_grid),
 		cmocka_unit_test(test_light_sample_sky_portals),
 		cmocka_unit_test(test_light_sample_sky_grid),
+		cmocka_unit_test(test_sky_pdf_views),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
