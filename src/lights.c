@@ -164,6 +164,49 @@ static ajar_status build_emitters(const Scene *s, Tri *tris, const TriShade *sha
 /* Pixels x strength, then the marginal and conditional CDFs of
  * luminance x sin(theta) at each row's centre (kernels/types.h). Returns
  * the average radiance luminance over the sphere in *avg_lum. */
+/* The share of a sky image's power (luminance x solid angle) that its
+ * brightest texels covering SUN_SOLID_ANGLE_SHARE of the sphere carry: a
+ * compact sun's. window-room-forest's sky 0.13, window-room-sunset's
+ * (3 degrees up, reddened) 0.03, that forest sky with everything above
+ * its 99th percentile clipped (overcast-like) 0.01. The brightest texels
+ * are found by a histogram of luminance in 1/16-octave bins below the
+ * maximum, the last bin taken in proportion, so the cost is two passes
+ * over the image. src/prepare.c reads it (portal's light subpaths). */
+#define SUN_SOLID_ANGLE_SHARE 0.001
+#define SUN_BINS 640 /* 40 octaves */
+static float env_sun_share(const float *pix, uint32_t w, uint32_t h)
+{
+	double sa[SUN_BINS] = {0}, pw[SUN_BINS] = {0}, sa_all = 0.0, pw_all = 0.0;
+	float max_lum = 0.0f;
+	for (size_t i = 0; i < (size_t)w * h; i++)
+		max_lum = fmaxf(max_lum, v3_lum(v3(pix[3 * i], pix[3 * i + 1], pix[3 * i + 2])));
+	if (!(max_lum > 0.0f))
+		return 0.0f;
+	double top = log2(max_lum);
+	for (uint32_t y = 0; y < h; y++) {
+		double sin_theta = sin(AJAR_PI * ((double)y + 0.5) / h);
+		sa_all += sin_theta * w;
+		for (uint32_t x = 0; x < w; x++) {
+			const float *p = pix + 3 * ((size_t)y * w + x);
+			float lum = v3_lum(v3(p[0], p[1], p[2]));
+			if (!(lum > 0.0f))
+				continue;
+			double b = (top - log2(lum)) * 16.0;
+			int k = b < SUN_BINS - 1 ? (int)b : SUN_BINS - 1;
+			sa[k] += sin_theta;
+			pw[k] += lum * sin_theta;
+			pw_all += lum * sin_theta;
+		}
+	}
+	double need = SUN_SOLID_ANGLE_SHARE * sa_all, got = 0.0;
+	for (int k = 0; k < SUN_BINS && need > 0.0; k++) {
+		double take = sa[k] < need ? 1.0 : need / sa[k];
+		got += take * pw[k];
+		need -= take * sa[k];
+	}
+	return pw_all > 0.0 ? (float)(got / pw_all) : 0.0f;
+}
+
 static ajar_status build_env_image(const Scene *s, LightTables *out, double *avg_lum)
 {
 	uint32_t w = s->env_width, h = s->env_height;
@@ -197,6 +240,7 @@ static ajar_status build_env_image(const Scene *s, LightTables *out, double *avg
 	cdf_build(out->env + ENV_MARGINAL(w, h), rows, h, 1);
 	/* Each texel spans (2 pi / w) x (pi / h) in (phi, theta). */
 	*avg_lum = sum * (2.0 * AJAR_PI / w) * (AJAR_PI / h) / (4.0 * AJAR_PI);
+	out->env_sun_share = env_sun_share(pix, w, h);
 	free(wt);
 	free(rows);
 	return AJAR_OK;

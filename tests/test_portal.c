@@ -1100,6 +1100,68 @@ static void test_portal_set(void **state)
 	unsetenv("AJAR_PORTAL_SET");
 }
 
+/* The sun's share of a sky image's power (src/lights.c, env_sun_share)
+ * and what portal makes of it (src/prepare.c, SKY_SUN_SHARE): a uniform
+ * sky with a disc 5000 times as bright covering 0.008% of the sphere gets
+ * the share the texels' solid angles give exactly; the shipped skies their
+ * measured shares; light subpaths from the sky (through the portals) only
+ * with a sun: window-room-forest and a strong synthetic sun yes,
+ * window-room-sunset and a sky without a sun no (the sky set's rate 0.3). */
+static void test_sky_sun_share(void **state)
+{
+	(void)state;
+	enum { W = 256, H = 128 };
+	float *rgb = malloc(sizeof(float) * 3 * W * H);
+	assert_non_null(rgb);
+	double cos_r = cos(0.02), disc = 0.0, all = 0.0;
+	for (int y = 0; y < H; y++)
+		for (int x = 0; x < W; x++) {
+			double phi = 2.0 * M_PI * ((x + 0.5) / W - 0.5), theta = M_PI * (y + 0.5) / H;
+			double dy = cos(theta), dz = -sin(theta) * cos(phi), sa = sin(theta);
+			int in = dy * 0.6 + dz * 0.8 > cos_r; /* the sun toward (0, 0.6, 0.8) */
+			for (int c = 0; c < 3; c++)
+				rgb[3 * (y * W + x) + c] = in ? 5000.0f : 1.0f;
+			disc += in ? sa : 0.0;
+			all += sa;
+		}
+	assert_true(disc > 0.0 && disc < 1e-3 * all);
+	ajar_scene *s;
+	if (ajar_scene_load(SCENE("window-room/window-room.gltf"), &s) != AJAR_OK)
+		fail_msg("%s", ajar_last_error());
+	assert_int_equal(scene_set_env_image(s, W, H, rgb, 1.0f), AJAR_OK);
+	HostScene h;
+	host_scene_open(&h, NULL, s, 8, 8, INTEGRATOR_PORTAL, 8);
+	double want = (5000.0 * disc + (1e-3 * all - disc)) / (all + 4999.0 * disc);
+	printf("  disc of %.3g%% of the sphere: share %.5f, expected %.5f\n", 100.0 * disc / all,
+	       h.data.lights.env_sun_share, want);
+	assert_float_equal(h.data.lights.env_sun_share, want, 1e-4 * want);
+	assert_true(h.data.params->light_paths);
+	host_scene_close(&h);
+
+	struct {
+		const char *scene;
+		Scene *sky;
+		float lo, hi;
+		int light_paths;
+	} cases[] = {
+		{SCENE("window-room-forest/window-room-forest.gltf"), NULL, 0.10f, 0.16f, 1},
+		{SCENE("window-room-sunset/window-room-sunset.gltf"), NULL, 0.02f, 0.045f, 0},
+		{NULL, sun_room(0, 3000.0f), 0.25f, 1.0f, 1},
+		{NULL, sun_room(0, 0.5f), 0.0f, 0.01f, 0}, /* the "sun" no brighter than the sky */
+	};
+	for (unsigned i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+		host_scene_open(&h, cases[i].scene, cases[i].sky, 8, 8, INTEGRATOR_PORTAL, 8);
+		float share = h.data.lights.env_sun_share;
+		printf("  case %u: sun share %.4f, light subpaths %d, rate %g\n", i, share, h.data.params->light_paths,
+		       h.data.params->portal_rate);
+		if (!(share >= cases[i].lo && share <= cases[i].hi))
+			fail_msg("case %u: sun share %g outside [%g, %g]", i, share, cases[i].lo, cases[i].hi);
+		assert_int_equal(h.data.params->light_paths, cases[i].light_paths);
+		assert_float_equal(h.data.params->portal_rate, cases[i].light_paths ? 0.1f : 0.3f, 0.0f);
+		host_scene_close(&h);
+	}
+}
+
 /* The rate of intermediate subpaths: 0.1 where a constant sky is the only
  * light and where a sky image is (with its light subpaths), 0.3 under a
  * sky image (sampled through planar portals) without light subpaths, 1
@@ -1225,6 +1287,7 @@ int main(void)
 		cmocka_unit_test(test_groups_unbiased_punctual),
 		cmocka_unit_test(test_portal_set),
 		cmocka_unit_test(test_portal_rate),
+		cmocka_unit_test(test_sky_sun_share),
 		cmocka_unit_test(test_mis_punctual),
 		cmocka_unit_test(test_portal_matches_pt_punctual),
 	};
