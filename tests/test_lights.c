@@ -1036,6 +1036,26 @@ static void check_sky_uv(Lit *l, int k, V3 x, const char *name)
 	assert_true(p > ALPHA);
 }
 
+/* The light scene under a sky with a sun seen from x through the window
+ * (add_window_portals), its portals' sky sides set as seen from x (the
+ * fifth faces the other way, the sixth has no sky): 4 planes. Returns the
+ * sun's direction. */
+static V3 window_sun_scene(Lit *l, V3 x)
+{
+	build_light_scene(l);
+	V3 sun = v3_norm(v3(0.15f, 0.5f, 1.0f));
+	assert_int_equal(scene_set_env_image(l->s, 128, 64, test_sun_sky(128, 64, sun.x, sun.y, sun.z, 0.06f, 300.0f), 0.05f), AJAR_OK);
+	add_window_portals(l);
+	for (int j = 0; j < 5; j++) {
+		PortalTri *pt = &l->s->portals[j];
+		float dn = v3_dot(v3_sub(x, pt->p0), pt->n);
+		pt->env_side = j == 4 ? (dn > 0 ? 1 : -1) : (dn > 0 ? -1 : 1);
+	}
+	l->s->portals[5].env_side = 0;
+	assert_int_equal(lit_planes(l), 4);
+	return sun;
+}
+
 /* The portals of test_light_sample_env_portals (a window quad in front of
  * x, an overlapping triangle behind it, a tiny far one in the same plane
  * but apart, one x sees from its sky side, one without sky) and a sky
@@ -1048,18 +1068,8 @@ static void test_light_sample_sky_portals(void **state)
 {
 	rng_state = 31;
 	Lit l;
-	build_light_scene(&l);
-	V3 sun = v3_norm(v3(0.15f, 0.5f, 1.0f)); /* seen from x through the window */
-	assert_int_equal(scene_set_env_image(l.s, 128, 64, test_sun_sky(128, 64, sun.x, sun.y, sun.z, 0.06f, 300.0f), 0.05f), AJAR_OK);
-	add_window_portals(&l);
 	V3 x = v3(0.1f, 0.2f, 0.05f);
-	for (int j = 0; j < 5; j++) {
-		PortalTri *pt = &l.s->portals[j];
-		float dn = v3_dot(v3_sub(x, pt->p0), pt->n);
-		pt->env_side = j == 4 ? (dn > 0 ? 1 : -1) : (dn > 0 ? -1 : 1);
-	}
-	l.s->portals[5].env_side = 0;
-	assert_int_equal(lit_planes(&l), 4);
+	V3 sun = window_sun_scene(&l, x);
 	SkyRect r;
 	int seen = 0;
 	for (int k = 0; k < 4; k++)
@@ -1136,18 +1146,7 @@ static void test_sky_pdf_views(void **state)
 {
 	rng_state = 41;
 	Lit l;
-	build_light_scene(&l);
-	V3 sun = v3_norm(v3(0.15f, 0.5f, 1.0f));
-	assert_int_equal(scene_set_env_image(l.s, 128, 64, test_sun_sky(128, 64, sun.x, sun.y, sun.z, 0.06f, 300.0f), 0.05f), AJAR_OK);
-	add_window_portals(&l);
-	V3 x0 = v3(0.1f, 0.2f, 0.05f);
-	for (int j = 0; j < 5; j++) {
-		PortalTri *pt = &l.s->portals[j];
-		float dn = v3_dot(v3_sub(x0, pt->p0), pt->n);
-		pt->env_side = j == 4 ? (dn > 0 ? 1 : -1) : (dn > 0 ? -1 : 1);
-	}
-	l.s->portals[5].env_side = 0;
-	assert_int_equal(lit_planes(&l), 4);
+	window_sun_scene(&l, v3(0.1f, 0.2f, 0.05f));
 	enum { NX = 7 };
 	V3 xs[NX];
 	for (int i = 0; i < NX; i++)
