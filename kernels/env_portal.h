@@ -33,9 +33,9 @@
 /* The same share where the planes' sky tables sample an image
  * (sky_nee_sample): 0.9 lowered pt's variance per sample by 7% and 10% on
  * window-room-forest and -sunset and left living-room-forest's within 1%
- * (0.95: 11%, 13%, and 3% worse; kernels/lights.md, "Sky images through
- * portals"). The rest still finds a sun through an opening without a
- * portal. */
+ * (0.95: 11%, 13%, and 3% worse; kernels/sky_measurements.md,
+ * "Measurements"). The rest still finds a sun through an opening without
+ * a portal. */
 #ifndef PORTAL_SKY_NEE_MIX
 #define PORTAL_SKY_NEE_MIX 0.9f
 #endif
@@ -506,7 +506,7 @@ INLINE int sky_plane_of(const SceneView *sc, GLOBAL const PortalTri *pt)
 /* The plane whose table guides intermediate subpaths from pt, or -1 (then
  * the environment's importance, folded). The host sets PortalPlane.guide
  * (src/portal_sky.c: off unless AJAR_PORTAL_GUIDE_SKY=1, as measured in
- * kernels/lights.md, "Sky images through portals"). */
+ * kernels/sky_measurements.md, "Measurements"). */
 INLINE int portal_guide_plane(const SceneView *sc, GLOBAL const PortalTri *pt)
 {
 	int k = sky_plane_of(sc, pt);

@@ -228,7 +228,7 @@ INLINE V3 punctual_dir_sample(GLOBAL const PunctualLight *l, float u1, float u2)
  * |n_k.w| (each crossed triangle j contributes A_j |n_j.w| / S for its
  * choice times 1 / (A_j |n_j.w|) per perpendicular area). The same
  * function at sampling and in every MIS record (densities.h,
- * bdpt_emission_pdf; kernels/lights.md, "Sky light subpaths through the
+ * bdpt_emission_pdf; kernels/sky_measurements.md, "Sky light subpaths through the
  * portals"). */
 #define SUN_DISK_SHARE 0.1f
 
@@ -236,7 +236,7 @@ INLINE V3 punctual_dir_sample(GLOBAL const PunctualLight *l, float u1, float u2)
  * portals: a sky image's (its sun finds the way in); a constant sky keeps
  * the disk, where its next-event estimation through the portals already
  * takes the direct light and the light subpaths that come in only added
- * variance and time (kernels/lights.md, "Sky light subpaths through the
+ * variance and time (kernels/sky_measurements.md, "Sky light subpaths through the
  * portals"). */
 INLINE int env_lines_through_portals(const SceneView *sc)
 {

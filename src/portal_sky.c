@@ -180,8 +180,8 @@ ajar_status portal_sky_build(const SceneView *sc, const PortalTri *portals, uint
 	/* Whether the planes' tables also guide the <- halves of intermediate
 	 * subpaths (kernels/env_portal.h, portal_guide_plane): measured worse
 	 * per sample than the environment's importance folded onto the sky
-	 * side on all three sky scenes (kernels/lights.md, "Sky images through
-	 * portals"), so only on request, for experiments. */
+	 * side on all three sky scenes (kernels/sky_measurements.md,
+	 * "Measurements"), so only on request, for experiments. */
 	const char *g_env = getenv("AJAR_PORTAL_GUIDE_SKY");
 	int guide = g_env && strcmp(g_env, "1") == 0;
 	size_t np = 0;

@@ -216,7 +216,7 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	 * line_sample): measured better per CPU second on window-room-forest
 	 * and living-room-forest, whose sky has a compact sun, and worse on
 	 * window-room-sunset (a low, dim sun) and under that forest sky with
-	 * its sun clipped (kernels/lights.md, "Sky light subpaths through the
+	 * its sun clipped (kernels/sky_measurements.md, "Sky light subpaths through the
 	 * portals"), so on for sky images whose brightest 0.1% of solid angle
 	 * carries at least SKY_SUN_SHARE of their power (src/lights.c,
 	 * env_sun_share: 0.13, 0.03 and 0.01 there). */

@@ -38,7 +38,7 @@ typedef struct {
 /* The sun's share of a sky image's power (src/lights.c, env_sun_share)
  * from which portal traces the sky's light subpaths (through the portals):
  * between window-room-sunset's 0.03, where they lost, and
- * window-room-forest's 0.13, where they won (kernels/lights.md). */
+ * window-room-forest's 0.13, where they won (kernels/sky_measurements.md). */
 #define SKY_SUN_SHARE 0.06f
 
 ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *out);
