@@ -101,6 +101,33 @@ static ajar_status setup_camera(const Scene *s, const PrepareOptions *o, Camera 
 }
 
 /* A rate in (0, 1] from the environment variable `name`, else `dflt`. */
+/* Whether a point or spot light lies behind a portal as the camera sees
+ * it: on the other side of some portal triangle's plane, within its range
+ * of the triangle. Its light then reaches the camera's side through the
+ * opening, as an emitter's in door-ajar does, and the intermediate
+ * subpaths carry it (kernels/sky_measurements.md, "Where light subpaths
+ * come in, portal is bdpt"). A plane test, not a visibility test: it
+ * only chooses the strategies, never the image's expectation. */
+static int lamp_behind_portal(const SceneData *d, V3 camera)
+{
+	for (uint32_t i = 0; i < d->lights.nlights; i++) {
+		const PunctualLight *l = &d->lights.lights[i];
+		if (l->type == LIGHT_DIRECTIONAL)
+			continue;
+		for (size_t k = 0; k < d->n_portals; k++) {
+			const PortalTri *t = &d->portals[k];
+			float side_cam = v3_dot(t->n, v3_sub(camera, t->p0)), side_l = v3_dot(t->n, v3_sub(l->pos, t->p0));
+			if (!(side_cam * side_l < 0.0f))
+				continue;
+			float near = fminf(v3_len(v3_sub(l->pos, t->p0)),
+					   fminf(v3_len(v3_sub(l->pos, t->p1)), v3_len(v3_sub(l->pos, t->p2))));
+			if (l->range <= 0.0f || fabsf(side_l) <= l->range || near <= l->range)
+				return 1;
+		}
+	}
+	return 0;
+}
+
 static float env_rate(const char *name, float dflt)
 {
 	const char *v = getenv(name);
@@ -233,17 +260,23 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	 * overrides it for experiments, e.g. "32,32,32,33,1" for all of them. */
 	/* Punctual lights without emitters (kernels/punctual.md, "Punctual
 	 * lights"): their light subpaths are kept (a sun's start on the
-	 * portals and find its patch), but the intermediate subpaths, which
+	 * portals and find its patch), and the intermediate subpaths, which
 	 * reach a delta light only by next-event estimation, carry the sky, so
-	 * the sky's set and rate: on window-room-sun the long halves at rate 1
-	 * cost 3x in time for no less noise. A sky image's light subpaths
-	 * take the same set and rate. */
-	int long_set = p->light_paths && !(p->num_emitters == 0 && (p->num_lights > 0 || sky_image_lines));
+	 * the sky's set and rate (a sky image's light subpaths take the same):
+	 * on window-room-sun the long halves at rate 1 cost 3x in time for no
+	 * less noise, on window-room-lamp (a lamp on the camera's side) 3.5x
+	 * bdpt's inefficiency. A point or spot light behind a portal counts as
+	 * an emitter: in door-ajar with a point lamp for its emitter the long
+	 * halves at rate 1 did 1.5x better than bdpt and 1.25x better than the
+	 * sky's set. */
+	int long_set = p->light_paths && (p->integrator != INTEGRATOR_PORTAL || p->num_emitters > 0 ||
+					  lamp_behind_portal(d, p->camera.pos));
 	p->portal_s_max = 1;
 	p->portal_sp_max = long_set ? AJAR_BIDIR_MAX_DEPTH : 2;
 	p->portal_tp_max = long_set ? AJAR_BIDIR_MAX_DEPTH : 1;
 	p->portal_t_max = long_set ? 1 << 20 : 3; /* any t, or 3 */
 	const char *set = getenv("AJAR_PORTAL_SET");
+	int set_given = 0;
 	if (set) {
 		int v[5] = {p->portal_s_max, p->portal_sp_max, p->portal_tp_max, p->portal_t_max, p->light_paths};
 		int nset = sscanf(set, "%d,%d,%d,%d,%d", &v[0], &v[1], &v[2], &v[3], &v[4]);
@@ -253,12 +286,26 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 			p->portal_tp_max = v[2];
 			p->portal_t_max = v[3];
 			p->light_paths = v[4] != 0;
+			set_given = 1;
 		} else {
 			log_msg(AJAR_LOG_WARNING, "AJAR_PORTAL_SET='%s' is not s,s',t'[,t[,light paths]]; ignored", set);
 		}
 	}
 	if (!p->light_paths && p->portal_s_max > 1)
 		p->portal_s_max = 1; /* larger s needs light subpaths */
+	/* Where light subpaths bring the light in through the openings (a sky
+	 * image with a sun, punctual lights without emitters), the sky's
+	 * intermediate strategies carry under 1.5% of the image, and the union
+	 * weights of every path that crosses a portal cost 1.1-1.3x bdpt's time
+	 * per sample for the same variance per sample: portal renders as bdpt
+	 * there, sample for sample (kernels/sky_measurements.md, "Where light
+	 * subpaths come in, portal is bdpt"). An explicit AJAR_PORTAL_SET keeps
+	 * the intermediate subpaths. */
+	if (p->integrator == INTEGRATOR_PORTAL && p->light_paths && !long_set && !set_given) {
+		p->integrator = INTEGRATOR_BDPT;
+		log_msg(AJAR_LOG_INFO, "%s: light subpaths bring the light in through the portals; portal renders as bdpt",
+			s->source ? s->source : "scene");
+	}
 	p->emitter_power = d->lights.emitter_power;
 	p->env_power = d->lights.env_power;
 	/* What lies behind each side of the portals, with the kernels' own

@@ -440,6 +440,19 @@ static Scene *punctual_scene(const char *path, const float dir[3], int inside, c
 static const float sun_in[3] = {0.3f, -0.5f, 0.8f}; /* through window-room's window */
 static const float wr_p[3] = {1.0f, 2.2f, 2.0f}, wr_q[3] = {3.0f, 2.5f, 1.5f};
 
+/* Opens a scene where portal renders as bdpt by default (light subpaths
+ * bring the light in: a sky image with a sun, punctual lights on the
+ * camera's side; src/prepare.c) with the sky's set named, 1,2,1,3,1, the
+ * default there before: an explicit AJAR_PORTAL_SET keeps the
+ * intermediate strategies, which these tests check. */
+static void open_portal_kept(HostScene *h, const char *path, Scene *built, uint32_t w, uint32_t hgt, int depth)
+{
+	setenv("AJAR_PORTAL_SET", "1,2,1,3,1", 1);
+	host_scene_open(h, path, built, w, hgt, INTEGRATOR_PORTAL, depth);
+	unsetenv("AJAR_PORTAL_SET");
+	assert_int_equal(h->data.params->integrator, INTEGRATOR_PORTAL);
+}
+
 /* Scenes lit only by the sky (no light subpaths, bdpt strategies s <= 1,
  * short eye parts, records within a horizon): the constant-sky window room
  * and window-room-forest (a sky image with a sun, portal planes), with the
@@ -558,7 +571,10 @@ static void test_bdpt_weight_shortcut(void **state)
 	for (int i = 0; i < 4; i++) {
 		for (int heur = 0; heur < 2; heur++) {
 			HostScene h;
-			host_scene_open(&h, scenes[i], NULL, 24, 24, INTEGRATOR_PORTAL, 8);
+			if (i < 3) /* the sun lamp, the lamp and the sky image: bdpt by default */
+				open_portal_kept(&h, scenes[i], NULL, 24, 24, 8);
+			else
+				host_scene_open(&h, scenes[i], NULL, 24, 24, INTEGRATOR_PORTAL, 8);
 			h.data.params->mis = heur;
 			int fast = 0, full = 0;
 			check_bdpt_weights(&h, 150, &fast, &full);
@@ -582,7 +598,7 @@ static void test_bdpt_weight_shortcut(void **state)
 static void test_mis_punctual(void **state)
 {
 	HostScene h;
-	host_scene_open(&h, NULL, sun_window_room(1, 1), 24, 24, INTEGRATOR_PORTAL, 8);
+	open_portal_kept(&h, NULL, sun_window_room(1, 1), 24, 24, 8);
 	assert_true(h.data.params->light_paths);
 	assert_true(check_scene_mis(&h, 200).portal_paths > 100);
 	use_all_portal_strategies(&h);
@@ -602,7 +618,7 @@ static void test_portal_matches_pt_punctual(void **state)
 {
 	HostScene hq, hp;
 	Estimate q, p;
-	host_scene_open(&hq, NULL, sun_window_room(1, 0), 12, 12, INTEGRATOR_PORTAL, 6);
+	open_portal_kept(&hq, NULL, sun_window_room(1, 0), 12, 12, 6);
 	host_scene_open(&hp, NULL, sun_window_room(1, 0), 12, 12, INTEGRATOR_PT, 6);
 	host_batch_estimate(&hq, 4, -1, 32, 2000, &q);
 	host_batch_estimate(&hp, 16, -1, 32, 2000, &p);
@@ -698,7 +714,7 @@ static Scene *sun_room(int low, float sun_l)
 static void test_mis_window_room_sun(void **state)
 {
 	HostScene h;
-	host_scene_open(&h, NULL, sun_room(0, 3000.0f), 24, 24, INTEGRATOR_PORTAL, 8);
+	open_portal_kept(&h, NULL, sun_room(0, 3000.0f), 24, 24, 8);
 	assert_true(h.data.params->num_portal_planes == 1);
 	assert_true(check_scene_mis(&h, 200).portal_paths > 100); /* the default set */
 	use_all_portal_strategies(&h);
@@ -796,7 +812,7 @@ static void test_groups_unbiased_window_room_sun(void **state)
 {
 	for (int low = 0; low < 2; low++) {
 		HostScene hp, ht;
-		host_scene_open(&hp, NULL, sun_room(low, 300.0f), 8, 8, INTEGRATOR_PORTAL, 3);
+		open_portal_kept(&hp, NULL, sun_room(low, 300.0f), 8, 8, 3);
 		host_scene_open(&ht, NULL, sun_room(low, 300.0f), 8, 8, INTEGRATOR_PT, 3);
 		assert_true(check_groups(&hp, &ht, 3, 4 * GROUP_SPP, 2 * GROUP_SPP) >= 3);
 		host_scene_close(&hp);
@@ -1100,6 +1116,72 @@ static void test_portal_set(void **state)
 	unsetenv("AJAR_PORTAL_SET");
 }
 
+/* A lamp at `pos` (range 0: unlimited) with window-room's constant sky. */
+static Scene *window_room_lamp_at(float x, float y, float z, float range)
+{
+	ajar_scene *s;
+	if (ajar_scene_load(SCENE("window-room/window-room.gltf"), &s) != AJAR_OK)
+		fail_msg("%s", ajar_last_error());
+	ajar_light l;
+	ajar_light_default(&l);
+	l.position[0] = x;
+	l.position[1] = y;
+	l.position[2] = z;
+	l.intensity = 683.0f;
+	l.range = range;
+	assert_int_equal(ajar_scene_add_light(s, &l), AJAR_OK);
+	return s;
+}
+
+/* Where light subpaths bring the light in through the portals (a sky
+ * image with a sun, punctual lights none of which lies behind a portal),
+ * portal renders as bdpt; a point light behind a portal counts as an
+ * emitter (the long set at rate 1); constant skies, window-room-sunset's
+ * sky (no light subpaths) and emitters keep their intermediate subpaths,
+ * and so does an explicit AJAR_PORTAL_SET (src/prepare.c). */
+static void test_portal_as_bdpt(void **state)
+{
+	(void)state;
+	const struct {
+		const char *scene;
+		Scene *built;
+		int integrator, long_set;
+	} cases[] = {
+		{"window-room/window-room.gltf", NULL, INTEGRATOR_PORTAL, 0},
+		{"window-room-sunset/window-room-sunset.gltf", NULL, INTEGRATOR_PORTAL, 0},
+		{"door-ajar/door-ajar.gltf", NULL, INTEGRATOR_PORTAL, 1},
+		{"window-room-forest/window-room-forest.gltf", NULL, INTEGRATOR_BDPT, 0},
+		{"window-room-sun/window-room-sun.gltf", NULL, INTEGRATOR_BDPT, 0},
+		{"window-room-lamp/window-room-lamp.gltf", NULL, INTEGRATOR_BDPT, 0},
+		{NULL, sun_window_room(1, 1), INTEGRATOR_BDPT, 0},     /* sun, lamp and spot in the room */
+		{NULL, door_ajar_lamps(), INTEGRATOR_PORTAL, 1},      /* a point light behind the door */
+		{NULL, window_room_lamp_at(2.0f, 1.4f, -1.0f, 0.0f), INTEGRATOR_PORTAL, 1}, /* outside the window */
+		{NULL, window_room_lamp_at(2.0f, 1.4f, -1.0f, 0.5f), INTEGRATOR_BDPT, 0},   /* its range ends short of it */
+		{NULL, window_room_lamp_at(2.0f, 1.4f, 2.0f, 0.0f), INTEGRATOR_BDPT, 0},    /* inside */
+	};
+	for (unsigned i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+		char path[256];
+		if (cases[i].scene)
+			snprintf(path, sizeof path, SCENE("%s"), cases[i].scene);
+		HostScene h;
+		host_scene_open(&h, cases[i].scene ? path : NULL, cases[i].built, 8, 8, INTEGRATOR_PORTAL, 8);
+		const Params *p = h.data.params;
+		if (p->integrator != cases[i].integrator || (p->portal_sp_max == AJAR_BIDIR_MAX_DEPTH) != cases[i].long_set)
+			fail_msg("case %u (%s): integrator %d, s' <= %d, expected %d and %s", i,
+				 cases[i].scene ? cases[i].scene : "built", p->integrator, p->portal_sp_max,
+				 cases[i].integrator, cases[i].long_set ? "the long set" : "the sky's");
+		if (cases[i].long_set)
+			assert_float_equal(p->portal_rate, 1.0f, 0.0f);
+		host_scene_close(&h);
+	}
+	setenv("AJAR_PORTAL_SET", "1,2,1,3,1", 1);
+	HostScene h;
+	host_scene_open(&h, SCENE("window-room-forest/window-room-forest.gltf"), NULL, 8, 8, INTEGRATOR_PORTAL, 8);
+	assert_int_equal(h.data.params->integrator, INTEGRATOR_PORTAL);
+	host_scene_close(&h);
+	unsetenv("AJAR_PORTAL_SET");
+}
+
 /* The sun's share of a sky image's power (src/lights.c, env_sun_share)
  * and what portal makes of it (src/prepare.c, SKY_SUN_SHARE): a uniform
  * sky with a disc 5000 times as bright covering 0.008% of the sphere gets
@@ -1286,6 +1368,7 @@ int main(void)
 		cmocka_unit_test(test_punctual_choices),
 		cmocka_unit_test(test_groups_unbiased_punctual),
 		cmocka_unit_test(test_portal_set),
+		cmocka_unit_test(test_portal_as_bdpt),
 		cmocka_unit_test(test_portal_rate),
 		cmocka_unit_test(test_sky_sun_share),
 		cmocka_unit_test(test_mis_punctual),
