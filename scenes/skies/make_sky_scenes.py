@@ -6,8 +6,9 @@ in a folder of its own with copies of the room's .bin and textures and of the
 sky (Ajar reads no file outside a scene's folder unless told to), the sky turned
 about +Y so that the sun's rays pass through a window onto a chosen surface,
 or, for window-room-sun, a KHR_lights_punctual directional light as the sun
-under a constant sky, and for window-room-lamp a point lamp in the room under
-the room's own sky. Python 3 standard library only; the output is
+under a constant sky, for window-room-lamp a point lamp in the room under
+the room's own sky, and for door-ajar-lamp a point lamp for door-ajar's
+emitter, behind the door. Python 3 standard library only; the output is
 byte-for-byte the same on every run.
 
     python3 make_sky_scenes.py          # writes ../<variant>/ (glTF and copies)
@@ -103,6 +104,12 @@ VARIANTS = {
 	# an opening.
 	"window-room-lamp": {"room": "window-room",
 			     "point": {"position": [0.8, 2.2, 2.2], "intensity": 1000.0, "color": [1.0, 0.75, 0.5]}},
+	# door-ajar with a point lamp for its ceiling emitter (turned off), 0.14 m
+	# below where the emitter was (x 3, z 5, the far room): 2134 cd of white
+	# (3.125 W/sr, the emitter's 39.3 W spread over the sphere), so the
+	# camera's room is lit only through the gap of the door, by a lamp.
+	"door-ajar-lamp": {"room": "door-ajar", "emitter_off": "light",
+			   "point": {"position": [3.0, 2.45, 5.0], "intensity": 2134.0, "color": [1.0, 1.0, 1.0]}},
 }
 
 
@@ -131,6 +138,12 @@ def make(name, spec):
 		extras["environment"] = {"image": "%s.exr" % spec["sky"], "strength": 1.0,
 					 "rotation": rotation_for(spec["sky"], spec["phi"])}
 	elif "point" in spec:
+		for m in g["materials"]:
+			if m.get("name") == spec.get("emitter_off"):
+				m["emissiveFactor"] = [0.0, 0.0, 0.0]
+				m.get("extensions", {}).pop("KHR_materials_emissive_strength", None)
+		if not any("KHR_materials_emissive_strength" in m.get("extensions", {}) for m in g["materials"]):
+			g["extensionsUsed"] = [e for e in g.get("extensionsUsed", []) if e != "KHR_materials_emissive_strength"]
 		lamp = spec["point"]
 		g.setdefault("extensionsUsed", []).append("KHR_lights_punctual")
 		g.setdefault("extensions", {})["KHR_lights_punctual"] = {"lights": [{
@@ -156,7 +169,7 @@ def make(name, spec):
 	with open(os.path.join(out, name + ".gltf"), "w") as f:
 		json.dump(g, f, indent=1, sort_keys=False)
 		f.write("\n")
-	return extras["environment"]
+	return extras.get("environment")
 
 
 def main():
