@@ -169,6 +169,12 @@ static void test_window_room_sun(void **state)
 	unsetenv("AJAR_PORTAL_SET");
 }
 static void test_door_ajar(void **state) { compare(SCENE("door-ajar/door-ajar.gltf"), 24, 24, 512, 128); }
+/* door-ajar with a point lamp for its emitter: portal's long halves at
+ * rate 1 (a lamp behind a portal counts as an emitter, src/prepare.c). */
+static void test_door_ajar_lamp(void **state)
+{
+	compare(SCENE("door-ajar-lamp/door-ajar-lamp.gltf"), 24, 24, 512, 128);
+}
 
 /* The Cornell box lit by its emitter, the sun through its open side, a
  * point light and a spot (no portals: the sun's light subpaths start on
@@ -294,6 +300,7 @@ int main(void)
 		cmocka_unit_test(test_living_room),
 		cmocka_unit_test(test_bathroom),
 		cmocka_unit_test(test_door_ajar),
+		cmocka_unit_test(test_door_ajar_lamp),
 		cmocka_unit_test(test_cornell_punctual),
 		cmocka_unit_test(test_window_room_punctual),
 		cmocka_unit_test(test_normal_alpha),
