@@ -36,13 +36,27 @@
 #include "path_mis.h"
 #include "strategies.h"
 
+/* pn_0 of one light subpath's origin for the two sides of its first
+ * vertex's normal: bdpt_nee_pdf reads a path's x_2 only for the side of
+ * x_1 it lies on (vertex_nee_normal), so every connection (s >= 2) of the
+ * light subpath takes one of these two; a sky image's costs a lookup
+ * through the portals' tables, once per side instead of once per
+ * connection. bdpt_strategies clears it (have = 0) per light subpath. */
+typedef struct {
+	float pn[2];
+	int have; /* bit i: pn[i] is set */
+} BdptPnCache;
+
 /* The MIS records of the path made of light vertices l[0..s-1] and eye
  * vertices e[t-1..0], with the densities next to the connection
  * recomputed: pr of l[s-1] and l[s-2], pf of e[t-1] and e[t-2]. With
  * `nee_stored` (the portal integrator, bdpt_weight) a next-event light
  * vertex (s = 1, t >= 2) brings its pn_0 and pr_0 (bdpt_nee), as
- * path_records_part takes them, instead of a second sky lookup. */
-INLINE int bdpt_mis_path(const SceneView *sc, VCRef l, int s, VCRef e, int t, MisVertex *mv, int nee_stored)
+ * path_records_part takes them, instead of a second sky lookup. With `pc`
+ * (bdpt_strategies) pn_0 comes from the cache of this light subpath, and
+ * a next-event sky vertex's from its sample (the same bits). */
+INLINE int bdpt_mis_path_cached(const SceneView *sc, VCRef l, int s, VCRef e, int t, MisVertex *mv, int nee_stored,
+				BdptPnCache *pc)
 {
 	GLOBAL const Camera *cam = &sc->params->camera;
 	int k = s + t;
@@ -80,6 +94,19 @@ INLINE int bdpt_mis_path(const SceneView *sc, VCRef l, int s, VCRef e, int t, Mi
 	if (nee_stored) {
 		mv[0].pf = bdpt_origin_pdf(sc, x0);
 		mv[0].pn = x0->pf;
+	} else if (pc && s == 1 && t >= 2 && x0->type == VERTEX_ENV) {
+		/* The sample's own density (bdpt_light_vertex), the same bits as
+		 * bdpt_nee_pdf's (test_lights, test_sky_pdf_views). */
+		mv[0].pf = bdpt_origin_pdf(sc, x0);
+		mv[0].pn = x0->pf;
+	} else if (pc && s >= 2) { /* k >= 3 */
+		int side = v3_dot(x1->ns, vertex_infinite(x2) ? x2->p : v3_sub(x2->p, x1->p)) < 0.0f;
+		mv[0].pf = bdpt_origin_pdf(sc, x0);
+		if (!(pc->have >> side & 1)) {
+			pc->pn[side] = bdpt_nee_pdf(sc, x0, x1, x2);
+			pc->have |= 1 << side;
+		}
+		mv[0].pn = pc->pn[side];
 	} else {
 		bdpt_light_records(sc, mv, x0, x1, x2, k);
 	}
@@ -115,6 +142,11 @@ INLINE int bdpt_mis_path(const SceneView *sc, VCRef l, int s, VCRef e, int t, Mi
 	return k;
 }
 
+INLINE int bdpt_mis_path(const SceneView *sc, VCRef l, int s, VCRef e, int t, MisVertex *mv, int nee_stored)
+{
+	return bdpt_mis_path_cached(sc, l, s, e, t, mv, nee_stored, 0);
+}
+
 /* The weight of bdpt strategy (s, t): over the bdpt strategies alone, or,
  * in the portal integrator, over both families (path_mis.h). There, where
  * no edge that an intermediate strategy in use pairs on crosses a portal
@@ -130,7 +162,7 @@ INLINE int bdpt_mis_path(const SceneView *sc, VCRef l, int s, VCRef e, int t, Mi
  * from the lamp takes the shortcut; on the sun scenes every path of 6 or
  * more vertices, whose first edge, through the window, is then no
  * pairing edge (lo = k - 5 with the sky's set, mis_pair_edges). */
-CALLED float bdpt_weight(const SceneView *sc, VCRef l, int s, VCRef e, int t)
+CALLED float bdpt_weight_cached(const SceneView *sc, VCRef l, int s, VCRef e, int t, BdptPnCache *pc)
 {
 	MisVertex mv[2 * SUBPATH_MAX];
 	if (PARAMS_INTEGRATOR(sc->params) == INTEGRATOR_PORTAL) {
@@ -143,11 +175,16 @@ CALLED float bdpt_weight(const SceneView *sc, VCRef l, int s, VCRef e, int t)
 			return path_union_weight(sc, &P, cur);
 		if (!set.light_paths)
 			return path_unpaired_weight(sc, &P, set, n, cur);
-		int k = bdpt_mis_path(sc, l, s, e, t, mv, 1);
+		int k = bdpt_mis_path_cached(sc, l, s, e, t, mv, 1, pc);
 		return mis_path_weight(mv, k, s, sc->params->mis);
 	}
-	int k = bdpt_mis_path(sc, l, s, e, t, mv, 0);
+	int k = bdpt_mis_path_cached(sc, l, s, e, t, mv, 0, pc);
 	return mis_path_weight(mv, k, s, sc->params->mis);
+}
+
+INLINE float bdpt_weight(const SceneView *sc, VCRef l, int s, VCRef e, int t)
+{
+	return bdpt_weight_cached(sc, l, s, e, t, 0);
 }
 
 /* Unoccluded segment between two vertices (either may be the camera,
@@ -404,14 +441,15 @@ INLINE V3 bdpt_to_camera(const SceneView *sc, const PathVertex *y, int origin, c
 }
 
 /* Light vertex s - 1 seen by the camera: splats its weighted contribution. */
-CALLED void bdpt_light_to_camera(const SceneView *sc, VCRef l, int s, VCRef cam_v, BdptFilm *out, Rng *rng)
+CALLED void bdpt_light_to_camera(const SceneView *sc, VCRef l, int s, VCRef cam_v, BdptFilm *out, BdptPnCache *pc,
+				 Rng *rng)
 {
 	uint pixel;
 	VTMP(yt);
 	VTMP(ct);
 	V3 c = bdpt_to_camera(sc, VLOAD(VAT(l, s - 1), yt), s == 1, VLOAD(cam_v, ct), &pixel);
 	if (!v3_is_zero(c))
-		bdpt_add(sc, out, s, 1, c, bdpt_weight(sc, l, s, cam_v, 1), pixel, rng);
+		bdpt_add(sc, out, s, 1, c, bdpt_weight_cached(sc, l, s, cam_v, 1, pc), pixel, rng);
 }
 
 /* Traces the eye subpath through raster point (px, py) into e[]; e[0] is
@@ -490,11 +528,13 @@ CALLED V3 bdpt_nee(const SceneView *sc, const PathVertex *z, const PathVertex *f
 CALLED void bdpt_strategies(const SceneView *sc, VRef l, int nl, VRef e, int ne, BdptFilm *out, Rng *rng)
 {
 	int depth = sc->params->max_depth;
+	BdptPnCache pc;
+	pc.have = 0;
 
 	/* t = 1: every light vertex to the camera. */
 	for (int s = 1; s <= nl && s <= depth; s++)
 		if (s > 1 || !VREF_DELTA_LIGHT(VAT(l, 0))) /* a punctual light is not seen */
-			bdpt_light_to_camera(sc, l, s, VAT(e, 0), out, rng);
+			bdpt_light_to_camera(sc, l, s, VAT(e, 0), out, &pc, rng);
 
 	for (int t = 2; t <= ne; t++) {
 		VTMP(zt);
@@ -516,7 +556,8 @@ CALLED void bdpt_strategies(const SceneView *sc, VRef l, int nl, VRef e, int ne,
 			PathVertex y;
 			V3 c = bdpt_nee(sc, z, VLOAD(VAT(e, t - 2), ft), &y, rng);
 			if (!v3_is_zero(c))
-				bdpt_add(sc, out, 1, t, c, bdpt_weight(sc, VNEE(e, y), 1, e, t), out->pixel, rng);
+				bdpt_add(sc, out, 1, t, c, bdpt_weight_cached(sc, VNEE(e, y), 1, e, t, &pc), out->pixel,
+					 rng);
 		}
 		/* s >= 2: light vertex s-1 to eye vertex t-1. */
 		for (int s = 2; s <= nl && s + t - 1 <= depth; s++) {
@@ -524,8 +565,8 @@ CALLED void bdpt_strategies(const SceneView *sc, VRef l, int nl, VRef e, int ne,
 			V3 c = bdpt_connect(sc, ly, z);
 			if (v3_is_zero(c))
 				continue;
-			bdpt_add(sc, out, s, t, v3_mul(v3_mul(ly->beta, c), z->beta), bdpt_weight(sc, l, s, e, t),
-				 out->pixel, rng);
+			bdpt_add(sc, out, s, t, v3_mul(v3_mul(ly->beta, c), z->beta),
+				 bdpt_weight_cached(sc, l, s, e, t, &pc), out->pixel, rng);
 		}
 	}
 }
