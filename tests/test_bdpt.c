@@ -8,6 +8,8 @@
  *   - each strategy alone, unweighted, converges to the path tracer's image
  *     of paths of exactly its length; light tracing alone (t = 1) too;
  *   - the weighted strategy layers sum to the image;
+ *   - the weights with a light subpath's pn_0 cache are those without it,
+ *     bit for bit;
  *   - bdpt and pt agree.
  * Statistics: image means from B independent batches (different seeds);
  * the batch spread gives the standard error, and a difference must stay
@@ -312,6 +314,113 @@ static void test_mis_sky_image_portal(void **state)
 	host_scene_close(&h);
 }
 
+/* ---- The light subpath's pn_0 cache ------------------------------------- */
+
+/* Every strategy of random samples, in bdpt_strategies' order with one
+ * BdptPnCache per light subpath, weighted with the cache and without it:
+ * the same bits. Counts the connections (s >= 2) that took a cached pn_0
+ * and those whose x_2 lay behind x_1's shading normal (the cache's second
+ * side) after the first side had been filled. */
+static int check_pn_cache(HostScene *h, int nsamples, int *reused, int *other_side)
+{
+	SceneView *sc = &h->view;
+	int depth = h->data.params->max_depth, compared = 0;
+	PathVertex l[SUBPATH_MAX], e[SUBPATH_MAX];
+	for (int n = 0; n < nsamples; n++) {
+		Rng rng = rng_init(97, (uint)n, 0, 7);
+		float px = rng_f(&rng) * h->data.params->camera.width, py = rng_f(&rng) * h->data.params->camera.height;
+		int nl = bdpt_light_subpath(sc, l, depth, &rng);
+		int ne = bdpt_eye_subpath(sc, px, py, e, depth + 1, &rng);
+		BdptPnCache pc;
+		pc.have = 0;
+		for (int t = 1; t <= ne; t++) {
+			for (int s = 1; s <= nl && s + t - 1 <= depth; s++) {
+				PathVertex y;
+				const PathVertex *lp = l;
+				if (t == 1) {
+					if (vertex_infinite(&l[s - 1]) || (s == 1 && vertex_delta_light(&l[0])))
+						continue;
+				} else if (e[t - 1].type != VERTEX_SURFACE) {
+					break;
+				} else if (s == 1) {
+					if (v3_is_zero(bdpt_nee(sc, &e[t - 1], &e[t - 2], &y, &rng)))
+						continue;
+					lp = &y;
+				} else if (v3_is_zero(bdpt_connect(sc, &l[s - 1], &e[t - 1]))) {
+					continue;
+				}
+				int had = pc.have;
+				if (s >= 2) {
+					const PathVertex *x2 = s >= 3 ? &l[2] : &e[t - 1];
+					int side = v3_dot(l[1].ns, vertex_infinite(x2) ? x2->p : v3_sub(x2->p, l[1].p)) < 0.0f;
+					*reused += had >> side & 1;
+					*other_side += had && !(had >> side & 1);
+				}
+				float want = bdpt_weight(sc, lp, s, e, t), got = bdpt_weight_cached(sc, lp, s, e, t, &pc);
+				if (memcmp(&want, &got, sizeof got) != 0)
+					fail_msg("strategy (s=%d, t=%d) of sample %d: weight %.9g with the cache, %.9g without", s,
+						 t, n, got, want);
+				compared++;
+			}
+		}
+	}
+	print_message("%d weights the same bits with the cache; %d connections took a cached pn_0, %d filled "
+		      "the second side\n", compared, *reused, *other_side);
+	return compared;
+}
+
+/* A sky image through window-room's window, with a rough glass pane in the
+ * room (light subpaths pass it, so one light subpath connects on both sides
+ * of a vertex's normal), the glossy scene under a sky image, and door-ajar
+ * (an emitter's pn_0). With the cache's side test replaced by side 0 the
+ * first scene fails (weight 0.999907613 against 0.999906182). */
+static void test_pn_cache_same_bits(void **state)
+{
+	ajar_scene *s;
+	if (ajar_scene_load(SCENE("window-room/window-room.gltf"), &s) != AJAR_OK)
+		fail_msg("%s", ajar_last_error());
+	float *sky = test_sun_sky(256, 128, 0.1f, sinf(0.84f), -cosf(0.84f), 0.03f, 3000.0f);
+	assert_int_equal(scene_set_env_image(s, 256, 128, sky, 1.0f), AJAR_OK);
+	ajar_material m;
+	uint32_t glass;
+	ajar_material_default(&m);
+	m.transmission = 1;
+	m.roughness = 0.3f;
+	assert_int_equal(ajar_scene_add_material(s, &m, &glass), AJAR_OK);
+	/* a pane across the room between the window (z = 0) and the floor the sky's
+	 * lines reach: most light subpaths' first vertex, and the camera (z = 0.3)
+	 * sees through it */
+	static const float pane_p[] = {0.1f, 0.1f, 0.6f, 3.9f, 0.1f, 0.6f, 3.9f, 2.6f, 0.6f, 0.1f, 2.6f, 0.6f};
+	static const uint32_t quad[] = {0, 1, 2, 0, 2, 3};
+	ajar_mesh mesh = {pane_p, NULL, NULL, 4, quad, 2, glass, NULL};
+	assert_int_equal(ajar_scene_add_mesh(s, &mesh), AJAR_OK);
+	/* A second portal, tilted across the window (x 1.6..2.4, y 1..1.8, z =
+	 * 0): with two planes the sky's next-event density reads the
+	 * receiver's normal, so the two sides of the pane have two pn_0. */
+	static const float tilt_p[] = {1.6f, 1.0f, 0.4f, 2.4f, 1.0f, 0.4f, 2.4f, 1.8f, 0.0f, 1.6f, 1.8f, 0.0f};
+	ajar_mesh tilt = {tilt_p, NULL, NULL, 4, quad, 2, 0, NULL};
+	assert_int_equal(ajar_scene_add_portal(s, &tilt), AJAR_OK);
+	HostScene h;
+	int reused = 0, other = 0;
+	host_scene_open(&h, NULL, s, 24, 24, INTEGRATOR_BDPT, 8);
+	assert_true(h.data.params->num_portals == 4 && h.data.params->env_type == ENV_IMAGE);
+	assert_true(check_pn_cache(&h, 400, &reused, &other) > 2000);
+	host_scene_close(&h);
+	assert_true(reused > 500);
+	assert_true(other > 20);
+
+	ajar_scene *g = glossy_scene();
+	sky = test_sun_sky(128, 64, 0.3f, 0.8f, 0.5f, 0.05f, 500.0f);
+	assert_int_equal(scene_set_env_image(g, 128, 64, sky, 1.0f), AJAR_OK);
+	host_scene_open(&h, NULL, g, 24, 24, INTEGRATOR_BDPT, 8);
+	assert_true(check_pn_cache(&h, 400, &reused, &other) > 300);
+	host_scene_close(&h);
+
+	host_scene_open(&h, SCENE("door-ajar/door-ajar.gltf"), NULL, 24, 24, INTEGRATOR_BDPT, 8);
+	assert_true(check_pn_cache(&h, 400, &reused, &other) > 500);
+	host_scene_close(&h);
+}
+
 /* ---- Convergence ------------------------------------------------------- */
 
 #define BATCHES 32
@@ -475,6 +584,7 @@ int main(void)
 		cmocka_unit_test(test_mis_punctual),
 		cmocka_unit_test(test_mis_sun_portal),
 		cmocka_unit_test(test_mis_sky_image_portal),
+		cmocka_unit_test(test_pn_cache_same_bits),
 		cmocka_unit_test(test_strategies_unbiased_punctual),
 		cmocka_unit_test(test_bdpt_matches_pt_punctual),
 		cmocka_unit_test(test_bdpt_matches_pt_sun_portal),
