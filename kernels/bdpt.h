@@ -38,7 +38,7 @@
 
 /* pn_0 of one light subpath's origin for the two sides of its first
  * vertex's normal: bdpt_nee_pdf reads a path's x_2 only for the side of
- * x_1 it lies on (vertex_nee_normal), so every connection (s >= 2) of the
+ * x_1 it lies on (vertex_nee_side), so every connection (s >= 2) of the
  * light subpath takes one of these two; a sky image's costs a lookup
  * through the portals' tables, once per side instead of once per
  * connection. bdpt_strategies clears it (have = 0) per light subpath. */
@@ -91,16 +91,13 @@ INLINE int bdpt_mis_path_cached(const SceneView *sc, VCRef l, int s, VCRef e, in
 	const PathVertex *x1 = VLOAD(s >= 2 ? VAT(l, 1) : (s == 1 ? VAT(e, t - 1) : VAT(e, t - 2)), t1);
 	const PathVertex *x2 = VLOAD(s >= 3 ? VAT(l, 2) : VAT(e, max(t + s - 3, 0)), t2);
 	nee_stored = nee_stored && s == 1 && t >= 2;
-	if (nee_stored) {
-		mv[0].pf = bdpt_origin_pdf(sc, x0);
-		mv[0].pn = x0->pf;
-	} else if (pc && s == 1 && t >= 2 && x0->type == VERTEX_ENV) {
-		/* The sample's own density (bdpt_light_vertex), the same bits as
-		 * bdpt_nee_pdf's (test_lights, test_sky_pdf_views). */
+	/* With the cache, a sky sample's own density (bdpt_light_vertex), the
+	 * same bits as bdpt_nee_pdf's (test_lights, test_sky_pdf_views). */
+	if (nee_stored || (pc && s == 1 && t >= 2 && x0->type == VERTEX_ENV)) {
 		mv[0].pf = bdpt_origin_pdf(sc, x0);
 		mv[0].pn = x0->pf;
 	} else if (pc && s >= 2) { /* k >= 3 */
-		int side = v3_dot(x1->ns, vertex_infinite(x2) ? x2->p : v3_sub(x2->p, x1->p)) < 0.0f;
+		int side = vertex_nee_side(x1, x2);
 		mv[0].pf = bdpt_origin_pdf(sc, x0);
 		if (!(pc->have >> side & 1)) {
 			pc->pn[side] = bdpt_nee_pdf(sc, x0, x1, x2);

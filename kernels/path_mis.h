@@ -652,8 +652,7 @@ INLINE float path_join_lpn(const SceneView *sc, VCRef R, VCRef x2, MisPnCache *c
 	VTMP(t1);
 	VTMP(t2);
 	const PathVertex *a = VLOAD(VAT(R, 1), t0), *b = VLOAD(VAT(R, 0), t1), *x = VLOAD(x2, t2);
-	V3 w = vertex_infinite(x) ? x->p : v3_sub(x->p, b->p);
-	int side = v3_dot(b->ns, w) < 0.0f; /* vertex_nee_normal's test */
+	int side = vertex_nee_side(b, x);
 	if (!(c->have >> side & 1)) {
 		c->lpn[side] = fast_log(mis_remap0(bdpt_nee_pdf(sc, a, b, x)));
 		c->have |= 1 << side;

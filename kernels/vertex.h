@@ -172,10 +172,15 @@ INLINE float vertex_density_a(const PathVertex *from, const PathVertex *to, floa
  * by (env_portal.h). Taken from the two positions, never from x's wo, so
  * that sampling and every MIS record of the same path agree bit for bit
  * whichever walk made x. */
-INLINE V3 vertex_nee_normal(const PathVertex *x, const PathVertex *from)
+INLINE int vertex_nee_side(const PathVertex *x, const PathVertex *from)
 {
 	V3 w = vertex_infinite(from) ? from->p : v3_sub(from->p, x->p);
-	return v3_dot(x->ns, w) < 0.0f ? v3_neg(x->ns) : x->ns;
+	return v3_dot(x->ns, w) < 0.0f;
+}
+
+INLINE V3 vertex_nee_normal(const PathVertex *x, const PathVertex *from)
+{
+	return vertex_nee_side(x, from) ? v3_neg(x->ns) : x->ns;
 }
 
 /* pbrt's correction for shading normals in light transport (Veach 1997,

@@ -296,17 +296,23 @@ static void test_mis_sun_portal(void **state)
 	host_scene_close(&h);
 }
 
-/* window-room under a sky image with a sun high behind the window: the
- * environment's light subpaths start on the portal (lights.h,
- * line_sample), and their pf_1 (line_pdf_perp) is checked against the oracle's
- * own crossing count. */
-static void test_mis_sky_image_portal(void **state)
+/* window-room under a sky image with a sun high behind the window. */
+static ajar_scene *sky_window_room(void)
 {
 	ajar_scene *s;
 	if (ajar_scene_load(SCENE("window-room/window-room.gltf"), &s) != AJAR_OK)
 		fail_msg("%s", ajar_last_error());
 	float *sky = test_sun_sky(256, 128, 0.1f, sinf(0.84f), -cosf(0.84f), 0.03f, 3000.0f);
 	assert_int_equal(scene_set_env_image(s, 256, 128, sky, 1.0f), AJAR_OK);
+	return s;
+}
+
+/* In that room the environment's light subpaths start on the portal
+ * (lights.h, line_sample), and their pf_1 (line_pdf_perp) is checked
+ * against the oracle's own crossing count. */
+static void test_mis_sky_image_portal(void **state)
+{
+	ajar_scene *s = sky_window_room();
 	HostScene h;
 	host_scene_open(&h, NULL, s, 32, 32, INTEGRATOR_BDPT, 8);
 	assert_true(h.data.params->num_portals > 0 && h.data.params->env_type == ENV_IMAGE);
@@ -352,7 +358,7 @@ static int check_pn_cache(HostScene *h, int nsamples, int *reused, int *other_si
 				int had = pc.have;
 				if (s >= 2) {
 					const PathVertex *x2 = s >= 3 ? &l[2] : &e[t - 1];
-					int side = v3_dot(l[1].ns, vertex_infinite(x2) ? x2->p : v3_sub(x2->p, l[1].p)) < 0.0f;
+					int side = vertex_nee_side(&l[1], x2);
 					*reused += had >> side & 1;
 					*other_side += had && !(had >> side & 1);
 				}
@@ -376,11 +382,7 @@ static int check_pn_cache(HostScene *h, int nsamples, int *reused, int *other_si
  * first scene fails (weight 0.999907613 against 0.999906182). */
 static void test_pn_cache_same_bits(void **state)
 {
-	ajar_scene *s;
-	if (ajar_scene_load(SCENE("window-room/window-room.gltf"), &s) != AJAR_OK)
-		fail_msg("%s", ajar_last_error());
-	float *sky = test_sun_sky(256, 128, 0.1f, sinf(0.84f), -cosf(0.84f), 0.03f, 3000.0f);
-	assert_int_equal(scene_set_env_image(s, 256, 128, sky, 1.0f), AJAR_OK);
+	ajar_scene *s = sky_window_room();
 	ajar_material m;
 	uint32_t glass;
 	ajar_material_default(&m);
@@ -410,7 +412,7 @@ static void test_pn_cache_same_bits(void **state)
 	assert_true(other > 20);
 
 	ajar_scene *g = glossy_scene();
-	sky = test_sun_sky(128, 64, 0.3f, 0.8f, 0.5f, 0.05f, 500.0f);
+	float *sky = test_sun_sky(128, 64, 0.3f, 0.8f, 0.5f, 0.05f, 500.0f);
 	assert_int_equal(scene_set_env_image(g, 128, 64, sky, 1.0f), AJAR_OK);
 	host_scene_open(&h, NULL, g, 24, 24, INTEGRATOR_BDPT, 8);
 	assert_true(check_pn_cache(&h, 400, &reused, &other) > 300);
