@@ -9,8 +9,12 @@
  *   t = 1   light vertex s-1 connected to the camera and splatted into the
  *           pixel it lands in (light tracing);
  *   others  light vertex s-1 connected to eye vertex t-1.
- * For each strategy the path's MIS records are built from the subpaths, with
- * the four densities next to the connection recomputed (bdpt_mis_path).
+ * For each strategy the path's MIS records are those of the subpaths but
+ * for the four densities next to the connection, which its evaluation
+ * finds (BdptConnPdf); the weight reads the records around the connection
+ * and, beyond them, the sums each subpath vertex carries (bdpt_mis_tails,
+ * mis.h). bdpt_mis_path builds all the records, recomputing those four
+ * from the vertices, for the tests and for callers without the tails.
  *
  * Light subpaths leave an emitter by power, a uniform point on it and a
  * cosine direction, or the environment by its importance, along a line on
@@ -41,56 +45,48 @@
  * x_1 it lies on (vertex_nee_side), so every connection (s >= 2) of the
  * light subpath takes one of these two; a sky image's costs a lookup
  * through the portals' tables, once per side instead of once per
- * connection. bdpt_strategies clears it (have = 0) per light subpath. */
+ * connection. With them, pf_0, the origin's own density, which is the same
+ * in every connection too. bdpt_strategies clears it (have = 0) per light
+ * subpath. */
 typedef struct {
 	float pn[2];
-	int have; /* bit i: pn[i] is set */
+	float pf0;
+	int have;  /* bit i < 2: pn[i] is set; bit 2: pf0 */
+	int tails; /* the subpaths' vertices carry their MIS tails (bdpt_mis_tails) */
 } BdptPnCache;
 
-/* The MIS records of the path made of light vertices l[0..s-1] and eye
- * vertices e[t-1..0], with the densities next to the connection
- * recomputed: pr of l[s-1] and l[s-2], pf of e[t-1] and e[t-2]. With
- * `nee_stored` (the portal integrator, bdpt_weight) a next-event light
- * vertex (s = 1, t >= 2) brings its pn_0 and pr_0 (bdpt_nee), as
- * path_records_part takes them, instead of a second sky lookup. With `pc`
- * (bdpt_strategies) pn_0 comes from the cache of this light subpath, and
- * a next-event sky vertex's from its sample (the same bits). */
-INLINE int bdpt_mis_path_cached(const SceneView *sc, VCRef l, int s, VCRef e, int t, MisVertex *mv, int nee_stored,
-				BdptPnCache *pc)
+/* The solid-angle densities that evaluating a connection found at its
+ * ends (bdpt_connect, bdpt_to_camera, bdpt_nee): each end's BSDF sampling
+ * the other end (fwd) and sampling its own subpath predecessor from the
+ * other end (rev). They are the four records next to the connection in
+ * solid angle, so the weight need not evaluate the BSDFs again. */
+typedef struct {
+	float l_fwd, l_rev; /* at the light end (s >= 2; l_rev for t = 1 too) */
+	float e_fwd, e_rev; /* at the eye end (t >= 2) */
+} BdptConnPdf;
+
+/* One record as its subpath left it. */
+INLINE void bdpt_record(MisVertex *m, VCRef x)
 {
-	GLOBAL const Camera *cam = &sc->params->camera;
+	m->pf = VGETF(x, pf);
+	m->pr = VGETF(x, pr);
+	m->delta = VGETI(x, delta);
+	m->infinite = VREF_INFINITE(x);
+}
+
+/* x_0's densities pf_0 and pn_0 (and for s = 0, pf_1), as
+ * bdpt_mis_records describes. */
+INLINE void bdpt_records_x0(const SceneView *sc, VCRef l, int s, VCRef e, int t, MisVertex *mv, int nee_stored,
+			    BdptPnCache *pc)
+{
 	int k = s + t;
-	for (int i = 0; i < s; i++) {
-		VCRef x = VAT(l, i);
-		mv[i].pf = VGETF(x, pf);
-		mv[i].pr = VGETF(x, pr);
-		mv[i].delta = VGETI(x, delta);
-		mv[i].infinite = VREF_INFINITE(x);
-	}
-	for (int j = 0; j < t; j++) {
-		MisVertex *m = &mv[k - 1 - j];
-		VCRef x = VAT(e, j);
-		m->pf = VGETF(x, pf);
-		m->pr = VGETF(x, pr);
-		m->delta = VGETI(x, delta);
-		m->infinite = VREF_INFINITE(x);
-	}
-	/* The connection's ends scatter through non-delta lobes on this path,
-	 * whatever their subpaths sampled next (pbrt does the same). */
-	if (s > 0)
-		mv[s - 1].delta = 0;
-	mv[s].delta = 0;
 	VTMP(t0);
 	VTMP(t1);
 	VTMP(t2);
-	VTMP(t3);
-	if (s > 0) /* a punctual light (mis.h) */
-		mv[0].delta = VREF_DELTA_LIGHT(VAT(l, 0));
 	const PathVertex *x0 = VLOAD(s > 0 ? VAT(l, 0) : VAT(e, t - 1), t0);
 	/* x_1 and x_2 (k >= 3 for the second): light vertices, then eye vertices. */
 	const PathVertex *x1 = VLOAD(s >= 2 ? VAT(l, 1) : (s == 1 ? VAT(e, t - 1) : VAT(e, t - 2)), t1);
 	const PathVertex *x2 = VLOAD(s >= 3 ? VAT(l, 2) : VAT(e, max(t + s - 3, 0)), t2);
-	nee_stored = nee_stored && s == 1 && t >= 2;
 	/* With the cache, a sky sample's own density (bdpt_light_vertex), the
 	 * same bits as bdpt_nee_pdf's (test_lights, test_sky_pdf_views). */
 	if (nee_stored || (pc && s == 1 && t >= 2 && x0->type == VERTEX_ENV)) {
@@ -98,7 +94,11 @@ INLINE int bdpt_mis_path_cached(const SceneView *sc, VCRef l, int s, VCRef e, in
 		mv[0].pn = x0->pf;
 	} else if (pc && s >= 2) { /* k >= 3 */
 		int side = vertex_nee_side(x1, x2);
-		mv[0].pf = bdpt_origin_pdf(sc, x0);
+		if (!(pc->have & 4)) {
+			pc->pf0 = bdpt_origin_pdf(sc, x0);
+			pc->have |= 4;
+		}
+		mv[0].pf = pc->pf0;
 		if (!(pc->have >> side & 1)) {
 			pc->pn[side] = bdpt_nee_pdf(sc, x0, x1, x2);
 			pc->have |= 1 << side;
@@ -107,22 +107,60 @@ INLINE int bdpt_mis_path_cached(const SceneView *sc, VCRef l, int s, VCRef e, in
 	} else {
 		bdpt_light_records(sc, mv, x0, x1, x2, k);
 	}
-	if (s == 0) {
-		/* e[t-1] is the light: its emission density. */
-		const PathVertex *lt = x0;
-		if (t >= 3)
-			mv[1].pf = bdpt_emission_pdf(sc, lt, x1);
+	if (s == 0 && t >= 3) /* e[t-1] is the light: its emission density */
+		mv[1].pf = bdpt_emission_pdf(sc, x0, x1);
+}
+
+/* The MIS records of the path made of light vertices l[0..s-1] and eye
+ * vertices e[t-1..0], with the densities next to the connection
+ * recomputed: pr of l[s-1] and l[s-2], pf of e[t-1] and e[t-2]. With
+ * `nee_stored` (the portal integrator, bdpt_weight) a next-event light
+ * vertex (s = 1, t >= 2) brings its pn_0 and pr_0 (bdpt_nee), as
+ * path_records_part takes them, instead of a second sky lookup. With `pc`
+ * (bdpt_strategies) pn_0 comes from the cache of this light subpath, and
+ * a next-event sky vertex's from its sample (the same bits). With
+ * `window`, only the records mis_path_weight_tails reads: x_{s-3} ..
+ * x_{s+2}, and x_0's densities only when s <= 3 (beyond, x_0 and x_1 lie
+ * in the light tail). With `cp`, the connection's densities from its
+ * evaluation. */
+INLINE int bdpt_mis_records(const SceneView *sc, VCRef l, int s, VCRef e, int t, MisVertex *mv, int nee_stored,
+			    BdptPnCache *pc, int window, const BdptConnPdf *cp)
+{
+	GLOBAL const Camera *cam = &sc->params->camera;
+	int k = s + t;
+	int lo = window ? max(0, s - 3) : 0, hi = window ? min(k - 1, s + 2) : k - 1;
+	for (int i = lo; i < s; i++)
+		bdpt_record(&mv[i], VAT(l, i));
+	for (int i = max(s, lo); i <= hi; i++)
+		bdpt_record(&mv[i], VAT(e, k - 1 - i));
+	/* The connection's ends scatter through non-delta lobes on this path,
+	 * whatever their subpaths sampled next (pbrt does the same). */
+	if (s > 0)
+		mv[s - 1].delta = 0;
+	mv[s].delta = 0;
+	if (s > 0 && lo == 0) /* a punctual light (mis.h) */
+		mv[0].delta = VREF_DELTA_LIGHT(VAT(l, 0));
+	nee_stored = nee_stored && s == 1 && t >= 2;
+	if (lo == 0)
+		bdpt_records_x0(sc, l, s, e, t, mv, nee_stored, pc);
+	if (s == 0)
 		return k;
-	}
+	VTMP(t0);
+	VTMP(t1);
+	VTMP(t2);
+	VTMP(t3);
 	const PathVertex *ls = VLOAD(VAT(l, s - 1), t0), *es = VLOAD(VAT(e, t - 1), t1);
 	/* Eye side of the connection: pf of e[t-1], then of e[t-2]. */
 	if (t >= 2) {
 		if (s == 1)
 			mv[s].pf = bdpt_emission_pdf(sc, ls, es);
 		else
-			mv[s].pf = bdpt_pdf_a(sc, ls, VLOAD(VAT(l, s - 2), t2), es, BSDF_IMPORTANCE);
-		if (t >= 3)
-			mv[s + 1].pf = bdpt_pdf_a(sc, es, ls, VLOAD(VAT(e, t - 2), t3), BSDF_RADIANCE);
+			mv[s].pf = cp ? vertex_density_a(ls, es, cp->l_fwd)
+				      : bdpt_pdf_a(sc, ls, VLOAD(VAT(l, s - 2), t2), es, BSDF_IMPORTANCE);
+		if (t >= 3) {
+			const PathVertex *e2 = VLOAD(VAT(e, t - 2), t3);
+			mv[s + 1].pf = cp ? vertex_density_a(es, e2, cp->e_rev) : bdpt_pdf_a(sc, es, ls, e2, BSDF_RADIANCE);
+		}
 	}
 	/* Light side: pr of l[s-1] (from the eye vertex or the camera), then of l[s-2]. */
 	if (t == 1) {
@@ -131,17 +169,66 @@ INLINE int bdpt_mis_path_cached(const SceneView *sc, VCRef l, int s, VCRef e, in
 		float d2 = v3_len2(d);
 		camera_raster(cam, v3_scale(d, 1.0f / sqrt(d2)), &px, &py, &cos_c);
 		mv[s - 1].pr = vertex_density_a(es, ls, camera_pdf_w(cam, cos_c));
+	} else if (cp) {
+		mv[s - 1].pr = vertex_density_a(es, ls, cp->e_fwd);
 	} else if (!(nee_stored && ls->pr > 0.0f)) {
 		mv[s - 1].pr = bdpt_pdf_a(sc, es, VLOAD(VAT(e, t - 2), t3), ls, BSDF_RADIANCE);
 	}
-	if (s >= 2)
-		mv[s - 2].pr = bdpt_pdf_a(sc, ls, es, VLOAD(VAT(l, s - 2), t2), BSDF_IMPORTANCE);
+	if (s >= 2) {
+		const PathVertex *l2 = VLOAD(VAT(l, s - 2), t2);
+		mv[s - 2].pr = cp ? vertex_density_a(ls, l2, cp->l_rev) : bdpt_pdf_a(sc, ls, es, l2, BSDF_IMPORTANCE);
+	}
 	return k;
 }
 
 INLINE int bdpt_mis_path(const SceneView *sc, VCRef l, int s, VCRef e, int t, MisVertex *mv, int nee_stored)
 {
-	return bdpt_mis_path_cached(sc, l, s, e, t, mv, nee_stored, 0);
+	return bdpt_mis_records(sc, l, s, e, t, mv, nee_stored, 0, 0, 0);
+}
+
+/* mis_path_weight of bdpt strategy (s, t); from the connection's
+ * neighbourhood and the subpaths' tails where they carry them (with
+ * `cp`, the connection's densities; 0 for s = 0). */
+INLINE float bdpt_path_weight(const SceneView *sc, VCRef l, int s, VCRef e, int t, MisVertex *mv, int nee_stored,
+			      BdptPnCache *pc, const BdptConnPdf *cp)
+{
+	int heuristic = sc->params->mis;
+	if (!(pc && pc->tails)) {
+		int k = bdpt_mis_records(sc, l, s, e, t, mv, nee_stored, pc, 0, 0);
+		return mis_path_weight(mv, k, s, heuristic);
+	}
+	int k = bdpt_mis_records(sc, l, s, e, t, mv, nee_stored, pc, 1, cp);
+	float ltail = s >= 3 ? VGETF(VAT(l, s - 3), tail) : 0.0f, etail = t >= 4 ? VGETF(VAT(e, t - 3), tail) : 0.0f;
+	return mis_path_weight_tails(mv, k, s, heuristic, ltail, etail);
+}
+
+/* Every vertex's MIS tail (mis.h) for the weights of bdpt_strategies:
+ * light vertices 0 .. nl - 3 (A_m, for s = m + 3), eye vertices 1 .. ne - 3
+ * (B_a, for t = a + 3). x_0's densities as bdpt_mis_records finds them for
+ * s >= 3, where x_1, x_2 are l[1], l[2]; pn_0 through the cache. */
+INLINE void bdpt_mis_tails(const SceneView *sc, VRef l, int nl, VRef e, int ne, BdptPnCache *pc)
+{
+	int heuristic = sc->params->mis;
+	MisVertex mv[SUBPATH_MAX];
+	float A[SUBPATH_MAX];
+	if (nl >= 3) {
+		for (int i = 0; i < nl - 2; i++)
+			bdpt_record(&mv[i], VAT(l, i));
+		mv[0].delta = VREF_DELTA_LIGHT(VAT(l, 0));
+		bdpt_records_x0(sc, l, 3, e, 1, mv, 0, pc);
+		mis_light_tails(mv, nl - 2, heuristic, A);
+		for (int m = 0; m < nl - 2; m++)
+			VSETF(VAT(l, m), tail, A[m]);
+	}
+	float b = 0.0f;
+	if (ne >= 4)
+		bdpt_record(&mv[0], VAT(e, 0));
+	for (int a = 1; a <= ne - 3; a++) {
+		bdpt_record(&mv[a], VAT(e, a));
+		b = mis_eye_tail(mv, a, heuristic, b);
+		VSETF(VAT(e, a), tail, b);
+	}
+	pc->tails = 1;
 }
 
 /* The weight of bdpt strategy (s, t): over the bdpt strategies alone, or,
@@ -159,7 +246,8 @@ INLINE int bdpt_mis_path(const SceneView *sc, VCRef l, int s, VCRef e, int t, Mi
  * from the lamp takes the shortcut; on the sun scenes every path of 6 or
  * more vertices, whose first edge, through the window, is then no
  * pairing edge (lo = k - 5 with the sky's set, mis_pair_edges). */
-CALLED float bdpt_weight_cached(const SceneView *sc, VCRef l, int s, VCRef e, int t, BdptPnCache *pc)
+CALLED float bdpt_weight_cached(const SceneView *sc, VCRef l, int s, VCRef e, int t, BdptPnCache *pc,
+				const BdptConnPdf *cp)
 {
 	MisVertex mv[2 * SUBPATH_MAX];
 	if (PARAMS_INTEGRATOR(sc->params) == INTEGRATOR_PORTAL) {
@@ -172,16 +260,14 @@ CALLED float bdpt_weight_cached(const SceneView *sc, VCRef l, int s, VCRef e, in
 			return path_union_weight(sc, &P, cur);
 		if (!set.light_paths)
 			return path_unpaired_weight(sc, &P, set, n, cur);
-		int k = bdpt_mis_path_cached(sc, l, s, e, t, mv, 1, pc);
-		return mis_path_weight(mv, k, s, sc->params->mis);
+		return bdpt_path_weight(sc, l, s, e, t, mv, 1, pc, cp);
 	}
-	int k = bdpt_mis_path_cached(sc, l, s, e, t, mv, 0, pc);
-	return mis_path_weight(mv, k, s, sc->params->mis);
+	return bdpt_path_weight(sc, l, s, e, t, mv, 0, pc, cp);
 }
 
 INLINE float bdpt_weight(const SceneView *sc, VCRef l, int s, VCRef e, int t)
 {
-	return bdpt_weight_cached(sc, l, s, e, t, 0);
+	return bdpt_weight_cached(sc, l, s, e, t, 0, 0);
 }
 
 /* Unoccluded segment between two vertices (either may be the camera,
@@ -218,6 +304,12 @@ INLINE V3 bdpt_scatter(const PathVertex *v, V3 wi, int mode)
 	float pdf_w;
 	return bdpt_scatter_pdf(v, wi, mode, &pdf_w);
 }
+
+/* The solid-angle density of v's BSDF sampling its subpath predecessor
+ * (along v->wo) from direction w: a connection's rev density, found only
+ * once the connection is known to be unoccluded (most are not, in
+ * door-ajar). */
+INLINE float bdpt_rev_pdf(const PathVertex *v, V3 w) { return bsdf_pdf_w(&v->bs, w, v->wo); }
 
 /* A light subpath from punctual light i (chosen with probability pf):
  * from a point or spot light in a direction by punctual_dir_sample (u3,
@@ -396,28 +488,42 @@ INLINE void bdpt_add(const SceneView *sc, BdptFilm *out, int s, int t, V3 c, flo
 
 /* Connecting light vertex y (s >= 2) to eye vertex z (t >= 2), both on
  * surfaces: f_y G f_z without the betas, or 0 if occluded or either BSDF
- * is black toward the other. */
-CALLED V3 bdpt_connect(const SceneView *sc, const PathVertex *y, const PathVertex *z)
+ * is black toward the other; and, with cp, the densities the MIS weight
+ * needs. */
+CALLED V3 bdpt_connect_pdf(const SceneView *sc, const PathVertex *y, const PathVertex *z, BdptConnPdf *cp)
 {
 	V3 d = v3_sub(z->p, y->p);
 	float d2 = v3_len2(d);
 	if (!(d2 > 0.0f))
 		return v3(0.0f, 0.0f, 0.0f);
 	V3 w = v3_scale(d, 1.0f / sqrt(d2));
-	V3 fy = bdpt_scatter(y, w, BSDF_IMPORTANCE);
+	float pdf_y, pdf_z;
+	V3 fy = bdpt_scatter_pdf(y, w, BSDF_IMPORTANCE, &pdf_y);
 	if (v3_is_zero(fy))
 		return fy;
-	V3 fz = bdpt_scatter(z, v3_neg(w), BSDF_RADIANCE);
+	V3 fz = bdpt_scatter_pdf(z, v3_neg(w), BSDF_RADIANCE, &pdf_z);
 	if (v3_is_zero(fz) || !bdpt_visible(sc, y, z))
 		return v3(0.0f, 0.0f, 0.0f);
+	if (cp) {
+		cp->l_fwd = pdf_y;
+		cp->e_fwd = pdf_z;
+		cp->l_rev = bdpt_rev_pdf(y, w);
+		cp->e_rev = bdpt_rev_pdf(z, v3_neg(w));
+	}
 	return v3_scale(v3_mul(fy, fz), 1.0f / d2);
+}
+
+INLINE V3 bdpt_connect(const SceneView *sc, const PathVertex *y, const PathVertex *z)
+{
+	return bdpt_connect_pdf(sc, y, z, 0);
 }
 
 /* Light-side vertex y (its subpath predecessor along y->wo; `origin` if it
  * is a light subpath's first vertex, which emits rather than scatters)
  * connected to the camera cam_v: the contribution without MIS weight, and
  * the pixel it lands in; 0 if it misses the image or is occluded. */
-INLINE V3 bdpt_to_camera(const SceneView *sc, const PathVertex *y, int origin, const PathVertex *cam_v, uint *pixel)
+INLINE V3 bdpt_to_camera_pdf(const SceneView *sc, const PathVertex *y, int origin, const PathVertex *cam_v,
+			     uint *pixel, BdptConnPdf *cp)
 {
 	GLOBAL const Camera *cam = &sc->params->camera;
 	V3 zero = v3(0.0f, 0.0f, 0.0f);
@@ -432,9 +538,16 @@ INLINE V3 bdpt_to_camera(const SceneView *sc, const PathVertex *y, int origin, c
 	V3 fy = origin ? v3_scale(bdpt_emitted(sc, y, w), fabs(v3_dot(y->ng, w))) : bdpt_scatter(y, w, BSDF_IMPORTANCE);
 	if (v3_is_zero(fy) || !bdpt_visible(sc, y, cam_v))
 		return zero;
+	if (cp && !origin)
+		cp->l_rev = bdpt_rev_pdf(y, w);
 	*pixel = (uint)py * (uint)cam->width + (uint)px;
 	/* We G = cos_c / (A cos_c^4) / d^2 for the pinhole (camera.h). */
 	return v3_scale(v3_mul(y->beta, fy), camera_pdf_w(cam, cos_c) / d2);
+}
+
+INLINE V3 bdpt_to_camera(const SceneView *sc, const PathVertex *y, int origin, const PathVertex *cam_v, uint *pixel)
+{
+	return bdpt_to_camera_pdf(sc, y, origin, cam_v, pixel, 0);
 }
 
 /* Light vertex s - 1 seen by the camera: splats its weighted contribution. */
@@ -444,9 +557,10 @@ CALLED void bdpt_light_to_camera(const SceneView *sc, VCRef l, int s, VCRef cam_
 	uint pixel;
 	VTMP(yt);
 	VTMP(ct);
-	V3 c = bdpt_to_camera(sc, VLOAD(VAT(l, s - 1), yt), s == 1, VLOAD(cam_v, ct), &pixel);
+	BdptConnPdf cp;
+	V3 c = bdpt_to_camera_pdf(sc, VLOAD(VAT(l, s - 1), yt), s == 1, VLOAD(cam_v, ct), &pixel, &cp);
 	if (!v3_is_zero(c))
-		bdpt_add(sc, out, s, 1, c, bdpt_weight_cached(sc, l, s, cam_v, 1, pc), pixel, rng);
+		bdpt_add(sc, out, s, 1, c, bdpt_weight_cached(sc, l, s, cam_v, 1, pc, &cp), pixel, rng);
 }
 
 /* Traces the eye subpath through raster point (px, py) into e[]; e[0] is
@@ -504,7 +618,8 @@ INLINE int bdpt_nee_visible(const SceneView *sc, const PathVertex *z, const Ligh
  * the eye side is `from`: the light sample's vertex
  * *y (with pr, z's density of sampling it, which MIS records need) and the
  * contribution from z's throughput on, 0 if occluded. */
-CALLED V3 bdpt_nee(const SceneView *sc, const PathVertex *z, const PathVertex *from, PathVertex *y, Rng *rng)
+CALLED V3 bdpt_nee_conn(const SceneView *sc, const PathVertex *z, const PathVertex *from, PathVertex *y, Rng *rng,
+			BdptConnPdf *cp)
 {
 	LightSample ls;
 	float u0, u1, u2, pdf_w;
@@ -517,7 +632,16 @@ CALLED V3 bdpt_nee(const SceneView *sc, const PathVertex *z, const PathVertex *f
 	if (v3_is_zero(f) || !bdpt_nee_visible(sc, z, &ls))
 		return zero;
 	y->pr = vertex_density_a(z, y, pdf_w);
+	if (cp) {
+		cp->e_fwd = pdf_w;
+		cp->e_rev = bdpt_rev_pdf(z, ls.wi);
+	}
 	return v3_scale(v3_mul(v3_mul(z->beta, f), ls.Le), 1.0f / ls.pdf_w);
+}
+
+INLINE V3 bdpt_nee(const SceneView *sc, const PathVertex *z, const PathVertex *from, PathVertex *y, Rng *rng)
+{
+	return bdpt_nee_conn(sc, z, from, y, rng, 0);
 }
 
 /* Every bdpt strategy of one light and one eye subpath: adds the eye
@@ -527,6 +651,7 @@ CALLED void bdpt_strategies(const SceneView *sc, VRef l, int nl, VRef e, int ne,
 	int depth = sc->params->max_depth;
 	BdptPnCache pc;
 	pc.have = 0;
+	bdpt_mis_tails(sc, l, nl, e, ne, &pc);
 
 	/* t = 1: every light vertex to the camera. */
 	for (int s = 1; s <= nl && s <= depth; s++)
@@ -542,7 +667,8 @@ CALLED void bdpt_strategies(const SceneView *sc, VRef l, int nl, VRef e, int ne,
 		if (z->type == VERTEX_ENV || sc->tris[z->tri].emitter >= 0) {
 			V3 Le = bdpt_emitted(sc, z, z->wo);
 			if (!v3_is_zero(Le))
-				bdpt_add(sc, out, 0, t, v3_mul(z->beta, Le), bdpt_weight(sc, l, 0, e, t), out->pixel, rng);
+				bdpt_add(sc, out, 0, t, v3_mul(z->beta, Le), bdpt_weight_cached(sc, l, 0, e, t, &pc, 0),
+					 out->pixel, rng);
 		}
 		if (z->type == VERTEX_ENV)
 			break;
@@ -551,19 +677,21 @@ CALLED void bdpt_strategies(const SceneView *sc, VRef l, int nl, VRef e, int ne,
 		/* s = 1: next-event estimation with a fresh light sample. */
 		{
 			PathVertex y;
-			V3 c = bdpt_nee(sc, z, VLOAD(VAT(e, t - 2), ft), &y, rng);
+			BdptConnPdf cp;
+			V3 c = bdpt_nee_conn(sc, z, VLOAD(VAT(e, t - 2), ft), &y, rng, &cp);
 			if (!v3_is_zero(c))
-				bdpt_add(sc, out, 1, t, c, bdpt_weight_cached(sc, VNEE(e, y), 1, e, t, &pc), out->pixel,
-					 rng);
+				bdpt_add(sc, out, 1, t, c, bdpt_weight_cached(sc, VNEE(e, y), 1, e, t, &pc, &cp),
+					 out->pixel, rng);
 		}
 		/* s >= 2: light vertex s-1 to eye vertex t-1. */
 		for (int s = 2; s <= nl && s + t - 1 <= depth; s++) {
 			const PathVertex *ly = VLOAD(VAT(l, s - 1), lt);
-			V3 c = bdpt_connect(sc, ly, z);
+			BdptConnPdf cp;
+			V3 c = bdpt_connect_pdf(sc, ly, z, &cp);
 			if (v3_is_zero(c))
 				continue;
 			bdpt_add(sc, out, s, t, v3_mul(v3_mul(ly->beta, c), z->beta),
-				 bdpt_weight_cached(sc, l, s, e, t, &pc), out->pixel, rng);
+				 bdpt_weight_cached(sc, l, s, e, t, &pc, &cp), out->pixel, rng);
 		}
 	}
 }

@@ -54,16 +54,18 @@ INLINE float mis_remap0(float p) { return p > 0.0f ? p : 1.0f; }
 
 INLINE float mis_term(float r, int heuristic) { return heuristic == MIS_BALANCE ? r : r * r; }
 
-/* Weight of strategy s (light vertices x_0..x_{s-1}) for the k-vertex path
- * v[0..k-1] among all strategies s' in [0, k-1] that can produce it (t' = 0
- * is impossible with a pinhole camera). The connection of s' joins
- * x_{s'-1} and x_{s'}; s' = 0 means the eye subpath hit the light. */
-CALLED float mis_path_weight(const MisVertex *v, int k, int s, int heuristic)
+/* The sum behind mis_path_weight and mis_path_weight_tails: the eye
+ * side's terms for x_s .. x_{eye_hi - 1} moving to the light side, then
+ * `etail` times the last ratio if eye_hi < k - 1 (the terms beyond); the
+ * light side's for x_{s-1} down to x_{light_lo}, then `ltail` likewise if
+ * light_lo > 0. x_0's records are read only where the walk reaches x_1. */
+INLINE float mis_path_sum(const MisVertex *v, int k, int s, int heuristic, int eye_hi, int light_lo, float ltail,
+			  float etail)
 {
 	/* x_0's density is pn for s' = 1 and pf for s' >= 2. */
-	float pn_pf = mis_remap0(v[0].pn) / mis_remap0(v[0].pf);
+	float pn_pf = light_lo <= 1 ? mis_remap0(v[0].pn) / mis_remap0(v[0].pf) : 1.0f;
 	float sum = 1.0f, r = 1.0f;
-	for (int i = s; i < k - 1; i++) { /* s' = i + 1: x_i moves to the light side */
+	for (int i = s; i < eye_hi; i++) { /* s' = i + 1: x_i moves to the light side */
 		if (i == 0)
 			r *= mis_remap0(v[0].pn) / mis_remap0(v[0].pr);
 		else
@@ -72,8 +74,10 @@ CALLED float mis_path_weight(const MisVertex *v, int k, int s, int heuristic)
 		    !((v[i].infinite || v[i].delta) && i + 1 == k - 1))
 			sum += mis_term(r, heuristic);
 	}
+	if (eye_hi < k - 1)
+		sum += mis_term(r, heuristic) * etail;
 	r = 1.0f;
-	for (int i = s - 1; i >= 0; i--) { /* s' = i: x_i moves to the eye side */
+	for (int i = s - 1; i >= light_lo; i--) { /* s' = i: x_i moves to the eye side */
 		if (i == 0)
 			r *= mis_remap0(v[0].pr) / mis_remap0(v[0].pn);
 		else
@@ -81,7 +85,67 @@ CALLED float mis_path_weight(const MisVertex *v, int k, int s, int heuristic)
 		if (!v[i].delta && (i <= 1 || !v[i - 1].delta))
 			sum += mis_term(r, heuristic);
 	}
-	return 1.0f / sum;
+	if (light_lo > 0)
+		sum += mis_term(r, heuristic) * ltail;
+	return sum;
+}
+
+/* Weight of strategy s (light vertices x_0..x_{s-1}) for the k-vertex path
+ * v[0..k-1] among all strategies s' in [0, k-1] that can produce it (t' = 0
+ * is impossible with a pinhole camera). The connection of s' joins
+ * x_{s'-1} and x_{s'}; s' = 0 means the eye subpath hit the light. */
+CALLED float mis_path_weight(const MisVertex *v, int k, int s, int heuristic)
+{
+	return 1.0f / mis_path_sum(v, k, s, heuristic, k - 1, 0, 0.0f, 0.0f);
+}
+
+/* ---- The same weight from the connection's neighbourhood and two tails ----
+ *
+ * Of mis_path_weight's ratios, only those of the two records on each side
+ * of the connection change with it; beyond them the records are the
+ * subpaths' own (bdpt.h recomputes pf of x_s, x_{s+1} and pr of x_{s-1},
+ * x_{s-2}). So each subpath vertex can carry the sum of its side's terms
+ * beyond a connection two vertices away, and one weight reads x_{s-3} ..
+ * x_{s+2} and two tails instead of walking the whole path. The sums agree
+ * with mis_path_weight's up to float rounding (test_bdpt,
+ * test_pn_cache_same_bits). */
+
+/* The light tail at x_m of a light subpath, for every strategy s >= m + 3:
+ * A_m = sum over i <= m of the terms of s' = i (valid as mis_path_weight
+ * tells) of prod_{j=i..m} q_j^beta, q_j = pr_j / pf_j (pr_0 / pn_0 and
+ * the pn_0 / pf_0 of q_1 as there). Recurrence A_m = q_m^beta ([valid_m]
+ * + A_{m-1}), A_{-1} = 0; v[0..n-1] are the light subpath's records (x_0's
+ * delta: a punctual light). */
+INLINE void mis_light_tails(const MisVertex *v, int n, int heuristic, float *A)
+{
+	float pn_pf = mis_remap0(v[0].pn) / mis_remap0(v[0].pf), a = 0.0f;
+	for (int m = 0; m < n; m++) {
+		float q = m == 0 ? mis_remap0(v[0].pr) / mis_remap0(v[0].pn)
+				 : mis_remap0(v[m].pr) / mis_remap0(v[m].pf) * (m == 1 ? pn_pf : 1.0f);
+		int valid = !v[m].delta && (m <= 1 || !v[m - 1].delta);
+		a = mis_term(q, heuristic) * ((valid ? 1.0f : 0.0f) + a);
+		A[m] = a;
+	}
+}
+
+/* The eye tail at eye vertex a >= 1 (e[0] the camera), for every strategy
+ * with t >= a + 3, from the one at a - 1 (`prev`; 0 at a = 1): B_a =
+ * u_a^beta ([valid_a] + B_{a-1}), u_a = pf / pr of e[a]; valid_a: neither
+ * e[a] nor e[a-1] scattered by a delta lobe, and e[1] joins the camera
+ * only from a surface. v[a] holds e[a]'s record. */
+INLINE float mis_eye_tail(const MisVertex *v, int a, int heuristic, float prev)
+{
+	float u = mis_remap0(v[a].pf) / mis_remap0(v[a].pr);
+	int valid = !v[a].delta && !v[a - 1].delta && !(a == 1 && v[a].infinite);
+	return mis_term(u, heuristic) * ((valid ? 1.0f : 0.0f) + prev);
+}
+
+/* mis_path_weight with v[] filled at x_{s-3} .. x_{s+2} (those that exist;
+ * x_0 too when s <= 3) and the tails beyond: `etail` the eye tail B_{t-3}
+ * (read when t >= 4), `ltail` the light tail A_{s-3} (read when s >= 3). */
+INLINE float mis_path_weight_tails(const MisVertex *v, int k, int s, int heuristic, float ltail, float etail)
+{
+	return 1.0f / mis_path_sum(v, k, s, heuristic, min(k - 1, s + 2), max(0, s - 2), ltail, etail);
 }
 
 /* ---- BDPT and intermediate-subpath strategies together (design.md) ----

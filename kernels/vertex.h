@@ -43,6 +43,7 @@ typedef struct {
 	int cross;    /* portal integrator: portal crossings of the edge to the previous vertex of this subpath */
 	V3 w0;        /* an intermediate subpath's first vertices: the portal point it started from */
 	int w0_tri;   /* and the portal triangle it lies on */
+	float tail;   /* bdpt's MIS: this subpath's terms beyond a connection two vertices on (bdpt_mis_tails) */
 	Bsdf bs;      /* VERTEX_SURFACE hits: the BSDF, set up once by vertex_trace;
 		       * connections and MIS densities read it many times per
 		       * vertex (rebuilding it was 17% of door-ajar's portal time) */

@@ -9,7 +9,8 @@
  *     of paths of exactly its length; light tracing alone (t = 1) too;
  *   - the weighted strategy layers sum to the image;
  *   - the weights with a light subpath's pn_0 cache are those without it,
- *     bit for bit;
+ *     bit for bit, and those from the subpaths' MIS tails and the
+ *     connection's own densities equal the whole path's up to rounding;
  *   - bdpt and pt agree.
  * Statistics: image means from B independent batches (different seeds);
  * the batch spread gives the standard error, and a difference must stay
@@ -31,7 +32,7 @@ static int check_mis(HostScene *h, int nsamples)
 	Params *prm = h->data.params;
 	PathVertex l[SUBPATH_MAX], e[SUBPATH_MAX], x[2 * SUBPATH_MAX];
 	int dl[2 * SUBPATH_MAX];
-	MisVertex rec[2 * SUBPATH_MAX], orc[2 * SUBPATH_MAX];
+	MisVertex rec[2 * SUBPATH_MAX], orc[2 * SUBPATH_MAX], rcp[2 * SUBPATH_MAX];
 	int checked = 0, with_delta = 0, with_env = 0, records = 0, off = 0;
 	int depth = prm->max_depth;
 	for (int n = 0; n < nsamples; n++) {
@@ -81,21 +82,38 @@ static int check_mis(HostScene *h, int nsamples)
 				if (s == 0 && x[0].type != VERTEX_ENV)
 					x[0].type = VERTEX_LIGHT;
 				bdpt_mis_path(sc, l, s, e, t, rec, 0);
+				/* and with the connection's densities as its evaluation finds them */
+				BdptConnPdf cp;
+				if (s >= 1 && t >= 2) {
+					V3 w = oracle_dir(&e[t - 1], &l[s - 1]);
+					bdpt_scatter_pdf(&e[t - 1], w, BSDF_RADIANCE, &cp.e_fwd);
+					cp.e_rev = bdpt_rev_pdf(&e[t - 1], w);
+				}
+				if (s >= 2) {
+					V3 w = v3_norm(v3_sub(e[t - 1].p, l[s - 1].p));
+					bdpt_scatter_pdf(&l[s - 1], w, BSDF_IMPORTANCE, &cp.l_fwd);
+					cp.l_rev = bdpt_rev_pdf(&l[s - 1], w);
+				}
+				bdpt_mis_records(sc, l, s, e, t, rcp, 0, NULL, 0, s > 0 ? &cp : NULL);
 				oracle(sc, x, dl, k, orc);
 				for (int i = 0; i < k; i++) {
 					if (i == k - 1 || (i == 0 && t == k))
 						continue; /* camera's pf, and pr of ... never used */
-					double diff = fmax(rel_diff(rec[i].pf, orc[i].pf), rel_diff(rec[i].pr, orc[i].pr));
-					if (i == 0)
-						diff = fmax(diff, rel_diff(rec[0].pn, orc[0].pn));
-					records++;
-					off += diff > 1e-2;
-					if ((diff > 0.1 && !near_contact(x, k, i, prm->scene_radius)) ||
-					    rec[i].delta != orc[i].delta)
-						fail_msg("strategy (s=%d, t=%d), vertex %d of %d: kernel pf %g pr %g delta %d, "
-							 "oracle pf %g pr %g delta %d",
-							 s, t, i, k, rec[i].pf, rec[i].pr, rec[i].delta, orc[i].pf, orc[i].pr,
-							 orc[i].delta);
+					for (int w = 0; w < 2; w++) {
+						const MisVertex *r = w ? &rcp[i] : &rec[i];
+						double diff = fmax(rel_diff(r->pf, orc[i].pf), rel_diff(r->pr, orc[i].pr));
+						if (i == 0)
+							diff = fmax(diff, rel_diff(r->pn, orc[0].pn));
+						records++;
+						off += diff > 1e-2;
+						if ((diff > 0.1 && !near_contact(x, k, i, prm->scene_radius)) ||
+						    r->delta != orc[i].delta)
+							fail_msg("strategy (s=%d, t=%d), vertex %d of %d: kernel pf %g pr %g delta "
+								 "%d (%s), oracle pf %g pr %g delta %d",
+								 s, t, i, k, r->pf, r->pr, r->delta,
+								 w ? "connection's densities" : "recomputed", orc[i].pf, orc[i].pr,
+								 orc[i].delta);
+					}
 				}
 				for (int heur = 0; heur < 2; heur++) {
 					double sum = 0;
@@ -323,11 +341,15 @@ static void test_mis_sky_image_portal(void **state)
 /* ---- The light subpath's pn_0 cache ------------------------------------- */
 
 /* Every strategy of random samples, in bdpt_strategies' order with one
- * BdptPnCache per light subpath, weighted with the cache and without it:
- * the same bits. Counts the connections (s >= 2) that took a cached pn_0
- * and those whose x_2 lay behind x_1's shading normal (the cache's second
+ * BdptPnCache per light subpath, weighted three ways: without the cache
+ * (bdpt_weight, the reference), with it (the same bits), and as
+ * bdpt_strategies weighs, from the subpaths' MIS tails and the densities
+ * the connection's evaluation found (bdpt_mis_tails, BdptConnPdf): equal
+ * up to float rounding, within *worst (the largest difference, returned
+ * there). Counts the connections (s >= 2) that took a cached pn_0 and
+ * those whose x_2 lay behind x_1's shading normal (the cache's second
  * side) after the first side had been filled. */
-static int check_pn_cache(HostScene *h, int nsamples, int *reused, int *other_side)
+static int check_pn_cache(HostScene *h, int nsamples, int *reused, int *other_side, float *worst)
 {
 	SceneView *sc = &h->view;
 	int depth = h->data.params->max_depth, compared = 0;
@@ -337,35 +359,53 @@ static int check_pn_cache(HostScene *h, int nsamples, int *reused, int *other_si
 		float px = rng_f(&rng) * h->data.params->camera.width, py = rng_f(&rng) * h->data.params->camera.height;
 		int nl = bdpt_light_subpath(sc, l, depth, &rng);
 		int ne = bdpt_eye_subpath(sc, px, py, e, depth + 1, &rng);
-		BdptPnCache pc;
-		pc.have = 0;
+		BdptPnCache pc, pt;
+		pc.have = pt.have = 0;
+		pc.tails = 0;
+		bdpt_mis_tails(sc, l, nl, e, ne, &pt);
 		for (int t = 1; t <= ne; t++) {
-			for (int s = 1; s <= nl && s + t - 1 <= depth; s++) {
+			for (int s = t >= 2 ? 0 : 1; s <= nl && s + t - 1 <= depth; s++) {
 				PathVertex y;
 				const PathVertex *lp = l;
-				if (t == 1) {
-					if (vertex_infinite(&l[s - 1]) || (s == 1 && vertex_delta_light(&l[0])))
+				BdptConnPdf cp;
+				uint pixel;
+				if (s == 0) {
+					if (e[t - 1].type != VERTEX_ENV && sc->tris[e[t - 1].tri].emitter < 0)
+						continue;
+				} else if (t == 1) {
+					if (v3_is_zero(bdpt_to_camera_pdf(sc, &l[s - 1], s == 1, &e[0], &pixel, &cp)))
 						continue;
 				} else if (e[t - 1].type != VERTEX_SURFACE) {
 					break;
 				} else if (s == 1) {
-					if (v3_is_zero(bdpt_nee(sc, &e[t - 1], &e[t - 2], &y, &rng)))
+					if (v3_is_zero(bdpt_nee_conn(sc, &e[t - 1], &e[t - 2], &y, &rng, &cp)))
 						continue;
 					lp = &y;
-				} else if (v3_is_zero(bdpt_connect(sc, &l[s - 1], &e[t - 1]))) {
+				} else if (v3_is_zero(bdpt_connect_pdf(sc, &l[s - 1], &e[t - 1], &cp))) {
 					continue;
 				}
-				int had = pc.have;
+				int had = pc.have & 3;
 				if (s >= 2) {
 					const PathVertex *x2 = s >= 3 ? &l[2] : &e[t - 1];
 					int side = vertex_nee_side(&l[1], x2);
 					*reused += had >> side & 1;
 					*other_side += had && !(had >> side & 1);
 				}
-				float want = bdpt_weight(sc, lp, s, e, t), got = bdpt_weight_cached(sc, lp, s, e, t, &pc);
-				if (memcmp(&want, &got, sizeof got) != 0)
+				float want = bdpt_weight(sc, lp, s, e, t), got = bdpt_weight_cached(sc, lp, s, e, t, &pc, 0);
+				const BdptConnPdf *cpp = s > 0 ? &cp : NULL;
+				float fast = bdpt_weight_cached(sc, lp, s, e, t, &pt, cpp);
+				MisVertex rec[2 * SUBPATH_MAX];
+				BdptPnCache none = {{0.0f, 0.0f}, 0.0f, 0, 0};
+				int k = bdpt_mis_records(sc, lp, s, e, t, rec, 0, &none, 0, cpp);
+				float whole = mis_path_weight(rec, k, s, h->data.params->mis);
+				if (s > 0 && memcmp(&want, &got, sizeof got) != 0)
 					fail_msg("strategy (s=%d, t=%d) of sample %d: weight %.9g with the cache, %.9g without", s,
 						 t, n, got, want);
+				if (!(fabsf(fast - whole) <= *worst)) {
+					*worst = fabsf(fast - whole);
+					print_message("largest difference so far: strategy (s=%d, t=%d) of sample %d: %.9g "
+						      "from tails, %.9g from the whole path\n", s, t, n, fast, whole);
+				}
 				compared++;
 			}
 		}
@@ -379,7 +419,9 @@ static int check_pn_cache(HostScene *h, int nsamples, int *reused, int *other_si
  * room (light subpaths pass it, so one light subpath connects on both sides
  * of a vertex's normal), the glossy scene under a sky image, and door-ajar
  * (an emitter's pn_0). With the cache's side test replaced by side 0 the
- * first scene fails (weight 0.999907613 against 0.999906182). */
+ * first scene fails (weight 0.999907613 against 0.999906182); so does the
+ * tails' comparison with the light tail read one vertex off (s - 2 for
+ * s - 3) or the eye tail's delta test of e[a - 1] dropped. */
 static void test_pn_cache_same_bits(void **state)
 {
 	ajar_scene *s = sky_window_room();
@@ -404,9 +446,10 @@ static void test_pn_cache_same_bits(void **state)
 	assert_int_equal(ajar_scene_add_portal(s, &tilt), AJAR_OK);
 	HostScene h;
 	int reused = 0, other = 0;
+	float worst = 0.0f;
 	host_scene_open(&h, NULL, s, 24, 24, INTEGRATOR_BDPT, 8);
 	assert_true(h.data.params->num_portals == 4 && h.data.params->env_type == ENV_IMAGE);
-	assert_true(check_pn_cache(&h, 400, &reused, &other) > 2000);
+	assert_true(check_pn_cache(&h, 400, &reused, &other, &worst) > 2000);
 	host_scene_close(&h);
 	assert_true(reused > 500);
 	assert_true(other > 20);
@@ -415,12 +458,14 @@ static void test_pn_cache_same_bits(void **state)
 	float *sky = test_sun_sky(128, 64, 0.3f, 0.8f, 0.5f, 0.05f, 500.0f);
 	assert_int_equal(scene_set_env_image(g, 128, 64, sky, 1.0f), AJAR_OK);
 	host_scene_open(&h, NULL, g, 24, 24, INTEGRATOR_BDPT, 8);
-	assert_true(check_pn_cache(&h, 400, &reused, &other) > 300);
+	assert_true(check_pn_cache(&h, 400, &reused, &other, &worst) > 300);
 	host_scene_close(&h);
 
 	host_scene_open(&h, SCENE("door-ajar/door-ajar.gltf"), NULL, 24, 24, INTEGRATOR_BDPT, 8);
-	assert_true(check_pn_cache(&h, 400, &reused, &other) > 500);
+	assert_true(check_pn_cache(&h, 1200, &reused, &other, &worst) > 300);
 	host_scene_close(&h);
+	/* float rounding: the sums are associated differently (1.8e-7 seen) */
+	assert_true(worst <= 2e-6f);
 }
 
 /* ---- Convergence ------------------------------------------------------- */
