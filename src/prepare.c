@@ -241,12 +241,13 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	 * portals) do their work, and the portal integrator leaves them out.
 	 * A sky image's light subpaths start on the portals (kernels/lights.h,
 	 * line_sample): measured better per CPU second on window-room-forest
-	 * and living-room-forest, whose sky has a compact sun, and worse on
-	 * window-room-sunset (a low, dim sun) and under that forest sky with
-	 * its sun clipped (kernels/sky_measurements.md, "Sky light subpaths through the
-	 * portals"), so on for sky images whose brightest 0.1% of solid angle
-	 * carries at least SKY_SUN_SHARE of their power (src/lights.c,
-	 * env_sun_share: 0.13, 0.03 and 0.01 there). */
+	 * and living-room-forest, whose sky has a compact sun, and on
+	 * window-room-sunset (a low, dim sun), and even with portal's own
+	 * strategies under that forest sky with its sun clipped
+	 * (kernels/sky_measurements.md, "Sky light subpaths through the
+	 * portals" and "Weights from tails"), so on for sky images whose
+	 * brightest 0.1% of solid angle carries at least SKY_SUN_SHARE of their
+	 * power (src/lights.c, env_sun_share: 0.13, 0.03 and 0.01 there). */
 	int sky_image_lines = p->integrator == INTEGRATOR_PORTAL && s->env_type == ENV_IMAGE && s->nportal_tris > 0 &&
 			      d->lights.env_sun_share >= SKY_SUN_SHARE;
 	p->light_paths = p->integrator != INTEGRATOR_PORTAL || p->num_emitters > 0 || p->num_lights > 0 || sky_image_lines;

@@ -36,10 +36,12 @@ typedef struct {
 /* Scenes lit only by a sky image, sampled through planar portals. */
 #define PORTAL_RATE_SKY_IMAGE 0.3f
 /* The sun's share of a sky image's power (src/lights.c, env_sun_share)
- * from which portal traces the sky's light subpaths (through the portals):
- * between window-room-sunset's 0.03, where they lost, and
- * window-room-forest's 0.13, where they won (kernels/sky_measurements.md). */
-#define SKY_SUN_SHARE 0.06f
+ * from which portal traces the sky's light subpaths (through the portals),
+ * and so renders as bdpt: between an overcast sky's 0.01, where bdpt and
+ * portal without them were even, and window-room-sunset's 0.03, where
+ * bdpt won by 1.3-1.4x once its weights read the subpaths' MIS tails
+ * (kernels/sky_measurements.md, "Weights from tails"; 0.06 before). */
+#define SKY_SUN_SHARE 0.02f
 
 ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *out);
 void prepare_free(SceneData *d);
