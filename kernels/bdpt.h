@@ -557,10 +557,10 @@ CALLED void bdpt_light_to_camera(const SceneView *sc, VCRef l, int s, VCRef cam_
 	uint pixel;
 	VTMP(yt);
 	VTMP(ct);
-	BdptConnPdf cp;
-	V3 c = bdpt_to_camera_pdf(sc, VLOAD(VAT(l, s - 1), yt), s == 1, VLOAD(cam_v, ct), &pixel, &cp);
+	BdptConnPdf cp, *cpp = pc->tails ? &cp : 0;
+	V3 c = bdpt_to_camera_pdf(sc, VLOAD(VAT(l, s - 1), yt), s == 1, VLOAD(cam_v, ct), &pixel, cpp);
 	if (!v3_is_zero(c))
-		bdpt_add(sc, out, s, 1, c, bdpt_weight_cached(sc, l, s, cam_v, 1, pc, &cp), pixel, rng);
+		bdpt_add(sc, out, s, 1, c, bdpt_weight_cached(sc, l, s, cam_v, 1, pc, cpp), pixel, rng);
 }
 
 /* Traces the eye subpath through raster point (px, py) into e[]; e[0] is
@@ -650,8 +650,13 @@ CALLED void bdpt_strategies(const SceneView *sc, VRef l, int nl, VRef e, int ne,
 {
 	int depth = sc->params->max_depth;
 	BdptPnCache pc;
-	pc.have = 0;
-	bdpt_mis_tails(sc, l, nl, e, ne, &pc);
+	pc.have = pc.tails = 0;
+	/* The tails and the connections' densities serve bdpt's own weights;
+	 * portal without light subpaths weighs by the union (path_mis.h) and
+	 * would only pay for them. */
+	if (sc->params->light_paths)
+		bdpt_mis_tails(sc, l, nl, e, ne, &pc);
+	BdptConnPdf cp, *cpp = pc.tails ? &cp : 0;
 
 	/* t = 1: every light vertex to the camera. */
 	for (int s = 1; s <= nl && s <= depth; s++)
@@ -677,21 +682,19 @@ CALLED void bdpt_strategies(const SceneView *sc, VRef l, int nl, VRef e, int ne,
 		/* s = 1: next-event estimation with a fresh light sample. */
 		{
 			PathVertex y;
-			BdptConnPdf cp;
-			V3 c = bdpt_nee_conn(sc, z, VLOAD(VAT(e, t - 2), ft), &y, rng, &cp);
+			V3 c = bdpt_nee_conn(sc, z, VLOAD(VAT(e, t - 2), ft), &y, rng, cpp);
 			if (!v3_is_zero(c))
-				bdpt_add(sc, out, 1, t, c, bdpt_weight_cached(sc, VNEE(e, y), 1, e, t, &pc, &cp),
+				bdpt_add(sc, out, 1, t, c, bdpt_weight_cached(sc, VNEE(e, y), 1, e, t, &pc, cpp),
 					 out->pixel, rng);
 		}
 		/* s >= 2: light vertex s-1 to eye vertex t-1. */
 		for (int s = 2; s <= nl && s + t - 1 <= depth; s++) {
 			const PathVertex *ly = VLOAD(VAT(l, s - 1), lt);
-			BdptConnPdf cp;
-			V3 c = bdpt_connect_pdf(sc, ly, z, &cp);
+			V3 c = bdpt_connect_pdf(sc, ly, z, cpp);
 			if (v3_is_zero(c))
 				continue;
 			bdpt_add(sc, out, s, t, v3_mul(v3_mul(ly->beta, c), z->beta),
-				 bdpt_weight_cached(sc, l, s, e, t, &pc, &cp), out->pixel, rng);
+				 bdpt_weight_cached(sc, l, s, e, t, &pc, cpp), out->pixel, rng);
 		}
 	}
 }
