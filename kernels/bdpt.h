@@ -192,14 +192,14 @@ INLINE int bdpt_mis_path(const SceneView *sc, VCRef l, int s, VCRef e, int t, Mi
 INLINE float bdpt_path_weight(const SceneView *sc, VCRef l, int s, VCRef e, int t, MisVertex *mv, int nee_stored,
 			      BdptPnCache *pc, const BdptConnPdf *cp)
 {
-	int heuristic = sc->params->mis;
+	int heuristic = sc->params->mis, conn = sc->params->bdpt_conn;
 	if (!(pc && pc->tails)) {
 		int k = bdpt_mis_records(sc, l, s, e, t, mv, nee_stored, pc, 0, 0);
-		return mis_path_weight(mv, k, s, heuristic);
+		return mis_path_weight_conn(mv, k, s, heuristic, conn);
 	}
 	int k = bdpt_mis_records(sc, l, s, e, t, mv, nee_stored, pc, 1, cp);
 	float ltail = s >= 3 ? VGETF(VAT(l, s - 3), tail) : 0.0f, etail = t >= 4 ? VGETF(VAT(e, t - 3), tail) : 0.0f;
-	return mis_path_weight_tails(mv, k, s, heuristic, ltail, etail);
+	return mis_path_weight_tails(mv, k, s, heuristic, conn, ltail, etail);
 }
 
 /* Every vertex's MIS tail (mis.h) for the weights of bdpt_strategies:
@@ -208,7 +208,7 @@ INLINE float bdpt_path_weight(const SceneView *sc, VCRef l, int s, VCRef e, int 
  * s >= 3, where x_1, x_2 are l[1], l[2]; pn_0 through the cache. */
 INLINE void bdpt_mis_tails(const SceneView *sc, VRef l, int nl, VRef e, int ne, BdptPnCache *pc)
 {
-	int heuristic = sc->params->mis;
+	int heuristic = sc->params->mis, conn = sc->params->bdpt_conn;
 	MisVertex mv[SUBPATH_MAX];
 	float A[SUBPATH_MAX];
 	if (nl >= 3) {
@@ -216,7 +216,7 @@ INLINE void bdpt_mis_tails(const SceneView *sc, VRef l, int nl, VRef e, int ne, 
 			bdpt_record(&mv[i], VAT(l, i));
 		mv[0].delta = VREF_DELTA_LIGHT(VAT(l, 0));
 		bdpt_records_x0(sc, l, 3, e, 1, mv, 0, pc);
-		mis_light_tails(mv, nl - 2, heuristic, A);
+		mis_light_tails(mv, nl - 2, heuristic, conn, A);
 		for (int m = 0; m < nl - 2; m++)
 			VSETF(VAT(l, m), tail, A[m]);
 	}
@@ -225,7 +225,7 @@ INLINE void bdpt_mis_tails(const SceneView *sc, VRef l, int nl, VRef e, int ne, 
 		bdpt_record(&mv[0], VAT(e, 0));
 	for (int a = 1; a <= ne - 3; a++) {
 		bdpt_record(&mv[a], VAT(e, a));
-		b = mis_eye_tail(mv, a, heuristic, b);
+		b = mis_eye_tail(mv, a, heuristic, conn, b);
 		VSETF(VAT(e, a), tail, b);
 	}
 	pc->tails = 1;
@@ -648,7 +648,7 @@ INLINE V3 bdpt_nee(const SceneView *sc, const PathVertex *z, const PathVertex *f
  * strategies to out->L and splats light tracing (t = 1). */
 CALLED void bdpt_strategies(const SceneView *sc, VRef l, int nl, VRef e, int ne, BdptFilm *out, Rng *rng)
 {
-	int depth = sc->params->max_depth;
+	int depth = sc->params->max_depth, conn = sc->params->bdpt_conn;
 	BdptPnCache pc;
 	pc.have = pc.tails = 0;
 	/* The tails and the connections' densities serve bdpt's own weights;
@@ -687,8 +687,9 @@ CALLED void bdpt_strategies(const SceneView *sc, VRef l, int nl, VRef e, int ne,
 				bdpt_add(sc, out, 1, t, c, bdpt_weight_cached(sc, VNEE(e, y), 1, e, t, &pc, cpp),
 					 out->pixel, rng);
 		}
-		/* s >= 2: light vertex s-1 to eye vertex t-1. */
-		for (int s = 2; s <= nl && s + t - 1 <= depth; s++) {
+		/* s >= 2: light vertex s-1 to eye vertex t-1, up to s = conn
+		 * (mis.h, mis_conn_in_set). */
+		for (int s = 2; s <= nl && s + t - 1 <= depth && (conn == 0 || s <= conn); s++) {
 			const PathVertex *ly = VLOAD(VAT(l, s - 1), lt);
 			V3 c = bdpt_connect_pdf(sc, ly, z, cpp);
 			if (v3_is_zero(c))

@@ -46,6 +46,7 @@
 	X(PunctualLight, cos_outer) X(PunctualLight, cone_scale)                       \
 	X(PunctualLight, disk_radius)                                                  \
 	X(Params, num_portal_planes) X(Params, env_rot_cos) X(Params, env_rot_sin)     \
+	X(Params, bdpt_conn)                                                           \
 	X(PortalPlane, o) X(PortalPlane, a0) X(PortalPlane, t) X(PortalPlane, n)      \
 	X(PortalPlane, b1) X(PortalPlane, table) X(PortalPlane, guide)
 #endif

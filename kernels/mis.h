@@ -54,13 +54,22 @@ INLINE float mis_remap0(float p) { return p > 0.0f ? p : 1.0f; }
 
 INLINE float mis_term(float r, int heuristic) { return heuristic == MIS_BALANCE ? r : r * r; }
 
+/* Which bdpt strategies are in use: all (conn = 0), or light tracing
+ * (t = 1, s = k - 1) with every light vertex and the other strategies with
+ * at most conn light vertices (s <= conn; conn is 1 or 2, which the tails
+ * below need): the portal integrator's set where light subpaths bring the
+ * light in (src/prepare.c, kernels/sky_measurements.md, "Connections to
+ * the first light vertices"). */
+INLINE int mis_conn_in_set(int conn, int k, int s) { return conn == 0 || s <= conn || s == k - 1; }
+
 /* The sum behind mis_path_weight and mis_path_weight_tails: the eye
  * side's terms for x_s .. x_{eye_hi - 1} moving to the light side, then
  * `etail` times the last ratio if eye_hi < k - 1 (the terms beyond); the
  * light side's for x_{s-1} down to x_{light_lo}, then `ltail` likewise if
- * light_lo > 0. x_0's records are read only where the walk reaches x_1. */
-INLINE float mis_path_sum(const MisVertex *v, int k, int s, int heuristic, int eye_hi, int light_lo, float ltail,
-			  float etail)
+ * light_lo > 0; over the strategies of `conn` (mis_conn_in_set). x_0's
+ * records are read only where the walk reaches x_1. */
+INLINE float mis_path_sum(const MisVertex *v, int k, int s, int heuristic, int conn, int eye_hi, int light_lo,
+			  float ltail, float etail)
 {
 	/* x_0's density is pn for s' = 1 and pf for s' >= 2. */
 	float pn_pf = light_lo <= 1 ? mis_remap0(v[0].pn) / mis_remap0(v[0].pf) : 1.0f;
@@ -71,7 +80,7 @@ INLINE float mis_path_sum(const MisVertex *v, int k, int s, int heuristic, int e
 		else
 			r *= mis_remap0(v[i].pf) / mis_remap0(v[i].pr) / (i == 1 ? pn_pf : 1.0f);
 		if ((i == 0 || !v[i].delta) && !v[i + 1].delta &&
-		    !((v[i].infinite || v[i].delta) && i + 1 == k - 1))
+		    !((v[i].infinite || v[i].delta) && i + 1 == k - 1) && mis_conn_in_set(conn, k, i + 1))
 			sum += mis_term(r, heuristic);
 	}
 	if (eye_hi < k - 1)
@@ -82,7 +91,7 @@ INLINE float mis_path_sum(const MisVertex *v, int k, int s, int heuristic, int e
 			r *= mis_remap0(v[0].pr) / mis_remap0(v[0].pn);
 		else
 			r *= mis_remap0(v[i].pr) / mis_remap0(v[i].pf) * (i == 1 ? pn_pf : 1.0f);
-		if (!v[i].delta && (i <= 1 || !v[i - 1].delta))
+		if (!v[i].delta && (i <= 1 || !v[i - 1].delta) && mis_conn_in_set(conn, k, i))
 			sum += mis_term(r, heuristic);
 	}
 	if (light_lo > 0)
@@ -96,7 +105,13 @@ INLINE float mis_path_sum(const MisVertex *v, int k, int s, int heuristic, int e
  * x_{s'-1} and x_{s'}; s' = 0 means the eye subpath hit the light. */
 CALLED float mis_path_weight(const MisVertex *v, int k, int s, int heuristic)
 {
-	return 1.0f / mis_path_sum(v, k, s, heuristic, k - 1, 0, 0.0f, 0.0f);
+	return 1.0f / mis_path_sum(v, k, s, heuristic, 0, k - 1, 0, 0.0f, 0.0f);
+}
+
+/* The same over the strategies of `conn` (mis_conn_in_set; s among them). */
+INLINE float mis_path_weight_conn(const MisVertex *v, int k, int s, int heuristic, int conn)
+{
+	return 1.0f / mis_path_sum(v, k, s, heuristic, conn, k - 1, 0, 0.0f, 0.0f);
 }
 
 /* ---- The same weight from the connection's neighbourhood and two tails ----
@@ -115,14 +130,16 @@ CALLED float mis_path_weight(const MisVertex *v, int k, int s, int heuristic)
  * tells) of prod_{j=i..m} q_j^beta, q_j = pr_j / pf_j (pr_0 / pn_0 and
  * the pn_0 / pf_0 of q_1 as there). Recurrence A_m = q_m^beta ([valid_m]
  * + A_{m-1}), A_{-1} = 0; v[0..n-1] are the light subpath's records (x_0's
- * delta: a punctual light). */
-INLINE void mis_light_tails(const MisVertex *v, int n, int heuristic, float *A)
+ * delta: a punctual light). With conn (1 or 2) only the terms of s' = i <=
+ * conn count: a strategy that reads A_m has s >= m + 3 > conn light
+ * vertices, so it is light tracing, and the tail's s' are all below it. */
+INLINE void mis_light_tails(const MisVertex *v, int n, int heuristic, int conn, float *A)
 {
 	float pn_pf = mis_remap0(v[0].pn) / mis_remap0(v[0].pf), a = 0.0f;
 	for (int m = 0; m < n; m++) {
 		float q = m == 0 ? mis_remap0(v[0].pr) / mis_remap0(v[0].pn)
 				 : mis_remap0(v[m].pr) / mis_remap0(v[m].pf) * (m == 1 ? pn_pf : 1.0f);
-		int valid = !v[m].delta && (m <= 1 || !v[m - 1].delta);
+		int valid = !v[m].delta && (m <= 1 || !v[m - 1].delta) && (conn == 0 || m <= conn);
 		a = mis_term(q, heuristic) * ((valid ? 1.0f : 0.0f) + a);
 		A[m] = a;
 	}
@@ -132,20 +149,25 @@ INLINE void mis_light_tails(const MisVertex *v, int n, int heuristic, float *A)
  * with t >= a + 3, from the one at a - 1 (`prev`; 0 at a = 1): B_a =
  * u_a^beta ([valid_a] + B_{a-1}), u_a = pf / pr of e[a]; valid_a: neither
  * e[a] nor e[a-1] scattered by a delta lobe, and e[1] joins the camera
- * only from a surface. v[a] holds e[a]'s record. */
-INLINE float mis_eye_tail(const MisVertex *v, int a, int heuristic, float prev)
+ * only from a surface. v[a] holds e[a]'s record. With conn (1 or 2) only
+ * light tracing (a = 1) counts: the strategy of a >= 2 eye vertices that
+ * a strategy with t >= a + 3 reads here has s' >= s + 3 > conn light
+ * vertices. */
+INLINE float mis_eye_tail(const MisVertex *v, int a, int heuristic, int conn, float prev)
 {
 	float u = mis_remap0(v[a].pf) / mis_remap0(v[a].pr);
-	int valid = !v[a].delta && !v[a - 1].delta && !(a == 1 && v[a].infinite);
+	int valid = !v[a].delta && !v[a - 1].delta && !(a == 1 && v[a].infinite) && (conn == 0 || a == 1);
 	return mis_term(u, heuristic) * ((valid ? 1.0f : 0.0f) + prev);
 }
 
-/* mis_path_weight with v[] filled at x_{s-3} .. x_{s+2} (those that exist;
- * x_0 too when s <= 3) and the tails beyond: `etail` the eye tail B_{t-3}
- * (read when t >= 4), `ltail` the light tail A_{s-3} (read when s >= 3). */
-INLINE float mis_path_weight_tails(const MisVertex *v, int k, int s, int heuristic, float ltail, float etail)
+/* mis_path_weight_conn with v[] filled at x_{s-3} .. x_{s+2} (those that
+ * exist; x_0 too when s <= 3) and the tails beyond, made with the same
+ * conn: `etail` the eye tail B_{t-3} (read when t >= 4), `ltail` the light
+ * tail A_{s-3} (read when s >= 3). */
+INLINE float mis_path_weight_tails(const MisVertex *v, int k, int s, int heuristic, int conn, float ltail,
+				   float etail)
 {
-	return 1.0f / mis_path_sum(v, k, s, heuristic, min(k - 1, s + 2), max(0, s - 2), ltail, etail);
+	return 1.0f / mis_path_sum(v, k, s, heuristic, conn, min(k - 1, s + 2), max(0, s - 2), ltail, etail);
 }
 
 /* ---- BDPT and intermediate-subpath strategies together (design.md) ----

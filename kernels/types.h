@@ -232,7 +232,9 @@ typedef struct {
 	int num_portal_planes;  /* 216, planar portals with sky tables (env_portal.h), 0 = none */
 	float env_rot_cos;      /* cos and sin of env_rotation, from the host in double */
 	float env_rot_sin;      /* 224 (env.h, env_turn) */
-	int pad2, pad3, pad4;
+	int bdpt_conn;          /* bdpt strategies other than light tracing use at most this many
+	                         * light vertices (1 or 2; 0 = any; mis.h, mis_conn_in_set) */
+	int pad3, pad4;
 } Params; /* 240 */
 
 /* Layout of the float array `env`: for an ENV_IMAGE of W x H,

@@ -302,10 +302,29 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	 * there, sample for sample (kernels/sky_measurements.md, "Where light
 	 * subpaths come in, portal is bdpt"). An explicit AJAR_PORTAL_SET keeps
 	 * the intermediate subpaths. */
+	p->bdpt_conn = 0;
 	if (p->integrator == INTEGRATOR_PORTAL && p->light_paths && !long_set && !set_given) {
+		/* ... with the strategies other than light tracing joining eye
+		 * vertices to the first PORTAL_BDPT_CONN light vertices only
+		 * (kernels/mis.h, mis_conn_in_set): the rest cost a third of the
+		 * time and lowered no variance on window-room-sunset and -forest
+		 * (kernels/sky_measurements.md, "Connections to the first light
+		 * vertices"). */
 		p->integrator = INTEGRATOR_BDPT;
-		log_msg(AJAR_LOG_INFO, "%s: light subpaths bring the light in through the portals; portal renders as bdpt",
-			s->source ? s->source : "scene");
+		p->bdpt_conn = PORTAL_BDPT_CONN;
+		log_msg(AJAR_LOG_INFO,
+			"%s: light subpaths bring the light in through the portals; portal renders as bdpt, connecting "
+			"eye vertices to the first %d light vertices",
+			s->source ? s->source : "scene", PORTAL_BDPT_CONN);
+	}
+	/* AJAR_BDPT_CONN=0, 1 or 2 sets it for bdpt (0: every strategy), for
+	 * comparisons and tests. */
+	const char *conn = getenv("AJAR_BDPT_CONN");
+	if (conn && p->integrator == INTEGRATOR_BDPT) {
+		if (strcmp(conn, "0") == 0 || strcmp(conn, "1") == 0 || strcmp(conn, "2") == 0)
+			p->bdpt_conn = conn[0] - '0';
+		else
+			log_msg(AJAR_LOG_WARNING, "AJAR_BDPT_CONN='%s' is not 0, 1 or 2; ignored", conn);
 	}
 	p->emitter_power = d->lights.emitter_power;
 	p->env_power = d->lights.env_power;

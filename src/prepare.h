@@ -42,6 +42,12 @@ typedef struct {
  * bdpt won by 1.3-1.4x once its weights read the subpaths' MIS tails
  * (kernels/sky_measurements.md, "Weights from tails"; 0.06 before). */
 #define SKY_SUN_SHARE 0.02f
+/* Where portal renders as bdpt (light subpaths bring the light in), its
+ * strategies other than light tracing use at most this many light
+ * vertices (Params.bdpt_conn): 2, measured against 1 and all
+ * (kernels/sky_measurements.md, "Connections to the first light
+ * vertices"). */
+#define PORTAL_BDPT_CONN 2
 
 ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *out);
 void prepare_free(SceneData *d);

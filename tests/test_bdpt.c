@@ -115,13 +115,21 @@ static int check_mis(HostScene *h, int nsamples)
 								 orc[i].delta);
 					}
 				}
-				for (int heur = 0; heur < 2; heur++) {
-					double sum = 0;
-					for (int s2 = 0; s2 < k; s2++)
-						if (strategy_valid(orc, k, s2))
-							sum += mis_path_weight(orc, k, s2, heur);
-					if (fabs(sum - 1) > 1e-4)
-						fail_msg("strategy (%d,%d): weights sum to %.7f (heuristic %d)", s, t, sum, heur);
+				/* over every strategy, and over the sets that connect eye
+				 * vertices to the first 1 or 2 light vertices only */
+				for (int conn = 0; conn <= 2; conn++) {
+					if (!mis_conn_in_set(conn, k, s))
+						continue;
+					for (int heur = 0; heur < 2; heur++) {
+						double sum = 0;
+						for (int s2 = 0; s2 < k; s2++)
+							if (strategy_valid(orc, k, s2) && mis_conn_in_set(conn, k, s2))
+								sum += mis_path_weight_conn(orc, k, s2, heur, conn);
+						if (fabs(sum - 1) > 1e-4)
+							fail_msg("strategy (%d,%d): weights sum to %.7f (heuristic %d, "
+								 "connections to %d light vertices)",
+								 s, t, sum, heur, conn);
+					}
 				}
 				checked++;
 				for (int i = 0; i < k; i++)
@@ -352,7 +360,7 @@ static void test_mis_sky_image_portal(void **state)
 static int check_pn_cache(HostScene *h, int nsamples, int *reused, int *other_side, float *worst)
 {
 	SceneView *sc = &h->view;
-	int depth = h->data.params->max_depth, compared = 0;
+	int depth = h->data.params->max_depth, compared = 0, conn = h->data.params->bdpt_conn;
 	PathVertex l[SUBPATH_MAX], e[SUBPATH_MAX];
 	for (int n = 0; n < nsamples; n++) {
 		Rng rng = rng_init(97, (uint)n, 0, 7);
@@ -365,6 +373,8 @@ static int check_pn_cache(HostScene *h, int nsamples, int *reused, int *other_si
 		bdpt_mis_tails(sc, l, nl, e, ne, &pt);
 		for (int t = 1; t <= ne; t++) {
 			for (int s = t >= 2 ? 0 : 1; s <= nl && s + t - 1 <= depth; s++) {
+				if (!mis_conn_in_set(conn, s + t, s))
+					continue; /* not among the strategies bdpt_strategies takes */
 				PathVertex y;
 				const PathVertex *lp = l;
 				BdptConnPdf cp;
@@ -397,7 +407,7 @@ static int check_pn_cache(HostScene *h, int nsamples, int *reused, int *other_si
 				MisVertex rec[2 * SUBPATH_MAX];
 				BdptPnCache none = {{0.0f, 0.0f}, 0.0f, 0, 0};
 				int k = bdpt_mis_records(sc, lp, s, e, t, rec, 0, &none, 0, cpp);
-				float whole = mis_path_weight(rec, k, s, h->data.params->mis);
+				float whole = mis_path_weight_conn(rec, k, s, h->data.params->mis, conn);
 				if (s > 0 && memcmp(&want, &got, sizeof got) != 0)
 					fail_msg("strategy (s=%d, t=%d) of sample %d: weight %.9g with the cache, %.9g without", s,
 						 t, n, got, want);
@@ -466,6 +476,32 @@ static void test_pn_cache_same_bits(void **state)
 	host_scene_close(&h);
 	/* float rounding: the sums are associated differently (1.8e-7 seen) */
 	assert_true(worst <= 2e-6f);
+}
+
+/* With the eye vertices joined to the first 1 or 2 light vertices only
+ * (Params.bdpt_conn, the portal integrator's set under a sun; light
+ * tracing keeps every light vertex), the weights from the tails made for
+ * that set equal the whole path's over it. With the set test taken out of
+ * mis_eye_tail the sky room fails (s = 1, t = 8: 0.90 from the tails
+ * against 0.999), and with it taken out of mis_light_tails (s = 8, t = 1:
+ * 0.006 against 0.996). */
+static void test_conn_weights_from_tails(void **state)
+{
+	for (int conn = 1; conn <= 2; conn++) {
+		HostScene h;
+		int reused = 0, other = 0;
+		float worst = 0.0f;
+		host_scene_open(&h, NULL, sky_window_room(), 24, 24, INTEGRATOR_BDPT, 8);
+		h.data.params->bdpt_conn = conn;
+		assert_true(check_pn_cache(&h, 400, &reused, &other, &worst) > 1000);
+		host_scene_close(&h);
+		host_scene_open(&h, SCENE("door-ajar/door-ajar.gltf"), NULL, 24, 24, INTEGRATOR_BDPT, 8);
+		h.data.params->bdpt_conn = conn;
+		assert_true(check_pn_cache(&h, 5000, &reused, &other, &worst) > 300);
+		host_scene_close(&h);
+		print_message("connections to %d light vertices: largest difference %.3g\n", conn, worst);
+		assert_true(worst <= 2e-6f);
+	}
 }
 
 /* ---- Convergence ------------------------------------------------------- */
@@ -618,6 +654,32 @@ static void test_bdpt_matches_pt_sun_portal(void **state)
 	host_scene_close(&hp);
 }
 
+/* The smaller sets of bdpt_conn against pt, under the sun lamp and under a
+ * sky image with a sun: what they leave out, the other strategies' weights
+ * take up. */
+static void test_conn_matches_pt(void **state)
+{
+	for (int sky = 0; sky < 2; sky++) {
+		HostScene hp;
+		Estimate p;
+		host_scene_open(&hp, NULL, sky ? sky_window_room() : sun_window_room(0), 12, 12, INTEGRATOR_PT, 6);
+		batch_estimate(&hp, sky ? 128 : 16, -1, &p);
+		for (int conn = 1; conn <= 2; conn++) {
+			HostScene hb;
+			Estimate b;
+			char what[96];
+			host_scene_open(&hb, NULL, sky ? sky_window_room() : sun_window_room(0), 12, 12, INTEGRATOR_BDPT, 6);
+			hb.data.params->bdpt_conn = conn;
+			batch_estimate(&hb, 8, -1, &b);
+			snprintf(what, sizeof what, "%s, bdpt joining eye vertices to %d light vertices vs pt",
+				 sky ? "window room under a sky image" : "window room lit by the sun", conn);
+			assert_agree(what, &b, &p, 5.0);
+			host_scene_close(&hb);
+		}
+		host_scene_close(&hp);
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -632,9 +694,11 @@ int main(void)
 		cmocka_unit_test(test_mis_sun_portal),
 		cmocka_unit_test(test_mis_sky_image_portal),
 		cmocka_unit_test(test_pn_cache_same_bits),
+		cmocka_unit_test(test_conn_weights_from_tails),
 		cmocka_unit_test(test_strategies_unbiased_punctual),
 		cmocka_unit_test(test_bdpt_matches_pt_punctual),
 		cmocka_unit_test(test_bdpt_matches_pt_sun_portal),
+		cmocka_unit_test(test_conn_matches_pt),
 	};
 	return cmocka_run_group_tests_name("bdpt", tests, NULL, NULL);
 }

@@ -1172,6 +1172,8 @@ static void test_portal_as_bdpt(void **state)
 				 cases[i].integrator, cases[i].long_set ? "the long set" : "the sky's");
 		if (cases[i].long_set)
 			assert_float_equal(p->portal_rate, 1.0f, 0.0f);
+		/* as bdpt, eye vertices join the first light vertices only */
+		assert_int_equal(p->bdpt_conn, p->integrator == INTEGRATOR_BDPT ? PORTAL_BDPT_CONN : 0);
 		host_scene_close(&h);
 	}
 	setenv("AJAR_PORTAL_SET", "1,2,1,3,1", 1);
