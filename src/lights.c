@@ -171,10 +171,13 @@ static ajar_status build_emitters(const Scene *s, Tri *tris, const TriShade *sha
  * its 99th percentile clipped (overcast-like) 0.01. The brightest texels
  * are found by a histogram of luminance in 1/16-octave bins below the
  * maximum, the last bin taken in proportion, so the cost is two passes
- * over the image. src/prepare.c reads it (portal's light subpaths). */
+ * over the image. With a weight per texel the same texels are the sun,
+ * and the shares are of the weighted power (src/portal_flux.c: of the
+ * power that comes in through the portals; src/prepare.c reads that for
+ * portal's light subpaths). */
 #define SUN_SOLID_ANGLE_SHARE 0.001
 #define SUN_BINS 640 /* 40 octaves */
-static float env_sun_share(const float *pix, uint32_t w, uint32_t h)
+float env_sun_share_weighted(const float *pix, uint32_t w, uint32_t h, EnvTexelWeight weight, void *ctx)
 {
 	double sa[SUN_BINS] = {0}, pw[SUN_BINS] = {0}, sa_all = 0.0, pw_all = 0.0;
 	float max_lum = 0.0f;
@@ -193,9 +196,10 @@ static float env_sun_share(const float *pix, uint32_t w, uint32_t h)
 				continue;
 			double b = (top - log2(lum)) * 16.0;
 			int k = b < SUN_BINS - 1 ? (int)b : SUN_BINS - 1;
+			double p_t = weight ? lum * sin_theta * weight(x, y, ctx) : lum * sin_theta;
 			sa[k] += sin_theta;
-			pw[k] += lum * sin_theta;
-			pw_all += lum * sin_theta;
+			pw[k] += p_t;
+			pw_all += p_t;
 		}
 	}
 	double need = SUN_SOLID_ANGLE_SHARE * sa_all, got = 0.0;
@@ -240,7 +244,7 @@ static ajar_status build_env_image(const Scene *s, LightTables *out, double *avg
 	cdf_build(out->env + ENV_MARGINAL(w, h), rows, h, 1);
 	/* Each texel spans (2 pi / w) x (pi / h) in (phi, theta). */
 	*avg_lum = sum * (2.0 * AJAR_PI / w) * (AJAR_PI / h) / (4.0 * AJAR_PI);
-	out->env_sun_share = env_sun_share(pix, w, h);
+	out->env_sun_share = env_sun_share_weighted(pix, w, h, NULL, NULL);
 	free(wt);
 	free(rows);
 	return AJAR_OK;

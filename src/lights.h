@@ -50,6 +50,12 @@ ajar_status lights_build(const Scene *s, Tri *tris, const TriShade *shade, const
 			 LightTables *out);
 void lights_free(LightTables *t);
 
+/* The share of an equirect sky's power (w x h RGB pixels) in its brightest
+ * 0.1% of solid angle, each texel's power times weight(x, y, ctx) when
+ * weight is not NULL (src/lights.c). */
+typedef double (*EnvTexelWeight)(uint32_t x, uint32_t y, void *ctx);
+float env_sun_share_weighted(const float *pix, uint32_t w, uint32_t h, EnvTexelWeight weight, void *ctx);
+
 /* Params.env_rotation and the cos and sin that kernels/env.h turns by,
  * computed here in double so that every device reads the same floats. */
 void lights_set_env_rotation(Params *p, float radians);

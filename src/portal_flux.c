@@ -120,3 +120,50 @@ ajar_status portal_flux_build(const SceneView *sc, PortalTri *portals, uint32_t 
 	free(flux);
 	return AJAR_OK;
 }
+
+/* The sun's share of the sky's power that comes in through the portals:
+ * each texel of the sky image weighted by the portals' area projected
+ * toward it from the side they see the sky through (env_side), so a sun
+ * behind the wall, or low along it, counts for nothing or little. Walls
+ * and eaves outside are not traced: the weight is geometric. It varies
+ * smoothly, so it is evaluated at the centres of a grid of at most
+ * SUN_GRID_W x SUN_GRID_H cells (cost: cells x portal triangles). */
+#define SUN_GRID_W 256
+#define SUN_GRID_H 128
+typedef struct {
+	const float *cell;
+	uint32_t w, h, gw, gh;
+} SunGrid;
+
+static double projected_area(uint32_t x, uint32_t y, void *ctx)
+{
+	const SunGrid *g = ctx;
+	return g->cell[(size_t)(y * g->gh / g->h) * g->gw + x * g->gw / g->w];
+}
+
+float portal_sun_share(const SceneView *sc, const PortalTri *portals, uint32_t n)
+{
+	GLOBAL const Params *prm = sc->params;
+	if (prm->env_type != ENV_IMAGE || n == 0)
+		return 0.0f;
+	SunGrid g = {NULL, (uint32_t)prm->env_width, (uint32_t)prm->env_height, 0, 0};
+	g.gw = g.w < SUN_GRID_W ? g.w : SUN_GRID_W;
+	g.gh = g.h < SUN_GRID_H ? g.h : SUN_GRID_H;
+	float *cell = malloc(sizeof(float) * g.gw * g.gh);
+	if (!cell)
+		return 0.0f;
+	for (uint32_t j = 0; j < g.gh; j++)
+		for (uint32_t i = 0; i < g.gw; i++) {
+			V3 d = env_dir(prm, (i + 0.5f) / g.gw, (j + 0.5f) / g.gh);
+			double a = 0.0;
+			for (uint32_t k = 0; k < n; k++) {
+				float c = v3_dot(d, portals[k].n) * (float)portals[k].env_side;
+				a += c > 0.0f ? portals[k].area * c : 0.0;
+			}
+			cell[(size_t)j * g.gw + i] = (float)a;
+		}
+	g.cell = cell;
+	float share = env_sun_share_weighted(sc->env + ENV_PIXELS(g.w, g.h), g.w, g.h, projected_area, &g);
+	free(cell);
+	return share;
+}

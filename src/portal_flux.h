@@ -13,4 +13,11 @@
  * triangles, emitter and environment tables, Params. */
 ajar_status portal_flux_build(const SceneView *sc, PortalTri *portals, uint32_t n, float *portal_cdf);
 
+/* The share of a sky image's power coming in through the portals (each
+ * texel weighted by the portals' area projected toward it from their sky
+ * side) that its brightest 0.1% of solid angle carries: a sun's, seen
+ * through the openings. 0 without a sky image. Call after
+ * portal_flux_build (it reads env_side). */
+float portal_sun_share(const SceneView *sc, const PortalTri *portals, uint32_t n);
+
 #endif

@@ -246,10 +246,23 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	 * strategies under that forest sky with its sun clipped
 	 * (kernels/sky_measurements.md, "Sky light subpaths through the
 	 * portals" and "Weights from tails"), so on for sky images whose
-	 * brightest 0.1% of solid angle carries at least SKY_SUN_SHARE of their
-	 * power (src/lights.c, env_sun_share: 0.13, 0.03 and 0.01 there). */
+	 * brightest 0.1% of solid angle carries at least SKY_SUN_SHARE of the
+	 * sky light that comes in through the portals (portal_flux.c,
+	 * portal_sun_share: 0.24, 0.066 and 0.020 there; 0 for a sun behind
+	 * the wall, where they only cost time). */
+	/* What lies behind each side of the portals, with the kernels' own
+	 * tracing run here on the finished light tables. */
+	SceneView view;
+#define PREPARE_VIEW(type, name) view.name = d->name;
+	AJAR_SCENE_BUFFERS(PREPARE_VIEW)
+#undef PREPARE_VIEW
+	if ((st = portal_flux_build(&view, d->portals, (uint32_t)d->n_portals, d->portal_cdf)) != AJAR_OK) {
+		prepare_free(d);
+		return st;
+	}
+	d->sun_share_portals = portal_sun_share(&view, d->portals, (uint32_t)d->n_portals);
 	int sky_image_lines = p->integrator == INTEGRATOR_PORTAL && s->env_type == ENV_IMAGE && s->nportal_tris > 0 &&
-			      d->lights.env_sun_share >= SKY_SUN_SHARE;
+			      d->sun_share_portals >= SKY_SUN_SHARE;
 	p->light_paths = p->integrator != INTEGRATOR_PORTAL || p->num_emitters > 0 || p->num_lights > 0 || sky_image_lines;
 	/* The intermediate strategies in use (kernels/portal.h), chosen by
 	 * measurement (kernels/README.md, "portal"). Where the sky is the only
@@ -328,16 +341,6 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	}
 	p->emitter_power = d->lights.emitter_power;
 	p->env_power = d->lights.env_power;
-	/* What lies behind each side of the portals, with the kernels' own
-	 * tracing run here on the finished tables. */
-	SceneView view;
-#define PREPARE_VIEW(type, name) view.name = d->name;
-	AJAR_SCENE_BUFFERS(PREPARE_VIEW)
-#undef PREPARE_VIEW
-	if ((st = portal_flux_build(&view, d->portals, (uint32_t)d->n_portals, d->portal_cdf)) != AJAR_OK) {
-		prepare_free(d);
-		return st;
-	}
 	/* Sky images are sampled through the planar portals by their radiance
 	 * (kernels/portal_sky.h); AJAR_PORTAL_SKY=0 keeps the triangles' solid
 	 * angle instead, for comparisons. */

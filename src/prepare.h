@@ -12,6 +12,7 @@ typedef struct {
 #undef AJAR_DATA_FIELD
 	Bvh bvh;
 	LightTables lights;
+	float sun_share_portals; /* a sky image's sun's share of the sky light through the portals (portal_flux.c) */
 	double bvh_seconds;
 	V3 bmin, bmax;
 	unsigned kernel_omit; /* DEVICE_OMIT_* (device.h): features no triangle or material uses */
@@ -35,13 +36,16 @@ typedef struct {
 #define PORTAL_RATE_EMITTERS 1.0f
 /* Scenes lit only by a sky image, sampled through planar portals. */
 #define PORTAL_RATE_SKY_IMAGE 0.3f
-/* The sun's share of a sky image's power (src/lights.c, env_sun_share)
- * from which portal traces the sky's light subpaths (through the portals),
- * and so renders as bdpt: between an overcast sky's 0.01, where bdpt and
- * portal without them were even, and window-room-sunset's 0.03, where
- * bdpt won by 1.3-1.4x once its weights read the subpaths' MIS tails
- * (kernels/sky_measurements.md, "Weights from tails"; 0.06 before). */
-#define SKY_SUN_SHARE 0.02f
+/* The sun's share of the sky light through the portals
+ * (src/portal_flux.c, portal_sun_share) from which portal traces the
+ * sky's light subpaths (through the portals), and so renders as bdpt:
+ * between an overcast sky's 0.020, where bdpt and portal without them were
+ * even, and window-room-sunset's 0.066, where bdpt won by 1.3-1.4x once
+ * its weights read the subpaths' MIS tails (kernels/sky_measurements.md,
+ * "Weights from tails", "The sun through the openings"). The whole sky's
+ * share, 0.02 until session 27, sat between the same skies' 0.01 and
+ * 0.03 but saw a sun behind the wall. */
+#define SKY_SUN_SHARE 0.04f
 /* Where portal renders as bdpt (light subpaths bring the light in), its
  * strategies other than light tracing use at most this many light
  * vertices (Params.bdpt_conn): 2, measured against 1 and all

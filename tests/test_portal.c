@@ -1184,13 +1184,18 @@ static void test_portal_as_bdpt(void **state)
 	unsetenv("AJAR_PORTAL_SET");
 }
 
-/* The sun's share of a sky image's power (src/lights.c, env_sun_share)
- * and what portal makes of it (src/prepare.c, SKY_SUN_SHARE): a uniform
- * sky with a disc 5000 times as bright covering 0.008% of the sphere gets
- * the share the texels' solid angles give exactly; the shipped skies their
- * measured shares; light subpaths from the sky (through the portals) only
- * with a sun: window-room-forest, window-room-sunset and a strong
- * synthetic sun yes, a sky without a sun no (the sky set's rate 0.3). */
+/* The sun's share of a sky image's power (src/lights.c, env_sun_share),
+ * of the sky light through the portals (src/portal_flux.c,
+ * portal_sun_share) and what portal makes of it (src/prepare.c,
+ * SKY_SUN_SHARE): a uniform sky with a disc 5000 times as bright covering
+ * 0.008% of the sphere gets the share the texels' solid angles give
+ * exactly; behind the wall, the disc brings no light subpaths, and turned
+ * by 180 degrees into the window it does, with the whole sky's share
+ * unchanged; the shipped skies their measured shares; light subpaths from
+ * the sky only with a sun through the window: window-room-forest,
+ * window-room-sunset and a strong synthetic sun yes, that sun turned
+ * behind the window's wall or a sky without a sun no (the sky set's rate
+ * 0.3). */
 static void test_sky_sun_share(void **state)
 {
 	(void)state;
@@ -1209,6 +1214,9 @@ static void test_sky_sun_share(void **state)
 			all += sa;
 		}
 	assert_true(disc > 0.0 && disc < 1e-3 * all);
+	float *turned = malloc(sizeof(float) * 3 * W * H); /* scene_set_env_image takes each */
+	assert_non_null(turned);
+	memcpy(turned, rgb, sizeof(float) * 3 * W * H);
 	ajar_scene *s;
 	if (ajar_scene_load(SCENE("window-room/window-room.gltf"), &s) != AJAR_OK)
 		fail_msg("%s", ajar_last_error());
@@ -1219,6 +1227,40 @@ static void test_sky_sun_share(void **state)
 	printf("  disc of %.3g%% of the sphere: share %.5f, expected %.5f\n", 100.0 * disc / all,
 	       h.data.lights.env_sun_share, want);
 	assert_float_equal(h.data.lights.env_sun_share, want, 1e-4 * want);
+	printf("  behind the wall: share through the portals %.5f\n", h.data.sun_share_portals);
+	assert_true(h.data.sun_share_portals < 0.01f);
+	assert_false(h.data.params->light_paths);
+	host_scene_close(&h);
+	if (ajar_scene_load(SCENE("window-room/window-room.gltf"), &s) != AJAR_OK)
+		fail_msg("%s", ajar_last_error());
+	assert_int_equal(scene_set_env_image(s, W, H, turned, 1.0f), AJAR_OK);
+	assert_int_equal(scene_set_env_rotation(s, 180.0f), AJAR_OK);
+	host_scene_open(&h, NULL, s, 8, 8, INTEGRATOR_PORTAL, 8);
+	printf("  turned into the window: share %.5f, through the portals %.5f\n", h.data.lights.env_sun_share,
+	       h.data.sun_share_portals);
+	assert_float_equal(h.data.lights.env_sun_share, want, 1e-3 * want);
+	/* Each texel's power times the portals' area projected toward its
+	 * turned direction from their sky side: the disc's, and of the rest
+	 * the part of solid angle that fills the brightest 0.1%. */
+	double in_disc = 0.0, in_rest = 0.0;
+	for (int y = 0; y < H; y++)
+		for (int x = 0; x < W; x++) {
+			double phi = 2.0 * M_PI * ((x + 0.5) / W - 0.5), theta = M_PI * (y + 0.5) / H;
+			double dx = sin(theta) * sin(phi), dy = cos(theta), dz = -sin(theta) * cos(phi);
+			double a = 0.0;
+			for (size_t k = 0; k < h.data.n_portals; k++) {
+				const PortalTri *pt = &h.data.portals[k];
+				double c = (-dx * pt->n.x + dy * pt->n.y - dz * pt->n.z) * pt->env_side;
+				a += c > 0.0 ? pt->area * c : 0.0;
+			}
+			if (dy * 0.6 + dz * 0.8 > cos_r)
+				in_disc += 5000.0 * sin(theta) * a;
+			else
+				in_rest += sin(theta) * a;
+		}
+	double want_in = (in_disc + in_rest * (1e-3 * all - disc) / (all - disc)) / (in_disc + in_rest);
+	printf("  expected through the portals %.5f\n", want_in);
+	assert_float_equal(h.data.sun_share_portals, want_in, 2e-3 * want_in);
 	assert_true(h.data.params->light_paths);
 	host_scene_close(&h);
 
@@ -1228,18 +1270,21 @@ static void test_sky_sun_share(void **state)
 		float lo, hi;
 		int light_paths;
 	} cases[] = {
-		{SCENE("window-room-forest/window-room-forest.gltf"), NULL, 0.10f, 0.16f, 1},
-		{SCENE("window-room-sunset/window-room-sunset.gltf"), NULL, 0.025f, 0.045f, 1},
+		{SCENE("window-room-forest/window-room-forest.gltf"), NULL, 0.18f, 0.30f, 1},
+		{SCENE("window-room-sunset/window-room-sunset.gltf"), NULL, 0.05f, 0.09f, 1},
 		{NULL, sun_room(0, 3000.0f), 0.25f, 1.0f, 1},
-		{NULL, sun_room(0, 0.5f), 0.0f, 0.01f, 0}, /* the "sun" no brighter than the sky */
+		{NULL, sun_room(0, 3000.0f), 0.0f, 0.01f, 0}, /* turned by 120 degrees, behind the wall's plane */
+		{NULL, sun_room(0, 0.5f), 0.0f, 0.02f, 0},    /* the "sun" no brighter than the sky */
 	};
+	assert_int_equal(scene_set_env_rotation(cases[3].sky, 120.0f), AJAR_OK);
 	for (unsigned i = 0; i < sizeof cases / sizeof cases[0]; i++) {
 		host_scene_open(&h, cases[i].scene, cases[i].sky, 8, 8, INTEGRATOR_PORTAL, 8);
-		float share = h.data.lights.env_sun_share;
-		printf("  case %u: sun share %.4f, light subpaths %d, rate %g\n", i, share, h.data.params->light_paths,
-		       h.data.params->portal_rate);
+		float share = h.data.sun_share_portals;
+		printf("  case %u: sun share %.4f, through the portals %.4f, light subpaths %d, rate %g\n", i,
+		       h.data.lights.env_sun_share, share, h.data.params->light_paths, h.data.params->portal_rate);
 		if (!(share >= cases[i].lo && share <= cases[i].hi))
-			fail_msg("case %u: sun share %g outside [%g, %g]", i, share, cases[i].lo, cases[i].hi);
+			fail_msg("case %u: sun share through the portals %g outside [%g, %g]", i, share, cases[i].lo,
+				 cases[i].hi);
 		assert_int_equal(h.data.params->light_paths, cases[i].light_paths);
 		assert_float_equal(h.data.params->portal_rate, cases[i].light_paths ? 0.1f : 0.3f, 0.0f);
 		host_scene_close(&h);
