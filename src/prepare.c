@@ -249,7 +249,7 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	 * brightest 0.1% of solid angle carries at least SKY_SUN_SHARE of the
 	 * sky light that comes in through the portals (portal_flux.c,
 	 * portal_sun_share: 0.24, 0.066 and 0.020 there; 0 for a sun behind
-	 * the wall, where they only cost time). */
+	 * the wall, where they were even with none). */
 	/* What lies behind each side of the portals, with the kernels' own
 	 * tracing run here on the finished light tables. */
 	SceneView view;
