@@ -172,9 +172,9 @@ static ajar_status build_emitters(const Scene *s, Tri *tris, const TriShade *sha
  * are found by a histogram of luminance in 1/16-octave bins below the
  * maximum, the last bin taken in proportion, so the cost is two passes
  * over the image. With a weight per texel the same texels are the sun,
- * and the shares are of the weighted power (src/portal_flux.c: of the
- * power that comes in through the portals; src/prepare.c reads that for
- * portal's light subpaths). */
+ * and the share is of the weighted power: src/portal_flux.c weighs by
+ * what comes in through the portals, and src/prepare.c reads that for
+ * portal's light subpaths. */
 #define SUN_SOLID_ANGLE_SHARE 0.001
 #define SUN_BINS 640 /* 40 octaves */
 float env_sun_share_weighted(const float *pix, uint32_t w, uint32_t h, EnvTexelWeight weight, void *ctx)
@@ -244,7 +244,6 @@ static ajar_status build_env_image(const Scene *s, LightTables *out, double *avg
 	cdf_build(out->env + ENV_MARGINAL(w, h), rows, h, 1);
 	/* Each texel spans (2 pi / w) x (pi / h) in (phi, theta). */
 	*avg_lum = sum * (2.0 * AJAR_PI / w) * (AJAR_PI / h) / (4.0 * AJAR_PI);
-	out->env_sun_share = env_sun_share_weighted(pix, w, h, NULL, NULL);
 	free(wt);
 	free(rows);
 	return AJAR_OK;

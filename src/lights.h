@@ -27,7 +27,6 @@ typedef struct {
 	float *env;
 	size_t nenv;
 	float env_power;       /* W: pi R^2 x pi x average radiance luminance */
-	float env_sun_share;   /* ENV_IMAGE: the share of its power in its brightest 0.1% of solid angle (a sun's) */
 	float *portal_cdf;     /* nportals + 1 (one float if none) */
 	uint32_t nportals;
 	float env_pdf_select;  /* probability that light sampling picks the environment */

@@ -235,6 +235,16 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	p->min_depth = (int)o->min_depth;
 	p->strategy_len = (int)o->strategy_len;
 	p->strategy_unweighted = o->strategy_unweighted;
+	/* What lies behind each side of the portals, with the kernels' own
+	 * tracing run here on the finished light tables. */
+	SceneView view;
+#define PREPARE_VIEW(type, name) view.name = d->name;
+	AJAR_SCENE_BUFFERS(PREPARE_VIEW)
+#undef PREPARE_VIEW
+	if ((st = portal_flux_build(&view, d->portals, (uint32_t)d->n_portals, d->portal_cdf)) != AJAR_OK) {
+		prepare_free(d);
+		return st;
+	}
 	/* Light subpaths from a constant sky start on a disk as wide as the
 	 * scene and rarely find the way in through an opening; where such a
 	 * sky is the only light, the intermediate subpaths (which start on the
@@ -250,19 +260,11 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	 * sky light that comes in through the portals (portal_flux.c,
 	 * portal_sun_share: 0.24, 0.066 and 0.020 there; 0 for a sun behind
 	 * the wall, where they were even with none). */
-	/* What lies behind each side of the portals, with the kernels' own
-	 * tracing run here on the finished light tables. */
-	SceneView view;
-#define PREPARE_VIEW(type, name) view.name = d->name;
-	AJAR_SCENE_BUFFERS(PREPARE_VIEW)
-#undef PREPARE_VIEW
-	if ((st = portal_flux_build(&view, d->portals, (uint32_t)d->n_portals, d->portal_cdf)) != AJAR_OK) {
-		prepare_free(d);
-		return st;
+	int sky_image_lines = 0;
+	if (p->integrator == INTEGRATOR_PORTAL && s->env_type == ENV_IMAGE && s->nportal_tris > 0) {
+		d->sun_share_portals = portal_sun_share(&view, d->portals, (uint32_t)d->n_portals);
+		sky_image_lines = d->sun_share_portals >= SKY_SUN_SHARE;
 	}
-	d->sun_share_portals = portal_sun_share(&view, d->portals, (uint32_t)d->n_portals);
-	int sky_image_lines = p->integrator == INTEGRATOR_PORTAL && s->env_type == ENV_IMAGE && s->nportal_tris > 0 &&
-			      d->sun_share_portals >= SKY_SUN_SHARE;
 	p->light_paths = p->integrator != INTEGRATOR_PORTAL || p->num_emitters > 0 || p->num_lights > 0 || sky_image_lines;
 	/* The intermediate strategies in use (kernels/portal.h), chosen by
 	 * measurement (kernels/README.md, "portal"). Where the sky is the only

@@ -12,7 +12,7 @@ typedef struct {
 #undef AJAR_DATA_FIELD
 	Bvh bvh;
 	LightTables lights;
-	float sun_share_portals; /* a sky image's sun's share of the sky light through the portals (portal_flux.c) */
+	float sun_share_portals; /* portal with a sky image: its sun's share of the sky light through the portals (portal_flux.c) */
 	double bvh_seconds;
 	V3 bmin, bmax;
 	unsigned kernel_omit; /* DEVICE_OMIT_* (device.h): features no triangle or material uses */
