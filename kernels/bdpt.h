@@ -375,7 +375,7 @@ CALLED int bdpt_light_subpath(const SceneView *sc, VRef l, int max_verts, Rng *r
 	if (u_sel < ps) {
 		float pdf_w;
 		V3 dir;
-		V3 Le = env_sample(sc, u1, u2, &dir, &pdf_w);
+		V3 Le = env_light_sample(sc, u1, u2, &dir, &pdf_w);
 		if (!(pdf_w > 0.0f))
 			return 0;
 		y->type = VERTEX_ENV;

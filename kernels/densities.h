@@ -24,7 +24,7 @@ INLINE float bdpt_origin_pdf(const SceneView *sc, const PathVertex *l)
 {
 	float ps = sc->params->env_pdf_select;
 	if (l->type == VERTEX_ENV)
-		return ps * env_pdf_w(sc, l->p);
+		return ps * env_light_pdf_w(sc, l->p);
 	if (vertex_delta_light(l)) /* the probability of the choice; its delta cancels */
 		return (1.0f - ps) * sc->punctual[l->tri].pdf_select;
 	return (1.0f - ps) * emitter_pdf_a(sc, l->tri, l->p);

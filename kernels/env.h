@@ -77,16 +77,38 @@ INLINE V3 env_pixel(const SceneView *sc, int row, int col)
 	return v3(p[0], p[1], p[2]);
 }
 
-/* Solid-angle density of the image's own sampling at texel (row, col). */
-INLINE float env_texel_pdf_w(const SceneView *sc, int row, int col, float sin_theta)
+/* The image's two tables: its own (line = 0) and, with Params.env_lines,
+ * the one of light subpaths that start on lines through the portals
+ * (line = 1: texels weighted by the light they bring in through the
+ * portals, src/portal_flux.c, portal_sky_lines_build). */
+INLINE GLOBAL const float *env_marginal(const SceneView *sc, int line)
+{
+	int w = sc->params->env_width, h = sc->params->env_height;
+	return sc->env + (line ? ENV_LINE_MARGINAL(w, h) : ENV_MARGINAL(w, h));
+}
+
+INLINE GLOBAL const float *env_conditional(const SceneView *sc, int line, int row)
+{
+	int w = sc->params->env_width, h = sc->params->env_height;
+	return sc->env + (line ? ENV_LINE_CONDITIONAL(w, h) : ENV_CONDITIONAL(w, h)) + row * (w + 1);
+}
+
+/* Solid-angle density of table `line`'s sampling at texel (row, col). */
+INLINE float env_table_pdf_w(const SceneView *sc, int line, int row, int col, float sin_theta)
 {
 	int w = sc->params->env_width, h = sc->params->env_height;
 	if (!(sin_theta > 0.0f))
 		return 0.0f;
-	GLOBAL const float *marg = sc->env + ENV_MARGINAL(w, h);
-	GLOBAL const float *cond = sc->env + ENV_CONDITIONAL(w, h) + row * (w + 1);
+	GLOBAL const float *marg = env_marginal(sc, line);
+	GLOBAL const float *cond = env_conditional(sc, line, row);
 	float p_uv = (marg[row + 1] - marg[row]) * (cond[col + 1] - cond[col]) * (float)(w * h);
 	return p_uv / (2.0f * AJAR_PI * AJAR_PI * sin_theta);
+}
+
+/* Solid-angle density of the image's own sampling at texel (row, col). */
+INLINE float env_texel_pdf_w(const SceneView *sc, int row, int col, float sin_theta)
+{
+	return env_table_pdf_w(sc, 0, row, col, sin_theta);
 }
 
 /* Radiance arriving from the sky along -d (d points to the sky). */
@@ -119,10 +141,10 @@ INLINE V3 env_radiance_pdf(const SceneView *sc, V3 d, float *pdf_w)
 	return env_pixel(sc, row, col);
 }
 
-/* Samples a sky direction *d by the environment's own distribution and
- * returns its radiance; *pdf_w = 0 (and black) if there is none, or, very
- * rarely, if rounding carried the sample into a texel that has none. */
-INLINE V3 env_sample(const SceneView *sc, float u1, float u2, V3 *d, float *pdf_w)
+/* Samples a sky direction *d by table `line` of the environment (env_marginal)
+ * and returns its radiance; *pdf_w = 0 (and black) if there is none, or,
+ * very rarely, if rounding carried the sample into a texel that has none. */
+INLINE V3 env_table_sample(const SceneView *sc, int line, float u1, float u2, V3 *d, float *pdf_w)
 {
 	GLOBAL const Params *prm = sc->params;
 	*pdf_w = 0.0f;
@@ -136,10 +158,10 @@ INLINE V3 env_sample(const SceneView *sc, float u1, float u2, V3 *d, float *pdf_
 		return v3(0.0f, 0.0f, 0.0f);
 	int w = prm->env_width, h = prm->env_height;
 	float p_row, p_col, ur, uc;
-	int row = sample_cdf(sc->env + ENV_MARGINAL(w, h), h, u1, &p_row, &ur);
+	int row = sample_cdf(env_marginal(sc, line), h, u1, &p_row, &ur);
 	if (row < 0)
 		return v3(0.0f, 0.0f, 0.0f);
-	int col = sample_cdf(sc->env + ENV_CONDITIONAL(w, h) + row * (w + 1), w, u2, &p_col, &uc);
+	int col = sample_cdf(env_conditional(sc, line, row), w, u2, &p_col, &uc);
 	if (col < 0)
 		return v3(0.0f, 0.0f, 0.0f);
 	*d = env_dir(prm, ((float)col + uc) / (float)w, ((float)row + ur) / (float)h);
@@ -147,8 +169,14 @@ INLINE V3 env_sample(const SceneView *sc, float u1, float u2, V3 *d, float *pdf_
 	 * and env_radiance return for d, even where rounding put a sample on
 	 * a texel edge into the neighbour. */
 	float sin_theta = env_texel(prm, *d, &row, &col);
-	*pdf_w = env_texel_pdf_w(sc, row, col, sin_theta);
+	*pdf_w = env_table_pdf_w(sc, line, row, col, sin_theta);
 	return *pdf_w > 0.0f ? env_pixel(sc, row, col) : v3(0.0f, 0.0f, 0.0f);
+}
+
+/* By the environment's own distribution. */
+INLINE V3 env_sample(const SceneView *sc, float u1, float u2, V3 *d, float *pdf_w)
+{
+	return env_table_sample(sc, 0, u1, u2, d, pdf_w);
 }
 
 /* Solid-angle density with which env_sample returns direction d. */
@@ -162,6 +190,25 @@ INLINE float env_pdf_w(const SceneView *sc, V3 d)
 	int row, col;
 	float sin_theta = env_texel(prm, d, &row, &col);
 	return env_texel_pdf_w(sc, row, col, sin_theta);
+}
+
+/* The direction of a light subpath from the environment: by the light
+ * that comes in through the portals where its lines start on them
+ * (Params.env_lines), else by the image's own distribution. */
+INLINE V3 env_light_sample(const SceneView *sc, float u1, float u2, V3 *d, float *pdf_w)
+{
+	return env_table_sample(sc, sc->params->env_lines, u1, u2, d, pdf_w);
+}
+
+/* Solid-angle density with which env_light_sample returns direction d. */
+INLINE float env_light_pdf_w(const SceneView *sc, V3 d)
+{
+	GLOBAL const Params *prm = sc->params;
+	if (!prm->env_lines)
+		return env_pdf_w(sc, d);
+	int row, col;
+	float sin_theta = env_texel(prm, d, &row, &col);
+	return env_table_pdf_w(sc, 1, row, col, sin_theta);
 }
 
 #endif

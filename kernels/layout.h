@@ -46,7 +46,7 @@
 	X(PunctualLight, cos_outer) X(PunctualLight, cone_scale)                       \
 	X(PunctualLight, disk_radius)                                                  \
 	X(Params, num_portal_planes) X(Params, env_rot_cos) X(Params, env_rot_sin)     \
-	X(Params, bdpt_conn)                                                           \
+	X(Params, bdpt_conn) X(Params, env_lines)                                      \
 	X(PortalPlane, o) X(PortalPlane, a0) X(PortalPlane, t) X(PortalPlane, n)      \
 	X(PortalPlane, b1) X(PortalPlane, table) X(PortalPlane, guide)
 #endif

@@ -234,7 +234,9 @@ typedef struct {
 	float env_rot_sin;      /* 224 (env.h, env_turn) */
 	int bdpt_conn;          /* bdpt strategies other than light tracing use at most this many
 	                         * light vertices (1 or 2; 0 = any; mis.h, mis_conn_in_set) */
-	int pad3, pad4;
+	int env_lines;          /* 232, a sky image's light subpaths start on lines through the
+	                         * portals, their directions from the ENV_LINE_* tables (env.h) */
+	int pad4;
 } Params; /* 240 */
 
 /* Layout of the float array `env`: for an ENV_IMAGE of W x H,
@@ -246,6 +248,12 @@ typedef struct {
 #define ENV_MARGINAL(w, h) (3 * (w) * (h))
 #define ENV_CONDITIONAL(w, h) (3 * (w) * (h) + (h) + 1)
 #define ENV_FLOATS(w, h) (3 * (w) * (h) + (h) + 1 + (h) * ((w) + 1))
+/* With Params.env_lines, the same two CDFs again for the directions of
+ * light subpaths that start on lines through the portals (env.h,
+ * env_line_sample; src/portal_flux.c, portal_sky_lines_build). */
+#define ENV_LINE_MARGINAL(w, h) ENV_FLOATS(w, h)
+#define ENV_LINE_CONDITIONAL(w, h) (ENV_FLOATS(w, h) + (h) + 1)
+#define ENV_LINE_FLOATS(w, h) (ENV_FLOATS(w, h) + (h) + 1 + (h) * ((w) + 1))
 
 /* The device arrays, listed once: kernel arguments, the SceneView below and
  * the host upload are all generated from this list so they cannot drift. */

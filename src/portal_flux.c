@@ -141,29 +141,91 @@ static double projected_area(uint32_t x, uint32_t y, void *ctx)
 	return g->cell[(size_t)(y * g->gh / g->h) * g->gw + x * g->gw / g->w];
 }
 
-float portal_sun_share(const SceneView *sc, const PortalTri *portals, uint32_t n)
+/* The portals' area projected toward each cell's centre from their sky
+ * side, on the grid g (g->cell left NULL when out of memory). */
+static void projected_area_grid(GLOBAL const Params *prm, const PortalTri *portals, uint32_t n, SunGrid *g)
 {
-	GLOBAL const Params *prm = sc->params;
-	if (prm->env_type != ENV_IMAGE || n == 0)
-		return 0.0f;
-	SunGrid g = {NULL, (uint32_t)prm->env_width, (uint32_t)prm->env_height, 0, 0};
-	g.gw = g.w < SUN_GRID_W ? g.w : SUN_GRID_W;
-	g.gh = g.h < SUN_GRID_H ? g.h : SUN_GRID_H;
-	float *cell = malloc(sizeof(float) * g.gw * g.gh);
+	g->w = (uint32_t)prm->env_width;
+	g->h = (uint32_t)prm->env_height;
+	g->gw = g->w < SUN_GRID_W ? g->w : SUN_GRID_W;
+	g->gh = g->h < SUN_GRID_H ? g->h : SUN_GRID_H;
+	float *cell = malloc(sizeof(float) * g->gw * g->gh);
+	g->cell = cell;
 	if (!cell)
-		return 0.0f;
-	for (uint32_t j = 0; j < g.gh; j++)
-		for (uint32_t i = 0; i < g.gw; i++) {
-			V3 d = env_dir(prm, (i + 0.5f) / g.gw, (j + 0.5f) / g.gh);
+		return;
+	for (uint32_t j = 0; j < g->gh; j++)
+		for (uint32_t i = 0; i < g->gw; i++) {
+			V3 d = env_dir(prm, (i + 0.5f) / g->gw, (j + 0.5f) / g->gh);
 			double a = 0.0;
 			for (uint32_t k = 0; k < n; k++) {
 				float c = v3_dot(d, portals[k].n) * (float)portals[k].env_side;
 				a += c > 0.0f ? portals[k].area * c : 0.0;
 			}
-			cell[(size_t)j * g.gw + i] = (float)a;
+			cell[(size_t)j * g->gw + i] = (float)a;
 		}
-	g.cell = cell;
+}
+
+float portal_sun_share(const SceneView *sc, const PortalTri *portals, uint32_t n)
+{
+	GLOBAL const Params *prm = sc->params;
+	if (prm->env_type != ENV_IMAGE || n == 0)
+		return 0.0f;
+	SunGrid g;
+	projected_area_grid(prm, portals, n, &g);
+	if (!g.cell)
+		return 0.0f;
 	float share = env_sun_share_weighted(sc->env + ENV_PIXELS(g.w, g.h), g.w, g.h, projected_area, &g);
-	free(cell);
+	free((float *)g.cell);
 	return share;
+}
+
+ajar_status portal_sky_lines_build(GLOBAL const Params *prm, const PortalTri *portals, uint32_t n, float **env,
+				   size_t *nenv)
+{
+	uint32_t w = (uint32_t)prm->env_width, h = (uint32_t)prm->env_height;
+	size_t need = ENV_LINE_FLOATS((size_t)w, (size_t)h);
+	float *grown = realloc(*env, sizeof(float) * need);
+	if (!grown)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory for the sky's table through the portals (%ux%u)",
+			       w, h);
+	*env = grown;
+	*nenv = need;
+	SunGrid g;
+	projected_area_grid(prm, portals, n, &g);
+	double *wt = malloc(sizeof(double) * (size_t)w * h), *rows = malloc(sizeof(double) * h);
+	if (!g.cell || !wt || !rows) {
+		free((float *)g.cell);
+		free(wt);
+		free(rows);
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory for the sky's table through the portals (%ux%u)",
+			       w, h);
+	}
+	/* lum sin(theta) (the image's own weight) and the same times the
+	 * projected area, each normalised, mixed. */
+	const float *pix = grown + ENV_PIXELS(w, h);
+	double sum = 0.0, sum_a = 0.0;
+	for (uint32_t y = 0; y < h; y++) {
+		double sin_theta = sin(AJAR_PI * ((double)y + 0.5) / h);
+		for (uint32_t x = 0; x < w; x++) {
+			const float *p = pix + 3 * ((size_t)y * w + x);
+			float lum = v3_lum(v3(p[0], p[1], p[2]));
+			double e = lum > 0.0f ? lum * sin_theta : 0.0;
+			wt[(size_t)y * w + x] = e;
+			sum += e;
+			sum_a += e * projected_area(x, y, &g);
+		}
+	}
+	double mix = sum_a > 0.0 ? SKY_LINES_PORTAL_MIX : 0.0;
+	for (uint32_t y = 0; y < h; y++) {
+		for (uint32_t x = 0; x < w; x++) {
+			double e = wt[(size_t)y * w + x];
+			wt[(size_t)y * w + x] = e > 0.0 ? (1.0 - mix) * e / sum + (mix > 0.0 ? mix * e * projected_area(x, y, &g) / sum_a : 0.0) : 0.0;
+		}
+		rows[y] = cdf_build(grown + ENV_LINE_CONDITIONAL(w, h) + (size_t)y * (w + 1), wt + (size_t)y * w, w, 1);
+	}
+	cdf_build(grown + ENV_LINE_MARGINAL(w, h), rows, h, 1);
+	free((float *)g.cell);
+	free(wt);
+	free(rows);
+	return AJAR_OK;
 }

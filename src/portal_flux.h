@@ -20,4 +20,19 @@ ajar_status portal_flux_build(const SceneView *sc, PortalTri *portals, uint32_t 
  * portal_flux_build (it reads env_side). */
 float portal_sun_share(const SceneView *sc, const PortalTri *portals, uint32_t n);
 
+/* The share of a sky image's light subpaths whose directions follow the
+ * light that comes in through the portals (the rest follow the image
+ * alone, a defensive part for openings without portals and for what the
+ * geometric weight misses). */
+#define SKY_LINES_PORTAL_MIX 0.9
+
+/* Appends to a sky image's float array (*env, *nenv floats; grown to
+ * ENV_LINE_FLOATS) the table its light subpaths take their directions
+ * from when they start on lines through the portals (kernels/env.h,
+ * env_line_sample): each texel's lum sin(theta), weighted by the portals'
+ * area projected toward it from their sky side, mixed with the image's
+ * own weight (SKY_LINES_PORTAL_MIX). Call after portal_flux_build. */
+ajar_status portal_sky_lines_build(GLOBAL const Params *prm, const PortalTri *portals, uint32_t n, float **env,
+				   size_t *nenv);
+
 #endif

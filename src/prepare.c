@@ -260,6 +260,23 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	 * sky light that comes in through the portals (portal_flux.c,
 	 * portal_sun_share: 0.24, 0.066 and 0.020 there; 0 for a sun behind
 	 * the wall, where they were even with none). */
+	/* Light subpaths from a sky image start on lines through the portals
+	 * (kernels/lights.h, line_sample); their directions follow the light
+	 * that comes in through them (portal_sky_lines_build). AJAR_SKY_LINES=0
+	 * keeps the image's own distribution, for comparisons. */
+	const char *lines = getenv("AJAR_SKY_LINES");
+	p->env_lines = 0;
+	if (s->env_type == ENV_IMAGE && s->nportal_tris > 0 && !(lines && strcmp(lines, "0") == 0)) {
+		if ((st = portal_sky_lines_build(p, d->portals, (uint32_t)d->n_portals, &d->lights.env,
+						 &d->lights.nenv)) != AJAR_OK) {
+			prepare_free(d);
+			return st;
+		}
+		d->env = d->lights.env;
+		view.env = d->env;
+		d->n_env = d->lights.nenv;
+		p->env_lines = 1;
+	}
 	int sky_image_lines = 0;
 	if (p->integrator == INTEGRATOR_PORTAL && s->env_type == ENV_IMAGE && s->nportal_tris > 0) {
 		d->sun_share_portals = portal_sun_share(&view, d->portals, (uint32_t)d->n_portals);

@@ -99,7 +99,10 @@ void oracle(const SceneView *sc, const PathVertex *x, const int *delta, int k, M
 		else if (i == 1 && punctual(&x[0]))
 			mv[i].pf = (float)punctual_pf1(sc, &x[0], &x[1]);
 		else if (i == 0)
-			mv[i].pf = x[0].type == VERTEX_ENV ? ps * env_pdf_w(sc, x[0].p)
+			/* A sky image's light subpaths through the portals take their
+			 * directions from its table of the light through them
+			 * (test_lights checks that table against its density). */
+			mv[i].pf = x[0].type == VERTEX_ENV ? ps * env_light_pdf_w(sc, x[0].p)
 							   : (1 - ps) * emitter_pdf_a(sc, x[0].tri, x[0].p);
 		else if (i == 1 && x[0].type == VERTEX_ENV)
 			/* A sky image's lines come through the portals, a constant sky's

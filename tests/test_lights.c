@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "lights.h"
+#include "portal_flux.h"
 #include "portal_sky.h"
 #include "scene.h"
 #include "../kernels/lights.h"
@@ -197,10 +198,30 @@ static V3 uv_dir(float u, float v)
 	return v3(sinf(theta) * sinf(phi), cosf(theta), -sinf(theta) * cosf(phi));
 }
 
-/* Histogram of env_sample over 16 x 8 cells in the scene's (u, v) (those
- * of an unturned sky), expected counts from env_pdf_w integrated over each
- * cell in solid angle; the sky turned by `degrees`. */
-static void env_sample_chi2(double degrees)
+/* A window quad at z = 1 (1.6 x 1.2) whose sky lies on its -z side, seen
+ * through it from z > 1, and the table of light subpaths' directions
+ * through it (src/portal_flux.c, portal_sky_lines_build). */
+static void add_line_window(Lit *l)
+{
+	float pos[] = {-0.8f, -0.4f, 1, 0.8f, -0.4f, 1, 0.8f, 0.8f, 1, -0.8f, 0.8f, 1};
+	uint32_t idx[] = {0, 1, 2, 0, 2, 3};
+	assert_int_equal(scene_add_portal(l->s, "window", pos, 4, idx, 2), AJAR_OK);
+	lights_free(&l->lt);
+	free(l->tris);
+	lit_build(l);
+	for (int j = 0; j < 2; j++)
+		l->s->portals[j].env_side = l->s->portals[j].n.z > 0.0f ? -1 : 1;
+	assert_int_equal(portal_sky_lines_build(&l->prm, l->s->portals, 2, &l->lt.env, &l->lt.nenv), AJAR_OK);
+	assert_int_equal(l->lt.nenv, ENV_LINE_FLOATS(l->s->env_width, l->s->env_height));
+	l->sc.env = l->lt.env;
+	l->prm.env_lines = 1;
+}
+
+/* Histogram of env_light_sample (env_sample, or with `line` the table of
+ * light subpaths through a window) over 16 x 8 cells in the scene's (u, v)
+ * (those of an unturned sky), expected counts from env_light_pdf_w
+ * integrated over each cell in solid angle; the sky turned by `degrees`. */
+static void env_sample_chi2(double degrees, int line)
 {
 	rng_state = 11;
 	Lit l;
@@ -209,6 +230,8 @@ static void env_sample_chi2(double degrees)
 	assert_int_equal(scene_set_env_image(l.s, w, h, synthetic_sky(w, h), 1.5f), AJAR_OK);
 	assert_int_equal(scene_set_env_rotation(l.s, degrees), AJAR_OK);
 	lit_build(&l);
+	if (line)
+		add_line_window(&l);
 	assert_true(l.lt.env_power > 0.0f);
 	assert_float_equal(l.lt.env_pdf_select, 1.0f, 0.0f); /* no emitters */
 
@@ -225,7 +248,7 @@ static void env_sample_chi2(double degrees)
 				for (int i = 0; i < SUB; i++) {
 					float u = (cu + (i + 0.5f) / SUB) / CU, v = (cv + (j + 0.5f) / SUB) / CV;
 					float st = sinf(AJAR_PI * v);
-					sum += env_pdf_w(&l.sc, uv_dir(u, v)) * st;
+					sum += env_light_pdf_w(&l.sc, uv_dir(u, v)) * st;
 				}
 			double cell = sum * (2.0 * M_PI / (CU * SUB)) * (M_PI / (CV * SUB));
 			expct[cv * CU + cu] = cell * N;
@@ -237,7 +260,7 @@ static void env_sample_chi2(double degrees)
 	for (int k = 0; k < N; k++) {
 		V3 d;
 		float pdf_w;
-		V3 L = env_sample(&l.sc, rnd(), rnd(), &d, &pdf_w);
+		V3 L = env_light_sample(&l.sc, rnd(), rnd(), &d, &pdf_w);
 		if (!(pdf_w > 0.0f)) {
 			/* Rounded across a texel edge into a black texel (or onto
 			 * a pole): a refused sample, which must stay rare. */
@@ -248,7 +271,7 @@ static void env_sample_chi2(double degrees)
 		assert_float_equal(v3_len(d), 1.0f, 1e-5f);
 		/* The returned density and radiance are exactly those of d. */
 		V3 Le = env_radiance(&l.sc, d);
-		assert_true(env_pdf_w(&l.sc, d) == pdf_w);
+		assert_true(env_light_pdf_w(&l.sc, d) == pdf_w);
 		assert_true(Le.x == L.x && Le.y == L.y && Le.z == L.z);
 		float u = 0.5f + atan2f(d.x, -d.z) / (2.0f * AJAR_PI);
 		float v = acosf(fminf(fmaxf(d.y, -1.0f), 1.0f)) / AJAR_PI;
@@ -259,7 +282,8 @@ static void env_sample_chi2(double degrees)
 	}
 	assert_true(refused < N / 10000);
 	double p = chi2_test(obs, expct, CU * CV, 5.0);
-	printf("  env_sample, turned %g degrees: p = %.3f (%d refused)\n", degrees, p, refused);
+	printf("  env_%s, turned %g degrees: p = %.3f (%d refused)\n", line ? "light_sample through a window" : "sample",
+	       degrees, p, refused);
 	assert_true(p > ALPHA);
 
 	/* Densities follow luminance: bright texel centres are denser. */
@@ -271,7 +295,64 @@ static void env_sample_chi2(double degrees)
 	lit_free(&l);
 }
 
-static void test_env_sample_chi2(void **state) { env_sample_chi2(0.0); }
+static void test_env_sample_chi2(void **state) { env_sample_chi2(0.0, 0); }
+
+/* The light subpaths' table through a window, sampled against its density
+ * (the sky turned, as the table's directions turn with it), and that
+ * density against the one it is made to be, in double: per texel, the
+ * image's own density times (1 - mix) + mix A S / S_A, A the window's area
+ * projected toward the texel's centre from its sky side (0 behind it), S
+ * the sum of lum sin(theta) over the texels, S_A the same weighted by A. */
+static void test_env_line_table(void **state)
+{
+	env_sample_chi2(37.0, 1);
+	Lit l;
+	assert_int_equal(scene_new("<test>", &l.s), AJAR_OK);
+	uint32_t w = 40, h = 20;
+	assert_int_equal(scene_set_env_image(l.s, w, h, synthetic_sky(w, h), 1.5f), AJAR_OK);
+	assert_int_equal(scene_set_env_rotation(l.s, 37.0), AJAR_OK);
+	lit_build(&l);
+	add_line_window(&l);
+	static double A[40 * 20], e[40 * 20];
+	double S = 0.0, SA = 0.0;
+	for (uint32_t y = 0; y < h; y++)
+		for (uint32_t x = 0; x < w; x++) {
+			V3 d = env_dir(&l.prm, (x + 0.5f) / w, (y + 0.5f) / h);
+			double a = 0.0;
+			for (int k = 0; k < 2; k++) {
+				const PortalTri *pt = &l.s->portals[k];
+				double c = ((double)d.x * pt->n.x + (double)d.y * pt->n.y + (double)d.z * pt->n.z) * pt->env_side;
+				a += c > 0.0 ? pt->area * c : 0.0;
+			}
+			const float *p = l.lt.env + 3 * (y * w + x);
+			double lum = v3_lum(v3(p[0], p[1], p[2]));
+			A[y * w + x] = a;
+			e[y * w + x] = lum > 0.0 ? lum * sin(M_PI * (y + 0.5) / h) : 0.0;
+			S += e[y * w + x];
+			SA += e[y * w + x] * a;
+		}
+	assert_true(SA > 0.0);
+	int behind = 0, through = 0;
+	double worst = 0.0;
+	for (uint32_t y = 0; y < h; y++)
+		for (uint32_t x = 0; x < w; x++) {
+			if (!(e[y * w + x] > 0.0))
+				continue;
+			V3 d = env_dir(&l.prm, (x + 0.5f) / w, (y + 0.5f) / h);
+			double want = env_pdf_w(&l.sc, d) *
+				      ((1.0 - SKY_LINES_PORTAL_MIX) + SKY_LINES_PORTAL_MIX * A[y * w + x] * S / SA);
+			double got = env_light_pdf_w(&l.sc, d), diff = fabs(got - want) / want;
+			worst = fmax(worst, diff);
+			behind += A[y * w + x] == 0.0;
+			through += A[y * w + x] > 0.5;
+			if (diff > 1e-3) /* both from float CDFs: their differences round */
+				fail_msg("texel (%u, %u): density %.7g, want %.7g (projected area %.4f)", x, y, got, want,
+					 A[y * w + x]);
+		}
+	printf("  line table: %d texels behind the window, %d through it, worst %.2e\n", behind, through, worst);
+	assert_true(behind > 100 && through > 50);
+	lit_free(&l);
+}
 
 /* env_uv (fastmath.h's atan2, the host's cos and sin of the turn) against
  * the exact map in double, turned by the same float angle: within 2e-7 in
@@ -323,7 +404,7 @@ static void test_env_uv_exact(void **state)
 
 /* Turned by 11 texels (99 degrees): the sub-grid above still meets the
  * texel edges (1/8 texel steps), so the expected counts stay exact. */
-static void test_env_sample_chi2_turned(void **state) { env_sample_chi2(99.0); }
+static void test_env_sample_chi2_turned(void **state) { env_sample_chi2(99.0, 0); }
 
 /* A 6 x 3 sky black but for texel (4, 1), centred on +X at the horizon.
  * Turned by +90 degrees (counter-clockwise seen from above) it is found
@@ -1253,6 +1334,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_env_orientation),
 		cmocka_unit_test(test_env_sample_chi2),
+		cmocka_unit_test(test_env_line_table),
 		cmocka_unit_test(test_env_sample_chi2_turned),
 		cmocka_unit_test(test_env_rotation_sense),
 		cmocka_unit_test(test_env_uv_exact),
