@@ -169,6 +169,13 @@ static void test_window_room_sun(void **state)
 	unsetenv("AJAR_PORTAL_SET");
 }
 static void test_door_ajar(void **state) { compare(SCENE("door-ajar/door-ajar.gltf"), 24, 24, 512, 128); }
+/* The shipped atrium: the forest sky's sun down through a portal in the
+ * roof (horizontal, where the other sky scenes' are in walls); portal
+ * renders as bdpt there (light subpaths on the portal's lines). */
+static void test_atrium_forest(void **state)
+{
+	compare(SCENE("atrium-forest/atrium-forest.gltf"), 24, 24, 64, 16);
+}
 /* door-ajar with a point lamp for its emitter: portal's long halves at
  * rate 1 (a lamp behind a portal counts as an emitter, src/prepare.c). */
 static void test_door_ajar_lamp(void **state)
@@ -301,6 +308,7 @@ int main(void)
 		cmocka_unit_test(test_bathroom),
 		cmocka_unit_test(test_door_ajar),
 		cmocka_unit_test(test_door_ajar_lamp),
+		cmocka_unit_test(test_atrium_forest),
 		cmocka_unit_test(test_cornell_punctual),
 		cmocka_unit_test(test_window_room_punctual),
 		cmocka_unit_test(test_normal_alpha),

@@ -1153,6 +1153,7 @@ static void test_portal_as_bdpt(void **state)
 		{"window-room-forest/window-room-forest.gltf", NULL, INTEGRATOR_BDPT, 0},
 		{"window-room-sun/window-room-sun.gltf", NULL, INTEGRATOR_BDPT, 0},
 		{"window-room-lamp/window-room-lamp.gltf", NULL, INTEGRATOR_BDPT, 0},
+		{"atrium-forest/atrium-forest.gltf", NULL, INTEGRATOR_BDPT, 0}, /* the sun through the roof */
 		{NULL, sun_window_room(1, 1), INTEGRATOR_BDPT, 0},     /* sun, lamp and spot in the room */
 		{NULL, door_ajar_lamps(), INTEGRATOR_PORTAL, 1},      /* a point light behind the door */
 		{NULL, window_room_lamp_at(2.0f, 1.4f, -1.0f, 0.0f), INTEGRATOR_PORTAL, 1}, /* outside the window */

@@ -233,12 +233,12 @@ static void count_warnings(ajar_log_level level, const char *message, void *user
 	snprintf(last_warning, sizeof last_warning, "%s", message);
 }
 
-/* The sky-lit variants (scenes/skies/make_sky_scenes.py): the rooms'
- * geometry, the sky image with its slightly negative pixels clamped (one
- * warning), and the sun where the scene's notes put it: the ray from the
- * sun's pixel, turned by the scene's rotation (right-handed about +Y,
- * worked out here again), through a window's centre lands on the surface
- * named. */
+/* The sky-lit variants (scenes/skies/make_sky_scenes.py) and the atrium
+ * (make_atrium.py): the rooms' geometry, the sky image with its slightly
+ * negative pixels clamped (one warning), and the sun where the scene's
+ * notes put it: the ray from the sun's pixel, turned by the scene's
+ * rotation (right-handed about +Y, worked out here again), through an
+ * opening's centre lands on the surface named. */
 static void sun_landing(const Scene *s, V3 from, V3 *hit, float plane, int axis)
 {
 	size_t best = 0;
@@ -268,8 +268,9 @@ static void test_sky_scenes(void **state)
 		{SCENE("window-room-sunset/window-room-sunset.gltf"), 28, 4, 45.5352f},
 		{SCENE("window-room-forest/window-room-forest.gltf"), 28, 826, 55.6836f},
 		{SCENE("living-room-forest/living-room-forest.gltf"), 143163, 826, 140.6836f},
+		{SCENE("atrium-forest/atrium-forest.gltf"), 42, 826, 75.6836f},
 	};
-	for (int k = 0; k < 3; k++) {
+	for (int k = 0; k < 4; k++) {
 		warnings = 0;
 		last_warning[0] = '\0';
 		ajar_set_log_callback(count_warnings, NULL);
@@ -296,11 +297,16 @@ static void test_sky_scenes(void **state)
 			 * so it lights the wall's bottom and the floor before it. */
 			sun_landing(s, v3(2.0f, 1.4f, 0.0f), &p, 3.0f, 2);
 			assert_true(p.y > -0.2f && p.y < 0.3f && p.x > 2.5f && p.x < 3.5f);
-		} else {
+		} else if (k == 2) {
 			/* Through the window at x = -0.436 (z in [-1.04, -0.15]) onto the
 			 * floor, in front of the camera (x 1.5..5.1, z in the room). */
 			sun_landing(s, v3(-0.436f, 1.58f, -0.595f), &p, 0.0f, 1);
 			assert_true(p.x > 1.5f && p.x < 5.1f && p.z > -3.6f && p.z < 0.0f);
+		} else {
+			/* Down through the roof's opening (its centre, 3.05 m up) onto the
+			 * far wall z = 4, near its corner with x = 4, 2 m up. */
+			sun_landing(s, v3(2.0f, 3.05f, 2.0f), &p, 4.0f, 2);
+			assert_true(p.x > 3.5f && p.x < 3.9f && p.y > 1.9f && p.y < 2.3f);
 		}
 		ajar_scene_destroy(&s);
 	}

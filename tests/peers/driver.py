@@ -12,7 +12,7 @@ renderers). relMSE is tests/bench.c's formula (images.rel_mse).
 Environment: PEERS_SECONDS (20), PEERS_SCENES ("window-room living-room
 door-ajar"; cornell also works, and "sky" names the sky- and lamp-lit scenes
 window-room-sunset window-room-forest living-room-forest window-room-sun window-room-lamp
-door-ajar-lamp), PEERS_SIZE (image width, height from the
+door-ajar-lamp atrium-forest), PEERS_SIZE (image width, height from the
 camera's aspect ratio, or WxH; 128), PEERS_REF_SECONDS (each reference half;
 300), PEERS_DEPTH (32), PEERS_THREADS (all cores), PEERS_RENDERERS (default
 all: ajar-pt ajar-bdpt ajar-portal mitsuba mitsuba-ld cycles cycles-noportal
@@ -43,9 +43,11 @@ ALL = ["ajar-pt", "ajar-bdpt", "ajar-portal", "mitsuba", "mitsuba-ld", "cycles",
 # Fastest to converge, measured on this machine (see the README of tests/peers).
 DEFAULT_REF = {"window-room": "mitsuba", "living-room": "mitsuba", "door-ajar": "mitsuba", "cornell": "mitsuba",
 	       "window-room-sunset": "mitsuba", "window-room-forest": "mitsuba", "living-room-forest": "mitsuba",
-	       "window-room-sun": "mitsuba", "window-room-lamp": "mitsuba", "door-ajar-lamp": "mitsuba"}
+	       "window-room-sun": "mitsuba", "window-room-lamp": "mitsuba", "door-ajar-lamp": "mitsuba",
+	       "atrium-forest": "mitsuba"}
 # The scenes lit by sky images and KHR_lights_punctual lamps (scenes/skies/make_sky_scenes.py).
-SKY_SCENES = "window-room-sunset window-room-forest living-room-forest window-room-sun window-room-lamp door-ajar-lamp"
+SKY_SCENES = ("window-room-sunset window-room-forest living-room-forest window-room-sun window-room-lamp door-ajar-lamp "
+	      "atrium-forest")
 
 
 def supports(renderer, scene):
