@@ -20,9 +20,7 @@
 #ifndef AJAR_MIS_H
 #define AJAR_MIS_H
 #include "fastmath.h"
-
-#define MIS_BALANCE 1
-#define MIS_POWER 0
+#include "types.h"
 
 /* Power heuristic (beta = 2) weight of a strategy with density a against
  * one with density b, both in the same measure. */

@@ -182,6 +182,10 @@ typedef struct {
 #define INTEGRATOR_BDPT 1
 #define INTEGRATOR_PORTAL 2
 
+/* Params.mis: the MIS heuristic (mis.h), ajar_mis's values. */
+#define MIS_POWER 0
+#define MIS_BALANCE 1
+
 /* The integrator a program runs. The host builds one program per integrator
  * (-DAJAR_INTEGRATOR=n), so a device compiles only the code it runs: GPU
  * compilers take minutes over all three inlined into one kernel. Without the
@@ -213,7 +217,7 @@ typedef struct {
 	uint seed;
 	float emitter_power;    /* 144, total power of emissive triangles */
 	float env_power;        /* power estimate of the environment */
-	int mis;                /* MIS_POWER or MIS_BALANCE (mis.h) */
+	int mis;                /* MIS_POWER or MIS_BALANCE */
 	int min_depth;          /* only paths of at least this many segments */
 	int strategy_len;       /* 160, bdpt: per-strategy layers up to this path length, 0 = none */
 	int strategy_unweighted;/* layers without MIS weights */

@@ -91,6 +91,7 @@ void ajar_options_default(ajar_options *o)
 	o->integrator = AJAR_INTEGRATOR_PT;
 	o->max_depth = 0; /* the integrator's default */
 	o->seed = 1;
+	o->mis = AJAR_MIS_AUTO;
 }
 
 /* Validates o into *out, with defaults resolved: max_depth 0 means 64 for
@@ -113,7 +114,7 @@ static ajar_status check_options(const ajar_options *in, ajar_options *out)
 	if (o->integrator != AJAR_INTEGRATOR_PT && o->max_depth > AJAR_BIDIR_MAX_DEPTH)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "max depth %u: bdpt and portal allow at most %d",
 			       o->max_depth, AJAR_BIDIR_MAX_DEPTH);
-	if (o->mis != AJAR_MIS_POWER && o->mis != AJAR_MIS_BALANCE)
+	if (o->mis != AJAR_MIS_POWER && o->mis != AJAR_MIS_BALANCE && o->mis != AJAR_MIS_AUTO)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "unknown MIS heuristic %d", (int)o->mis);
 	if (o->min_depth > o->max_depth)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "min depth %u exceeds max depth %u", o->min_depth,

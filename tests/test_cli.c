@@ -188,6 +188,7 @@ static void test_usage_errors(void **state)
 	expect((const char *[]){"render", CORNELL, "-o", out, "--size=64x", NULL}, 1, "--size");
 	expect((const char *[]){"render", CORNELL, "-o", out, "--time", "-1", NULL}, 1, "--time");
 	expect((const char *[]){"render", CORNELL, "-o", out, "--integrator", "magic", NULL}, 1, "--integrator");
+	expect((const char *[]){"render", CORNELL, "-o", out, "--mis", "heavy", NULL}, 1, "not auto, power or balance");
 	expect((const char *[]){"render", CORNELL, "-o", out, "--max-depth", "0", NULL}, 1, "--max-depth");
 	expect((const char *[]){"render", CORNELL, NULL}, 1, "-o");
 	expect((const char *[]){"render", "-o", out, NULL}, 1, "scene");

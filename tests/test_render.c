@@ -453,6 +453,67 @@ static void test_portal_as_bdpt(void **state)
 	}
 }
 
+/* AJAR_MIS_AUTO, the default: the balance heuristic under a sky image whose
+ * sun shines in through the portals and is the only light (bdpt and portal
+ * alike), the power heuristic elsewhere: under a constant sky, a sun lamp,
+ * and the same sunny sky with a lamp added. Compared bit for bit with the
+ * heuristic named. */
+static void render_mis(ajar_scene *s, ajar_integrator integ, ajar_mis mis, float *img)
+{
+	ajar_renderer *r;
+	ajar_options o;
+	ajar_options_default(&o);
+	o.width = o.height = 16;
+	o.spp = 2;
+	o.seed = 5;
+	o.integrator = integ;
+	o.mis = mis;
+	assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_OK);
+	assert_int_equal(ajar_renderer_render(r, NULL, NULL), AJAR_OK);
+	assert_int_equal(ajar_renderer_image(r, img, NULL, NULL), AJAR_OK);
+	ajar_renderer_destroy(&r);
+}
+
+static void test_mis_auto(void **state)
+{
+	static const struct {
+		const char *scene;
+		int lamp;
+		ajar_mis want;
+	} cases[] = {
+		{"window-room-forest/window-room-forest.gltf", 0, AJAR_MIS_BALANCE},
+		{"window-room-sunset/window-room-sunset.gltf", 0, AJAR_MIS_BALANCE},
+		{"window-room-forest/window-room-forest.gltf", 1, AJAR_MIS_POWER},
+		{"window-room-sun/window-room-sun.gltf", 0, AJAR_MIS_POWER},
+		{"window-room/window-room.gltf", 0, AJAR_MIS_POWER},
+	};
+	static float a[16 * 16 * 4], b[16 * 16 * 4], c[16 * 16 * 4];
+	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+		ajar_scene *s;
+		char path[256];
+		snprintf(path, sizeof path, SCENE("%s"), cases[i].scene);
+		assert_int_equal(ajar_scene_load(path, &s), AJAR_OK);
+		if (cases[i].lamp) {
+			ajar_light l;
+			ajar_light_default(&l);
+			l.position[1] = 1.5f;
+			l.intensity = 50.0f;
+			assert_int_equal(ajar_scene_add_light(s, &l), AJAR_OK);
+		}
+		for (int k = 0; k < 2; k++) {
+			ajar_integrator integ = k ? AJAR_INTEGRATOR_PORTAL : AJAR_INTEGRATOR_BDPT;
+			render_mis(s, integ, AJAR_MIS_AUTO, a);
+			render_mis(s, integ, cases[i].want, b);
+			render_mis(s, integ, cases[i].want == AJAR_MIS_BALANCE ? AJAR_MIS_POWER : AJAR_MIS_BALANCE, c);
+			print_message("%s%s, %s: auto is %s\n", cases[i].scene, cases[i].lamp ? " with a lamp" : "",
+				      k ? "portal" : "bdpt", cases[i].want == AJAR_MIS_BALANCE ? "balance" : "power");
+			assert_memory_equal(a, b, sizeof a);
+			assert_memory_not_equal(a, c, sizeof a);
+		}
+		ajar_scene_destroy(&s);
+	}
+}
+
 /* Strategy images: written with their header, refused when not kept. */
 static void test_strategy_file(void **state)
 {
@@ -552,6 +613,7 @@ int main(void)
 		cmocka_unit_test(test_cornell_reference),
 		cmocka_unit_test(test_same_seed_same_bits),
 		cmocka_unit_test(test_portal_as_bdpt),
+		cmocka_unit_test(test_mis_auto),
 		cmocka_unit_test(test_strategy_file),
 		cmocka_unit_test(test_cancel_keeps_image),
 		cmocka_unit_test(test_bad_options),

@@ -222,12 +222,14 @@ int args_parse_render(int argc, char **argv, RenderArgs *a)
 				rc = args_usage_error("--exposure: '%s' is not a number in -30..30", val);
 		}
 		else if (!strcmp(name, "--mis")) {
-			if (!strcmp(val, "power"))
+			if (!strcmp(val, "auto"))
+				a->opt.mis = AJAR_MIS_AUTO;
+			else if (!strcmp(val, "power"))
 				a->opt.mis = AJAR_MIS_POWER;
 			else if (!strcmp(val, "balance"))
 				a->opt.mis = AJAR_MIS_BALANCE;
 			else
-				rc = args_usage_error("--mis: '%s' is not power or balance", val);
+				rc = args_usage_error("--mis: '%s' is not auto, power or balance", val);
 		}
 		else /* --seed */
 			rc = parse_u32(name, val, 0, UINT32_MAX, &a->opt.seed);

@@ -68,7 +68,9 @@ static const char usage_render[] =
 	"  --max-depth N          maximum path segments, camera segment included\n"
 	"                         (default 64 for pt, 32 for bdpt and portal, their limit)\n"
 	"  --min-depth N          leave out paths of fewer segments\n"
-	"  --mis NAME             power (default) or balance heuristic (bdpt, portal)\n"
+	"  --mis NAME             bdpt, portal: MIS heuristic, auto (default: balance\n"
+	"                         where a sky image's sun through the portals is the\n"
+	"                         only light, else power), power or balance\n"
 	"  --strategies OUT.exr   bdpt, portal: also write one RGB layer per strategy of\n"
 	"                         paths of up to --strategy-len N segments (default 4):\n"
 	"                         len<n>.s<s>t<t>.R/G/B for bdpt's (s, t), and for\n"
@@ -283,7 +285,10 @@ static int write_outputs(ajar_renderer *r, const RenderArgs *a)
 	return EXIT_OK;
 }
 
-static const char *mis_name(ajar_mis m) { return m == AJAR_MIS_BALANCE ? "balance" : "power"; }
+static const char *mis_name(ajar_mis m)
+{
+	return m == AJAR_MIS_BALANCE ? "balance" : m == AJAR_MIS_AUTO ? "auto" : "power";
+}
 
 /* --resume: the options come from the checkpoint; an option given on the
  * command line must agree with it, except --spp, --time and --device,

@@ -6,7 +6,8 @@ bench-peers; run with the peers' venv:
   build/peers/venv/bin/python tests/peers/sky_eff.py AJAR SCENE INTEGRATOR SPP [VAR=VALUE ...]
 
 renders seeds 1 and 2 (or seeds=A,B) at 64 x 64 with one PoCL thread (depth=N: at
---max-depth N, as bench-peers renders at 32; default the scene's), and prints spp, the
+--max-depth N, as bench-peers renders at 32; default the scene's; mis=NAME: with
+--mis NAME), and prints spp, the
 relative variance of one render (mean over pixels and channels of
 (a - b)^2 / 2 / (r^2 + (0.1 mean r)^2), r the two seeds' mean, the error
 measure of tests/bench.c without a reference), relvar x spp (the variance
@@ -27,9 +28,9 @@ sys.path.insert(0, os.path.dirname(__file__))
 import images  # noqa: E402
 
 
-def render(ajar, scene, integ, spp, seed, env, out, depth=None):
+def render(ajar, scene, integ, spp, seed, env, out, depth=None, mis=None):
 	cmd = [ajar, "render", scene, "--integrator", integ, "--size", "64x64", "--spp", str(spp), "--seed", str(seed),
-	       "-o", out, "-q"] + (["--max-depth", str(depth)] if depth else [])
+	       "-o", out, "-q"] + (["--max-depth", str(depth)] if depth else []) + (["--mis", mis] if mis else [])
 	before = resource.getrusage(resource.RUSAGE_CHILDREN)
 	r = subprocess.run(cmd, env=env, capture_output=True, text=True)
 	after = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -46,20 +47,23 @@ def main():
 	env = dict(os.environ, POCL_MAX_PTHREAD_COUNT="1")
 	seeds = (1, 2)
 	depth = None
+	mis = None
 	for kv in sys.argv[5:]:
 		k, v = kv.split("=", 1)
 		if k == "seeds":  # seeds=3,4: another pair
 			seeds = tuple(int(x) for x in v.split(","))
 		elif k == "depth":  # depth=32: the bench's --max-depth (default: the scene's)
 			depth = int(v)
+		elif k == "mis":  # mis=balance: --mis (default: the renderer's, auto)
+			mis = v
 		else:
 			env[k] = v
 	tmp = os.environ.get("TMPDIR", "/tmp")
 	tag = f"{os.getpid()}"
-	render(ajar, scene, integ, 1, 3, env, f"{tmp}/sky_eff_{tag}_0.exr", depth)  # builds the kernel if not cached
-	_, c1 = render(ajar, scene, integ, 1, 3, env, f"{tmp}/sky_eff_{tag}_0.exr", depth)
-	a, ca = render(ajar, scene, integ, spp, seeds[0], env, f"{tmp}/sky_eff_{tag}_1.exr", depth)
-	b, cb = render(ajar, scene, integ, spp, seeds[1], env, f"{tmp}/sky_eff_{tag}_2.exr", depth)
+	render(ajar, scene, integ, 1, 3, env, f"{tmp}/sky_eff_{tag}_0.exr", depth, mis)  # builds the kernel if not cached
+	_, c1 = render(ajar, scene, integ, 1, 3, env, f"{tmp}/sky_eff_{tag}_0.exr", depth, mis)
+	a, ca = render(ajar, scene, integ, spp, seeds[0], env, f"{tmp}/sky_eff_{tag}_1.exr", depth, mis)
+	b, cb = render(ajar, scene, integ, spp, seeds[1], env, f"{tmp}/sky_eff_{tag}_2.exr", depth, mis)
 	r = 0.5 * (a + b)
 	m = float(r.mean())
 	relvar = float(np.mean((a - b) ** 2 / 2.0 / (r * r + 0.01 * m * m)))
