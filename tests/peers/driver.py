@@ -12,7 +12,8 @@ renderers). relMSE is tests/bench.c's formula (images.rel_mse).
 Environment: PEERS_SECONDS (20), PEERS_SCENES ("window-room living-room
 door-ajar"; cornell also works, and "sky" names the sky- and lamp-lit scenes
 window-room-sunset window-room-forest living-room-forest window-room-sun window-room-lamp
-door-ajar-lamp atrium-forest), PEERS_SIZE (image width, height from the
+door-ajar-lamp atrium-forest window-room-fullsun, the last window-room-forest
+with its sun as an unclipped download has it), PEERS_SIZE (image width, height from the
 camera's aspect ratio, or WxH; 128), PEERS_REF_SECONDS (each reference half;
 300), PEERS_DEPTH (32), PEERS_THREADS (all cores), PEERS_RENDERERS (default
 all: ajar-pt ajar-bdpt ajar-portal mitsuba mitsuba-ld cycles cycles-noportal
@@ -23,6 +24,7 @@ import hashlib
 import json
 import os
 import resource
+import shutil
 import subprocess
 import sys
 import time
@@ -44,10 +46,44 @@ ALL = ["ajar-pt", "ajar-bdpt", "ajar-portal", "mitsuba", "mitsuba-ld", "cycles",
 DEFAULT_REF = {"window-room": "mitsuba", "living-room": "mitsuba", "door-ajar": "mitsuba", "cornell": "mitsuba",
 	       "window-room-sunset": "mitsuba", "window-room-forest": "mitsuba", "living-room-forest": "mitsuba",
 	       "window-room-sun": "mitsuba", "window-room-lamp": "mitsuba", "door-ajar-lamp": "mitsuba",
-	       "atrium-forest": "mitsuba"}
+	       "atrium-forest": "mitsuba", "window-room-fullsun": "mitsuba"}
 # The scenes lit by sky images and KHR_lights_punctual lamps (scenes/skies/make_sky_scenes.py).
 SKY_SCENES = ("window-room-sunset window-room-forest living-room-forest window-room-sun window-room-lamp door-ajar-lamp "
-	      "atrium-forest")
+	      "atrium-forest window-room-fullsun")
+
+
+# Sky scenes with the sun as a download with an unclipped sun has it. The
+# shipped skies are Blender's 1k copies, whose suns are clipped (forest: peak
+# 1,437, the sun 5% of the sky's power), so their rooms are lit mostly by the
+# sky; here the sky's sun pixels (luminance above 0.3 of the peak) are
+# multiplied, so the sun carries most of the light (forest x 60: 75%, peak
+# 81,000; kernels/sky_measurements.md, "A sun as bright as the sky's own").
+# Made from the shipped scene into build/peers/ by sun_variant; not shipped.
+SUN_VARIANTS = {"window-room-fullsun": ("window-room-forest", 60.0)}
+
+
+def sun_variant(name):
+	"""build/peers/NAME.gltf: SUN_VARIANTS[name]'s scene under its sky with
+	the sun multiplied, and the note that says so."""
+	base, gain = SUN_VARIANTS[name]
+	src = os.path.join(ROOT, "scenes", base, base + ".gltf")
+	doc = json.load(open(src))
+	env = doc["scenes"][0]["extras"]["environment"]
+	rgb, _ = images.read_exr(os.path.join(os.path.dirname(src), env["image"]))
+	rgb = np.maximum(rgb, 0.0)
+	lum = rgb @ np.array([0.2126, 0.7152, 0.0722])
+	sun = lum > 0.3 * lum.max()
+	rgb[sun] *= gain
+	env["image"] = name + "-sky.exr"
+	images.write_exr(os.path.join(OUT, env["image"]), rgb)
+	for b in doc["buffers"]:
+		dst = os.path.join(OUT, b["uri"])
+		if not os.path.exists(dst):
+			shutil.copyfile(os.path.join(os.path.dirname(src), b["uri"]), dst)
+	out = os.path.join(OUT, name + ".gltf")
+	with open(out, "w") as f:
+		json.dump(doc, f)
+	return out, f"{base} with its sky's {int(sun.sum())} sun pixels x {gain:g} (peak {lum.max() * gain:.0f})"
 
 
 def supports(renderer, scene):
@@ -252,6 +288,11 @@ def reference(name, path, size, depth, ref_seconds):
 def scene_path(name):
 	"""The shipped scene, or its matched Lambertian variant when it is not
 	Lambertian already (living-room)."""
+	if name in SUN_VARIANTS:
+		path, note = sun_variant(name)
+		s = Scene(path)
+		s.check_lambertian()
+		return path, s, [note]
 	path = os.path.join(ROOT, "scenes", name, name + ".gltf")
 	s = Scene(path)
 	try:
