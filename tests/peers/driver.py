@@ -18,7 +18,8 @@ camera's aspect ratio, or WxH; 128), PEERS_REF_SECONDS (each reference half;
 300), PEERS_DEPTH (32), PEERS_THREADS (all cores), PEERS_RENDERERS (default
 all: ajar-pt ajar-bdpt ajar-portal mitsuba mitsuba-ld cycles cycles-noportal
 luxcore-path luxcore-bidir), PEERS_REF_<SCENE> (reference renderer for a
-scene, e.g. PEERS_REF_DOOR_AJAR=mitsuba).
+scene, e.g. PEERS_REF_DOOR_AJAR=mitsuba), PEERS_AJAR_MIS (Ajar's --mis; default
+its own, auto).
 """
 import hashlib
 import json
@@ -160,6 +161,8 @@ def run_ajar(integrator, path, size, depth, out, seconds=0.0, spp=0, seed=7):
 		cmd += ["--time", str(seconds)]
 	if spp:
 		cmd += ["--spp", str(spp)]
+	if os.environ.get("PEERS_AJAR_MIS"):
+		cmd += ["--mis", os.environ["PEERS_AJAR_MIS"]]
 	for attempt in range(4):
 		r, wall, cpu = run_timed(cmd, cwd=ROOT, env=sub_env(), capture_output=True, text=True)
 		if r.returncode == 0:
