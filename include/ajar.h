@@ -161,9 +161,9 @@ ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info);
 /* ---- Rendering --------------------------------------------------------- */
 
 typedef enum { AJAR_INTEGRATOR_PT = 0, AJAR_INTEGRATOR_BDPT = 1, AJAR_INTEGRATOR_PORTAL = 2 } ajar_integrator;
-/* AJAR_MIS_AUTO (the default): the balance heuristic where a sky image's sun
- * shining in through the portals is the only light, the power heuristic
- * elsewhere (README, "Choosing an integrator"). */
+/* The bidirectional integrators' MIS heuristic. AJAR_MIS_AUTO (the default):
+ * the balance heuristic where a sky image's sun shining in through the
+ * portals is the only light, the power heuristic elsewhere. */
 typedef enum { AJAR_MIS_POWER = 0, AJAR_MIS_BALANCE = 1, AJAR_MIS_AUTO = 2 } ajar_mis;
 /* Longest path (segments) the bidirectional integrators take. */
 #define AJAR_BIDIR_MAX_DEPTH 32
