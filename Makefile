@@ -40,7 +40,7 @@ LIB_CXX := $(wildcard src/*.cpp)
 LIB_OBJS := $(LIB_C:src/%.c=$(BUILD)/src/%.o) $(LIB_CXX:src/%.cpp=$(BUILD)/src/%.o) $(BUILD)/kernel_source.o
 CLI_OBJS := $(patsubst src/cli/%.c,$(BUILD)/cli/%.o,$(wildcard src/cli/*.c))
 KERNELS := $(wildcard kernels/*.h kernels/*.cl)
-TESTS := $(patsubst tests/%.c,%,$(wildcard tests/test_*.c))
+TESTS := $(patsubst tests/%.c,%,$(wildcard tests/test_*.c)) test_lights_fine
 
 # One test binary per module, linking only what it tests (plus error.o).
 obj = $(addprefix $(BUILD)/src/,$(addsuffix .o,$(1)))
@@ -48,6 +48,7 @@ DEPS_test_bsdf := $(call obj,error)
 DEPS_test_sampling := $(call obj,error)
 DEPS_test_bvh := $(call obj,error scene bvh gltf tangents exr exr_dwa exr_huf hdr)
 DEPS_test_lights := $(call obj,error scene lights exr exr_dwa exr_huf hdr portal_sky portal_flux)
+DEPS_test_lights_fine := $(DEPS_test_lights)
 DEPS_test_scene := $(call obj,error scene scene_api gltf tangents exr exr_dwa exr_huf hdr)
 DEPS_test_exr := $(call obj,error exr exr_dwa exr_huf png)
 DEPS_test_confine := $(call obj,error scene scene_api gltf tangents exr exr_dwa exr_huf hdr png)
@@ -159,6 +160,13 @@ $(BUILD)/tests/%.o: tests/%.c
 	@echo "  CC      $<"
 	$(Q)$(CC) $(CPPFLAGS) -Itests $(PKG_CFLAGS) $(CFLAGS) -c -o $@ $<
 
+# test_lights again with the planes' sky tables at 512 cells a side, as pt
+# takes them under skies of 2048 columns or more (src/prepare.c).
+$(BUILD)/tests/test_lights_fine.o: tests/test_lights.c
+	@mkdir -p $(@D)
+	@echo "  CC      $< (PORTAL_SKY_RES=512)"
+	$(Q)$(CC) $(CPPFLAGS) -Itests $(PKG_CFLAGS) $(CFLAGS) -DPORTAL_SKY_RES=512 -c -o $@ $<
+
 # Test binaries link their module objects (secondary expansion of DEPS_*).
 .SECONDEXPANSION:
 $(BUILD)/tests/test_%: $(BUILD)/tests/test_%.o $(BUILD)/tests/testutil.o $$(DEPS_test_$$*)
@@ -179,7 +187,7 @@ test:
 	$(Q)sh tests/run.sh $(BUILD) $(TESTS)
 
 # Host tests that need no OpenCL device, under ASan + UBSan.
-ASAN_TESTS := test_bsdf test_sampling test_bvh test_lights test_scene test_exr test_bdpt test_portal test_confine test_punctual
+ASAN_TESTS := test_bsdf test_sampling test_bvh test_lights test_lights_fine test_scene test_exr test_bdpt test_portal test_confine test_punctual
 asan:
 	$(Q)$(MAKE) --no-print-directory deps
 	$(Q)$(MAKE) --no-print-directory MODE=asan $(ASAN_TESTS:%=build/asan/tests/%)

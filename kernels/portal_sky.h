@@ -28,8 +28,15 @@
 #include "types.h"
 #include "fastmath.h"
 
+/* Cells on a side of each plane's table: 128 (1.4 degrees at the centre)
+ * unless the host builds the program with -DPORTAL_SKY_RES=N: pt takes 256,
+ * or 512 under a sky image of 2048 columns or more, whose small sun a
+ * 1.4-degree cell spreads thin (src/prepare.c, sky_table_res). */
+#ifndef PORTAL_SKY_RES
 #define PORTAL_SKY_RES 128
-#define PORTAL_SKY_FLOATS (2 * (PORTAL_SKY_RES + 1) * (PORTAL_SKY_RES + 1))
+#endif
+/* Floats of a table of n cells a side: (n + 1)^2 (hi, lo) pairs. */
+#define PORTAL_SKY_FLOATS_OF(n) (2 * ((n) + 1) * ((n) + 1))
 #define PORTAL_SKY_CELL (AJAR_PI / (float)PORTAL_SKY_RES) /* radians per cell */
 
 /* What x sees of a plane: its rectangle in cell units, and the rows and

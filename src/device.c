@@ -19,6 +19,7 @@
 
 #include "error.h"
 #include "kernel_source.h"
+#include "../kernels/portal_sky.h"
 #include "../kernels/types.h"
 
 #define MAX_PLATFORMS 16
@@ -531,6 +532,8 @@ void device_render_options(const Device *d, int integrator, const DevicePlan *p,
 	for (size_t i = 0; i < sizeof omit / sizeof omit[0] && n < cap; i++)
 		if (!p->general && (p->omit & omit[i].bit))
 			n += (size_t)snprintf(buf + n, cap - n, "%s", omit[i].option);
+	if (p->sky_res && p->sky_res != PORTAL_SKY_RES && n < cap)
+		n += (size_t)snprintf(buf + n, cap - n, "-DPORTAL_SKY_RES=%d ", p->sky_res);
 	if (n < cap)
 		snprintf(buf + n, cap - n, "%s", extra ? extra : "");
 }

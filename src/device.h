@@ -61,6 +61,7 @@ typedef struct {
 	size_t scratch_bytes; /* 0 without scratch */
 	unsigned omit;        /* DEVICE_OMIT_*: scene features the program leaves out (the caller sets it) */
 	int general;          /* AJAR_KERNEL_FEATURES=all: omit nothing, whatever `omit` says */
+	int sky_res;          /* cells a side of the planes' sky tables (-DPORTAL_SKY_RES unless 128; the caller sets it) */
 } DevicePlan;
 /* Scene features render_pass can be built without (kernel specialisation,
  * kernels/materials.md "Feature-specialised programs"): prepare_scene says

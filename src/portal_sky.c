@@ -90,9 +90,8 @@ static int plane_frame(const PortalTri *portals, const uint32_t *root, uint32_t 
 	return P->a1 > P->a0 && P->b1 > P->b0;
 }
 
-static int plane_table(const SceneView *sc, const PortalPlane *P, float *out)
+static int plane_table(const SceneView *sc, const PortalPlane *P, int N, float *out)
 {
-	enum { N = PORTAL_SKY_RES };
 	double *cell = malloc(sizeof(double) * N * N), sum = 0.0;
 	double *S = calloc((size_t)(N + 1) * (N + 1), sizeof(double));
 	if (!cell || !S) {
@@ -135,9 +134,10 @@ static int plane_table(const SceneView *sc, const PortalPlane *P, float *out)
 	return 1;
 }
 
-ajar_status portal_sky_build(const SceneView *sc, const PortalTri *portals, uint32_t n, PortalPlane **planes,
+ajar_status portal_sky_build(const SceneView *sc, const PortalTri *portals, uint32_t n, int res, PortalPlane **planes,
 			     size_t *nplanes, float **sky, size_t *nsky)
 {
+	const size_t floats = PORTAL_SKY_FLOATS_OF((size_t)res);
 	*planes = NULL;
 	*sky = NULL;
 	*nplanes = *nsky = 0;
@@ -170,7 +170,7 @@ ajar_status portal_sky_build(const SceneView *sc, const PortalTri *portals, uint
 		return AJAR_OK;
 	}
 	PortalPlane *pl = malloc(sizeof *pl * groups);
-	float *tab = malloc(sizeof *tab * (size_t)groups * PORTAL_SKY_FLOATS);
+	float *tab = malloc(sizeof *tab * groups * floats);
 	if (!pl || !tab) {
 		free(root);
 		free(pl);
@@ -188,9 +188,9 @@ ajar_status portal_sky_build(const SceneView *sc, const PortalTri *portals, uint
 	for (uint32_t g = 0; g < n; g++) {
 		if (root[g] != g || portals[g].env_side == 0 || !plane_frame(portals, root, n, g, &pl[np]))
 			continue;
-		pl[np].table = (int)(np * PORTAL_SKY_FLOATS);
+		pl[np].table = (int)(np * floats);
 		pl[np].guide = guide;
-		if (!plane_table(sc, &pl[np], tab + np * PORTAL_SKY_FLOATS)) {
+		if (!plane_table(sc, &pl[np], res, tab + np * floats)) {
 			free(root);
 			free(pl);
 			free(tab);
@@ -202,6 +202,6 @@ ajar_status portal_sky_build(const SceneView *sc, const PortalTri *portals, uint
 	*planes = pl;
 	*sky = tab;
 	*nplanes = np;
-	*nsky = np * PORTAL_SKY_FLOATS;
+	*nsky = np * floats;
 	return AJAR_OK;
 }

@@ -128,6 +128,33 @@ static int lamp_behind_portal(const SceneData *d, V3 camera)
 	return 0;
 }
 
+/* Cells a side of the planes' sky tables (kernels/portal_sky.h). With 128
+ * cells (1.4 degrees at the centre) a sun of a sky of 2048 columns or more
+ * (0.53 degrees, a few texels) covers a fraction of its cell, and pt's
+ * next-event samples drawn into that cell mostly miss it: 512 cells (0.35
+ * degrees) halved pt's variance per sample there (2k and 4k skies,
+ * window-room and living-room: 1.7-2x less variance x time), and 256 gave
+ * it 3-22% under the shipped 1k skies. bdpt and portal keep 128: their
+ * light subpaths bring the sun in by the image's own full-resolution table,
+ * their MIS weights read the tables many times, and finer ones gave them
+ * 2-6% less variance for 4-40% more time (kernels/sky_measurements.md,
+ * "Sharper sky tables for pt"). AJAR_SKY_RES = 128, 256 or 512 sets it for
+ * any integrator, for comparisons. */
+static int sky_table_res(const Scene *s, int integrator)
+{
+	int res = 128;
+	if (integrator == INTEGRATOR_PT && s->env_type == ENV_IMAGE)
+		res = s->env_width >= 2048 ? 512 : 256;
+	const char *v = getenv("AJAR_SKY_RES");
+	if (v) {
+		if (strcmp(v, "128") == 0 || strcmp(v, "256") == 0 || strcmp(v, "512") == 0)
+			res = atoi(v);
+		else
+			log_msg(AJAR_LOG_WARNING, "AJAR_SKY_RES='%s' is not 128, 256 or 512; ignored", v);
+	}
+	return res;
+}
+
 static float env_rate(const char *name, float dflt)
 {
 	const char *v = getenv(name);
@@ -382,9 +409,10 @@ ajar_status prepare_scene(const Scene *s, const PrepareOptions *o, SceneData *d)
 	 * (kernels/portal_sky.h); AJAR_PORTAL_SKY=0 keeps the triangles' solid
 	 * angle instead, for comparisons. */
 	const char *sky = getenv("AJAR_PORTAL_SKY");
+	d->sky_res = o->sky_res ? o->sky_res : sky_table_res(s, p->integrator);
 	if (!(sky && strcmp(sky, "0") == 0) &&
-	    (st = portal_sky_build(&view, d->portals, (uint32_t)d->n_portals, &d->portal_planes, &d->n_portal_planes,
-				   &d->portal_sky, &d->n_portal_sky)) != AJAR_OK) {
+	    (st = portal_sky_build(&view, d->portals, (uint32_t)d->n_portals, d->sky_res, &d->portal_planes,
+				   &d->n_portal_planes, &d->portal_sky, &d->n_portal_sky)) != AJAR_OK) {
 		prepare_free(d);
 		return st;
 	}

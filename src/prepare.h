@@ -13,6 +13,7 @@ typedef struct {
 	Bvh bvh;
 	LightTables lights;
 	float sun_share_portals; /* portal with a sky image: its sun's share of the sky light through the portals (portal_flux.c) */
+	int sky_res;             /* cells a side of the planes' sky tables: the program's PORTAL_SKY_RES (kernels/portal_sky.h) */
 	double bvh_seconds;
 	V3 bmin, bmax;
 	unsigned kernel_omit; /* DEVICE_OMIT_* (device.h): features no triangle or material uses */
@@ -27,6 +28,7 @@ typedef struct {
 	uint32_t min_depth;
 	uint32_t strategy_len;
 	int strategy_unweighted;
+	int sky_res; /* cells a side of the planes' sky tables; 0: prepare_scene's choice (tests set their kernels' PORTAL_SKY_RES) */
 } PrepareOptions;
 
 /* The portal integrator's default rates of intermediate subpaths, in

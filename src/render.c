@@ -183,6 +183,7 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 	if ((st = device_plan(d, r->data.params->integrator, (size_t)r->width * r->height, &rd->plan)) != AJAR_OK)
 		return st;
 	rd->plan.omit = r->data.kernel_omit; /* features the scene lacks: a specialised program */
+	rd->plan.sky_res = r->data.sky_res;
 	device_render_options(d, r->data.params->integrator, &rd->plan, extra, options, sizeof options);
 	if ((st = device_build(d, ajar_kernel_source, options)) != AJAR_OK) {
 		char *why = extra && extra[0] ? strdup(ajar_last_error()) : NULL;
@@ -352,7 +353,7 @@ ajar_status renderer_new(const ajar_scene *scene, const ajar_options *opt, Check
 	r->opt.height = r->height;
 	snprintf(r->scene_name, sizeof r->scene_name, "%s", scene->source ? scene->source : "");
 	PrepareOptions po = {r->width, r->height, (int)opt->integrator, opt->max_depth, opt->seed,
-			     (int)opt->mis, opt->min_depth, opt->strategy_len, opt->strategy_unweighted};
+			     (int)opt->mis, opt->min_depth, opt->strategy_len, opt->strategy_unweighted, 0};
 	if ((st = prepare_scene(scene, &po, &r->data)) != AJAR_OK)
 		goto fail;
 	if (ck && (st = render_checkpoint_check(r, ck, ck_path)) != AJAR_OK)

@@ -118,7 +118,7 @@ static void bench_scene(const char *path, uint32_t spp)
 	double t0 = now();
 	check(ajar_scene_load(path, &s));
 	double load = now() - t0;
-	PrepareOptions po = {64, 64, 0, 64, 1, 0, 0, 0, 0};
+	PrepareOptions po = {64, 64, 0, 64, 1, 0, 0, 0, 0, 0};
 	check(prepare_scene(s, &po, &sd));
 	check(device_select(NULL, &plat, &id, 1, &ndev));
 	check(device_open(&d, plat, id));

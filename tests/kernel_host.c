@@ -17,7 +17,8 @@ void host_scene_open(HostScene *h, const char *path, Scene *built, uint32_t w, u
 	} else {
 		h->scene = built;
 	}
-	PrepareOptions po = {w, hgt, integrator, (uint32_t)max_depth, 1, MIS_POWER, 0, 0, 0};
+	/* The kernels compiled here read sky tables of PORTAL_SKY_RES cells a side. */
+	PrepareOptions po = {w, hgt, integrator, (uint32_t)max_depth, 1, MIS_POWER, 0, 0, 0, PORTAL_SKY_RES};
 	if (prepare_scene(h->scene, &po, &h->data) != AJAR_OK)
 		fail_msg("%s", ajar_last_error());
 #define HOST_VIEW(type, name) h->view.name = h->data.name;

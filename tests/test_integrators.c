@@ -139,16 +139,24 @@ static void compare_punctual(const char *path, const char *what, const float dir
 	compare_scene(s, what, w, h, spp_pt, spp_bdpt);
 }
 
-/* path under a sky with a sun disc of radiance 300 at elevation `sun`
- * (radians) toward -z. */
-static void compare_sky(const char *path, float sun, uint32_t w, uint32_t h, uint32_t spp_pt, uint32_t spp_bdpt)
+/* path under a sky of sw x sh texels with a sun disc of angular radius
+ * `radius` (radians) at elevation `sun` toward -z, its radiance so that it
+ * carries what a disc of 0.04 rad at 300 does. */
+static void compare_sky_image(const char *path, uint32_t sw, uint32_t sh, float sun, float radius, uint32_t w,
+			      uint32_t h, uint32_t spp_pt, uint32_t spp_bdpt)
 {
 	ajar_scene *s;
 	if (ajar_scene_load(path, &s) != AJAR_OK)
 		fail_msg("%s", ajar_last_error());
-	float *sky = test_sun_sky(256, 128, 0.1f, sinf(sun), -cosf(sun), 0.04f, 300.0f);
-	assert_int_equal(scene_set_env_image(s, 256, 128, sky, 1.0f), AJAR_OK);
+	float L = 300.0f * (0.04f / radius) * (0.04f / radius);
+	float *sky = test_sun_sky(sw, sh, 0.1f, sinf(sun), -cosf(sun), radius, L);
+	assert_int_equal(scene_set_env_image(s, sw, sh, sky, 1.0f), AJAR_OK);
 	compare_scene(s, path, w, h, spp_pt, spp_bdpt);
+}
+
+static void compare_sky(const char *path, float sun, uint32_t w, uint32_t h, uint32_t spp_pt, uint32_t spp_bdpt)
+{
+	compare_sky_image(path, 256, 128, sun, 0.04f, w, h, spp_pt, spp_bdpt);
 }
 
 static void test_cornell(void **state) { compare(SCENE("cornell/cornell.gltf"), 32, 32, 32, 8); }
@@ -166,6 +174,18 @@ static void test_window_room_sun(void **state)
 	setenv("AJAR_PORTAL_SET", "1,2,1,3,1", 1);
 	compare_sky(SCENE("window-room/window-room.gltf"), 0.84f, 32, 32, 64, 16);
 	compare_sky(SCENE("window-room/window-room.gltf"), 0.14f, 32, 32, 64, 16);
+	unsetenv("AJAR_PORTAL_SET");
+}
+/* A sun of 0.57 degrees sampled through the planes' tables of 512 cells a
+ * side, as pt takes them under skies of 2048 columns or more (src/prepare.c,
+ * sky_table_res; test_render checks that choice), here for all three on a
+ * smaller image. */
+static void test_window_room_small_sun(void **state)
+{
+	setenv("AJAR_PORTAL_SET", "1,2,1,3,1", 1);
+	setenv("AJAR_SKY_RES", "512", 1);
+	compare_sky_image(SCENE("window-room/window-room.gltf"), 1024, 512, 0.84f, 0.01f, 32, 32, 64, 16);
+	unsetenv("AJAR_SKY_RES");
 	unsetenv("AJAR_PORTAL_SET");
 }
 static void test_door_ajar(void **state) { compare(SCENE("door-ajar/door-ajar.gltf"), 24, 24, 512, 128); }
@@ -304,6 +324,7 @@ int main(void)
 		cmocka_unit_test(test_cornell),
 		cmocka_unit_test(test_window_room),
 		cmocka_unit_test(test_window_room_sun),
+		cmocka_unit_test(test_window_room_small_sun),
 		cmocka_unit_test(test_living_room),
 		cmocka_unit_test(test_bathroom),
 		cmocka_unit_test(test_door_ajar),

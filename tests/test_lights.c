@@ -113,7 +113,8 @@ static int lit_planes(Lit *l)
 	size_t np, ns;
 	free(l->planes);
 	free(l->sky);
-	assert_int_equal(portal_sky_build(&l->sc, l->s->portals, l->s->nportal_tris, &l->planes, &np, &l->sky, &ns),
+	assert_int_equal(portal_sky_build(&l->sc, l->s->portals, l->s->nportal_tris, PORTAL_SKY_RES, &l->planes, &np,
+					  &l->sky, &ns),
 			 AJAR_OK);
 	l->sc.portal_planes = l->planes;
 	l->sc.portal_sky = l->sky;
@@ -1069,7 +1070,7 @@ static void test_light_sample_env_portal_grid(void **state)
  * sky half. */
 static void check_sky_uv(Lit *l, int k, V3 x, const char *name)
 {
-	enum { B = 4, NB = (PORTAL_SKY_RES / B) * (PORTAL_SKY_RES / B), N = 200000 };
+	enum { B = PORTAL_SKY_RES / 32, NB = (PORTAL_SKY_RES / B) * (PORTAL_SKY_RES / B), N = 200000 };
 	static double obs[NB], expct[NB];
 	const PortalPlane *P = &l->planes[k];
 	const float *S = l->sky + P->table;
@@ -1352,5 +1353,11 @@ int main(void)
 		cmocka_unit_test(test_light_sample_sky_grid),
 		cmocka_unit_test(test_sky_pdf_views),
 	};
+	/* test_lights_fine (Makefile): the planes' tables at PORTAL_SKY_RES
+	 * cells a side, as pt takes them under large skies (src/prepare.c,
+	 * sky_table_res): the sky-through-planes tests alone, the last three. */
+	enum { NT = sizeof tests / sizeof tests[0], FINE = 3 };
+	if (PORTAL_SKY_RES != 128)
+		return _cmocka_run_group_tests("lights, fine sky tables", tests + NT - FINE, FINE, NULL, NULL);
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -366,7 +366,7 @@ static unsigned scene_omit(const char *path)
 	SceneData d;
 	if (ajar_scene_load(path, &s) != AJAR_OK)
 		fail_msg("%s: %s", path, ajar_last_error());
-	PrepareOptions po = {8, 8, 0, 8, 1, 0, 0, 0, 0};
+	PrepareOptions po = {8, 8, 0, 8, 1, 0, 0, 0, 0, 0};
 	if (prepare_scene(s, &po, &d) != AJAR_OK)
 		fail_msg("%s: %s", path, ajar_last_error());
 	unsigned omit = d.kernel_omit;
@@ -514,6 +514,43 @@ static void test_mis_auto(void **state)
 	}
 }
 
+/* The planes' sky tables: 512 cells a side for pt under a sky of 2048
+ * columns, 256 under a shipped 1k sky (src/prepare.c, sky_table_res), 128
+ * for bdpt; each default compared bit for bit with AJAR_SKY_RES naming the
+ * resolution, and pt's with 128. */
+static void render_sky_res(ajar_scene *s, ajar_integrator integ, const char *res, float *img)
+{
+	if (res)
+		setenv("AJAR_SKY_RES", res, 1);
+	render_mis(s, integ, AJAR_MIS_AUTO, img);
+	unsetenv("AJAR_SKY_RES");
+}
+
+static void test_sky_table_res(void **state)
+{
+	static float a[16 * 16 * 4], b[16 * 16 * 4];
+	ajar_scene *s;
+	assert_int_equal(ajar_scene_load(SCENE("window-room/window-room.gltf"), &s), AJAR_OK);
+	float *sky = test_sun_sky(2048, 1024, 0.1f, 0.74f, -0.67f, 0.01f, 4800.0f);
+	assert_int_equal(scene_set_env_image(s, 2048, 1024, sky, 1.0f), AJAR_OK);
+	render_sky_res(s, AJAR_INTEGRATOR_PT, NULL, a);
+	render_sky_res(s, AJAR_INTEGRATOR_PT, "512", b);
+	assert_memory_equal(a, b, sizeof a);
+	render_sky_res(s, AJAR_INTEGRATOR_PT, "128", b);
+	assert_memory_not_equal(a, b, sizeof a);
+	render_sky_res(s, AJAR_INTEGRATOR_BDPT, NULL, a);
+	render_sky_res(s, AJAR_INTEGRATOR_BDPT, "128", b);
+	assert_memory_equal(a, b, sizeof a);
+	ajar_scene_destroy(&s);
+	assert_int_equal(ajar_scene_load(SCENE("window-room-forest/window-room-forest.gltf"), &s), AJAR_OK);
+	render_sky_res(s, AJAR_INTEGRATOR_PT, NULL, a);
+	render_sky_res(s, AJAR_INTEGRATOR_PT, "256", b);
+	assert_memory_equal(a, b, sizeof a);
+	render_sky_res(s, AJAR_INTEGRATOR_PT, "128", b);
+	assert_memory_not_equal(a, b, sizeof a);
+	ajar_scene_destroy(&s);
+}
+
 /* Strategy images: written with their header, refused when not kept. */
 static void test_strategy_file(void **state)
 {
@@ -614,6 +651,7 @@ int main(void)
 		cmocka_unit_test(test_same_seed_same_bits),
 		cmocka_unit_test(test_portal_as_bdpt),
 		cmocka_unit_test(test_mis_auto),
+		cmocka_unit_test(test_sky_table_res),
 		cmocka_unit_test(test_strategy_file),
 		cmocka_unit_test(test_cancel_keeps_image),
 		cmocka_unit_test(test_bad_options),
