@@ -137,13 +137,13 @@ static int lamp_behind_portal(const SceneData *d, V3 camera)
  * it 3-22% under the shipped 1k skies. bdpt and portal keep 128: their
  * light subpaths bring the sun in by the image's own full-resolution table,
  * their MIS weights read the tables many times, and finer ones gave them
- * 2-6% less variance for 4-40% more time (kernels/sky_measurements.md,
+ * 1-6% less variance for up to 30% more time (kernels/sky_measurements.md,
  * "Sharper sky tables for pt"). AJAR_SKY_RES = 128, 256 or 512 sets it for
  * any integrator, for comparisons. */
 static int sky_table_res(const Scene *s, int integrator)
 {
 	int res = 128;
-	if (integrator == INTEGRATOR_PT && s->env_type == ENV_IMAGE)
+	if (integrator == INTEGRATOR_PT && s->env_type == ENV_IMAGE && s->nportal_tris > 0)
 		res = s->env_width >= 2048 ? 512 : 256;
 	const char *v = getenv("AJAR_SKY_RES");
 	if (v) {
