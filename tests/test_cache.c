@@ -325,6 +325,13 @@ static void test_render_options(void **state)
 	p.general = 1;
 	device_render_options(&gpu, 1, &p, NULL, buf, sizeof buf);
 	assert_string_equal(buf, KERNEL_OPTIONS "1 -DAJAR_CALLS -DAJAR_SUBPATH_SOA=128 -DAJAR_SUBPATH_WORDS=72 ");
+	/* The planes' sky tables: an option only where they are not the kernels' default size. */
+	DevicePlan q = {.sky_res = 128};
+	device_render_options(&cpu, 0, &q, NULL, buf, sizeof buf);
+	assert_string_equal(buf, KERNEL_OPTIONS "0 ");
+	q.sky_res = 512;
+	device_render_options(&cpu, 0, &q, NULL, buf, sizeof buf);
+	assert_string_equal(buf, KERNEL_OPTIONS "0 -DPORTAL_SKY_RES=512 ");
 }
 
 static void test_directory_fallbacks(void **state)
