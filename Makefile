@@ -17,13 +17,13 @@ MODE_FLAGS_release := -O2 -g
 MODE_FLAGS_debug := -O0 -g
 MODE_FLAGS_asan := -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
 MFLAGS := $(MODE_FLAGS_$(MODE))
-CPPFLAGS += -Iinclude -Isrc -MMD -MP
+CPPFLAGS += -Iinclude -Isrc -Ikernels -MMD -MP
 CFLAGS += -std=c11 -D_GNU_SOURCE -ffp-contract=off $(WARN) $(MFLAGS) -fPIC
 CXXFLAGS += -std=c++14 $(WARN) $(MFLAGS) -fPIC
 LDFLAGS += $(MFLAGS)
 LDLIBS = $(PKG_LIBS) $(MPI_LIBS) -lz -lm -lpthread
 
-# Open MPI (several machines, src/cluster.c): built in when found, unless
+# Open MPI (several machines, src/render/cluster.c): built in when found, unless
 # MPI=0. Only cluster.c is compiled with its flags (and AJAR_MPI); without
 # it the library is built exactly as before, with one rank.
 # Found through pkg-config (ompi-c), else through Open MPI's compiler wrapper.
@@ -35,24 +35,27 @@ MPI_CFLAGS := $(if $(MPI_PC),$(shell pkg-config --cflags ompi-c),$(shell mpicc -
 MPI_LIBS := $(if $(MPI_PC),$(shell pkg-config --libs ompi-c),$(shell mpicc --showme:link))
 endif
 
-LIB_C := $(wildcard src/*.c)
-LIB_CXX := $(wildcard src/*.cpp)
+# The library: every domain folder of src/ but the command (cli) and the
+# build tools (tools).
+LIB_DIRS := core scene image prepare device render
+LIB_C := $(foreach d,$(LIB_DIRS),$(wildcard src/$(d)/*.c))
+LIB_CXX := $(foreach d,$(LIB_DIRS),$(wildcard src/$(d)/*.cpp))
 LIB_OBJS := $(LIB_C:src/%.c=$(BUILD)/src/%.o) $(LIB_CXX:src/%.cpp=$(BUILD)/src/%.o) $(BUILD)/kernel_source.o
 CLI_OBJS := $(patsubst src/cli/%.c,$(BUILD)/cli/%.o,$(wildcard src/cli/*.c))
-KERNELS := $(wildcard kernels/*.h kernels/*.cl)
+KERNELS := $(wildcard kernels/*.cl kernels/*/*.h)
 TESTS := $(patsubst tests/%.c,%,$(wildcard tests/test_*.c)) test_lights_fine
 
 # One test binary per module, linking only what it tests (plus error.o).
 obj = $(addprefix $(BUILD)/src/,$(addsuffix .o,$(1)))
-DEPS_test_bsdf := $(call obj,error)
-DEPS_test_sampling := $(call obj,error)
-DEPS_test_bvh := $(call obj,error scene bvh gltf tangents exr exr_dwa exr_huf hdr)
-DEPS_test_lights := $(call obj,error scene lights exr exr_dwa exr_huf hdr portal_sky portal_flux)
+DEPS_test_bsdf := $(call obj,core/error)
+DEPS_test_sampling := $(call obj,core/error)
+DEPS_test_bvh := $(call obj,core/error scene/scene prepare/bvh_build scene/gltf scene/tangents image/exr image/exr_dwa image/exr_huf image/hdr)
+DEPS_test_lights := $(call obj,core/error scene/scene prepare/light_tables image/exr image/exr_dwa image/exr_huf image/hdr prepare/sky_tables prepare/portal_flux)
 DEPS_test_lights_fine := $(DEPS_test_lights)
-DEPS_test_scene := $(call obj,error scene scene_api gltf tangents exr exr_dwa exr_huf hdr)
-DEPS_test_exr := $(call obj,error exr exr_dwa exr_huf png)
-DEPS_test_confine := $(call obj,error scene scene_api gltf tangents exr exr_dwa exr_huf hdr png)
-DEPS_test_bdpt := $(BUILD)/tests/kernel_host.o $(BUILD)/tests/mis_oracle.o $(call obj,error scene scene_api gltf tangents exr exr_dwa exr_huf hdr bvh lights prepare portal_flux portal_sky)
+DEPS_test_scene := $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_dwa image/exr_huf image/hdr)
+DEPS_test_exr := $(call obj,core/error image/exr image/exr_dwa image/exr_huf image/png)
+DEPS_test_confine := $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_dwa image/exr_huf image/hdr image/png)
+DEPS_test_bdpt := $(BUILD)/tests/kernel_host.o $(BUILD)/tests/mis_oracle.o $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_dwa image/exr_huf image/hdr prepare/bvh_build prepare/light_tables prepare/prepare prepare/portal_flux prepare/sky_tables)
 DEPS_test_portal := $(DEPS_test_bdpt)
 DEPS_test_punctual := $(DEPS_test_bdpt)
 # Tests that render need the whole library.
@@ -108,7 +111,7 @@ $(BUILD)/src/%.o: src/%.c
 	$(Q)$(CC) $(CPPFLAGS) $(PKG_CFLAGS) $(CFLAGS) -c -o $@ $<
 
 # With or without MPI: mpi.flag changes when MPI does, and cluster.o is rebuilt.
-$(BUILD)/src/cluster.o: src/cluster.c $(BUILD)/mpi.flag
+$(BUILD)/src/render/cluster.o: src/render/cluster.c $(BUILD)/mpi.flag
 	@mkdir -p $(@D)
 	@echo "  CC      $< (MPI=$(MPI))"
 	$(Q)$(CC) $(CPPFLAGS) $(MPI_CFLAGS) $(CFLAGS) -c -o $@ $<
@@ -146,12 +149,12 @@ $(BUILD)/kernel_source.o: $(BUILD)/kernel_source.c
 # kernels' own microfacet code by a build tool, one build for every MODE
 # (always -O2, no sanitizers: the same bits), and kept in the tree so the
 # kernels can include them; deterministic, so regenerating changes nothing.
-TABLE_SRC := src/tools/bsdf_tables.c kernels/microfacet.h kernels/sampling.h kernels/fastmath.h kernels/vec.h kernels/compat.h
+TABLE_SRC := src/tools/bsdf_tables.c kernels/material/microfacet.h kernels/sample/sampling.h kernels/base/fastmath.h kernels/base/vec.h kernels/base/compat.h
 build/tools/bsdf_tables: $(TABLE_SRC)
 	@mkdir -p $(@D)
-	$(Q)$(CC) -std=c11 -D_GNU_SOURCE -ffp-contract=off $(WARN) -O2 -o $@ $< -lm
+	$(Q)$(CC) -std=c11 -D_GNU_SOURCE -ffp-contract=off $(WARN) -Ikernels -O2 -o $@ $< -lm
 
-kernels/bsdf_tables.h: build/tools/bsdf_tables
+kernels/material/bsdf_tables.h: build/tools/bsdf_tables
 	@echo "  GEN     $@"
 	$(Q)$< > $@.tmp && mv $@.tmp $@
 
@@ -161,7 +164,7 @@ $(BUILD)/tests/%.o: tests/%.c
 	$(Q)$(CC) $(CPPFLAGS) -Itests $(PKG_CFLAGS) $(CFLAGS) -c -o $@ $<
 
 # test_lights again with the planes' sky tables at 512 cells a side, as pt
-# takes them under skies of 2048 columns or more (src/prepare.c).
+# takes them under skies of 2048 columns or more (src/prepare/prepare.c).
 $(BUILD)/tests/test_lights_fine.o: tests/test_lights.c
 	@mkdir -p $(@D)
 	@echo "  CC      $< (PORTAL_SKY_RES=512)"

@@ -1,10 +1,10 @@
 /* ajar.cl — the kernel entry points; everything else is in the headers,
  * which the host also compiles for its tests. */
-#include "aov.h"
-#include "film.h"
-#include "layout.h"
-#include "portal.h"
-#include "pt.h"
+#include "film/aov.h"
+#include "film/film.h"
+#include "base/layout.h"
+#include "integrator/portal.h"
+#include "integrator/pt.h"
 
 #define AJAR_KERNEL_ARG(type, name) __global const type *name,
 #define AJAR_VIEW_INIT(type, name) sc.name = name;

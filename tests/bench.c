@@ -12,11 +12,11 @@
 #include <time.h>
 
 #include "ajar.h"
-#include "device.h"
-#include "kernel_source.h"
-#include "prepare.h"
-#include "scene.h"
-#include "upload.h"
+#include "device/device.h"
+#include "device/kernel_source.h"
+#include "prepare/prepare.h"
+#include "scene/scene.h"
+#include "device/upload.h"
 
 static double now(void)
 {

@@ -4,9 +4,9 @@
  * what the device compiles. */
 #ifndef AJAR_KERNEL_HOST_H
 #define AJAR_KERNEL_HOST_H
-#include "../kernels/portal.h"
-#include "../kernels/pt.h"
-#include "prepare.h"
+#include "integrator/portal.h"
+#include "integrator/pt.h"
+#include "prepare/prepare.h"
 
 typedef struct {
 	Scene *scene;

@@ -215,7 +215,7 @@ static int emitter_at(const SceneView *sc, V3 p)
 
 /* Under a sky image: the solid-angle density of unit direction to (toward
  * the sky) by the whole table of the planar portal that portal triangle
- * pt lies in (kernels/env_portal.h, sky_behind_pdf_w), in double from the
+ * pt lies in (kernels/light/env_portal.h, sky_behind_pdf_w), in double from the
  * summed-area table: the cell's share of the table over the cell's solid
  * angle in (u, v). *found = 0 if pt lies in no plane or its plane does
  * not guide (PortalPlane.guide). */
@@ -261,7 +261,7 @@ static double sky_behind_pdf(const SceneView *sc, GLOBAL const PortalTri *pt, co
 }
 
 /* Density per projected solid angle of the portal direction toward a
- * (x_m) from point w of portal triangle pt (design of kernels/portal.h):
+ * (x_m) from point w of portal triangle pt (design of kernels/integrator/portal.h):
  * half a side (+n with probability side_plus) and a cosine direction on
  * it; half a light sample from w that reached a, environment directions
  * by the sky behind pt's planar portal under a sky image, else folded

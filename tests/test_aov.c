@@ -14,7 +14,7 @@
 #include <unistd.h>
 
 #include "ajar.h"
-#include "exr.h"
+#include "image/exr.h"
 #include "testutil.h"
 
 #define W 24

@@ -19,7 +19,7 @@
 #include <sys/wait.h>
 
 #include "ajar.h"
-#include "exr.h"
+#include "image/exr.h"
 #include "testutil.h"
 
 #define CORNELL SCENE("cornell/cornell.gltf")

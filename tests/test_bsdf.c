@@ -1,4 +1,4 @@
-/* test_bsdf.c — kernels/bsdf.h on the host.
+/* test_bsdf.c — kernels/material/bsdf.h on the host.
  *
  * For every material family and several outgoing directions (both sides of
  * the surface, a tilted normal): a chi-square test of bsdf_sample's
@@ -14,8 +14,8 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "../kernels/bsdf.h"
-#include "../kernels/rng.h"
+#include "material/bsdf.h"
+#include "sample/rng.h"
 
 #ifdef __SANITIZE_ADDRESS__
 #define N_CHI2 150000 /* sanitizers are ~10x slower; fewer samples, same cells */

@@ -1,4 +1,4 @@
-/* test_bvh.c — the BVH build (src/bvh.c) and traversal (kernels/bvh.h):
+/* test_bvh.c — the BVH build (src/prepare/bvh_build.c) and traversal (kernels/geom/bvh.h):
  * structure invariants, closest hits identical to brute force over every
  * triangle on random soups (uniform, clustered, coplanar, degenerate and
  * sliver triangles, one triangle, all-identical triangles, a depth-hostile
@@ -13,10 +13,10 @@
 #include <string.h>
 #include <time.h>
 
-#include "bvh.h"
-#include "gltf.h"
-#include "scene.h"
-#include "../kernels/bvh.h"
+#include "prepare/bvh_build.h"
+#include "scene/gltf.h"
+#include "scene/scene.h"
+#include "geom/bvh.h"
 
 static uint64_t rng_state;
 

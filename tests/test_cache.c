@@ -1,4 +1,4 @@
-/* test_cache.c — the kernel binary cache of src/device.c: a first build
+/* test_cache.c — the kernel binary cache of src/device/device.c: a first build
  * compiles and writes exactly one cache file, the next build of the same
  * source and options loads it and the program runs; other options get
  * their own file; a corrupted file is detected, rebuilt and replaced by a
@@ -19,8 +19,8 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "device.h"
-#include "kernel_source.h"
+#include "device/device.h"
+#include "device/kernel_source.h"
 #include "testutil.h"
 
 #define BASE_OPTIONS KERNEL_OPTIONS "0"

@@ -24,7 +24,7 @@
 #include <unistd.h>
 
 #include "ajar.h"
-#include "checkpoint.h"
+#include "render/checkpoint_file.h"
 #include "testutil.h"
 
 #define W 16

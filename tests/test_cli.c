@@ -14,7 +14,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "exr.h"
+#include "image/exr.h"
 #include "testutil.h"
 
 #define CORNELL SCENE("cornell/cornell.gltf")
@@ -344,7 +344,7 @@ static void test_cl_options(void **state)
 {
 	(void)state;
 	same_image_with("-cl-opt-disable", CORNELL, "pt");
-	/* What the host adds for GPUs (kernels/compat.h): the same image. */
+	/* What the host adds for GPUs (kernels/base/compat.h): the same image. */
 	same_image_with("-DAJAR_CALLS", DOOR_AJAR, "portal");
 
 	char *bad = path_in("bad.exr");

@@ -14,7 +14,7 @@
 #include <unistd.h>
 #include <zlib.h>
 
-#include "exr.h"
+#include "image/exr.h"
 #include "testutil.h"
 
 /* Number of entries in `dir` other than . and .. */

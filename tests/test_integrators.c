@@ -18,7 +18,7 @@
 #include <string.h>
 
 #include "ajar.h"
-#include "scene.h"
+#include "scene/scene.h"
 #include "testutil.h"
 
 #define BATCHES 16
@@ -165,8 +165,8 @@ static void test_living_room(void **state) { compare(SCENE("living-room/living-r
 static void test_bathroom(void **state) { compare(SCENE("bathroom/bathroom.gltf"), 24, 24, 32, 8); }
 /* Under a sky with a sun through the window, high (the patch on the
  * floor) and low (on the far wall): next-event estimation through the
- * portal by the sky's radiance (kernels/portal_sky.h). */
-/* portal renders as bdpt there by default (src/prepare.c; test_render
+ * portal by the sky's radiance (kernels/light/portal_sky.h). */
+/* portal renders as bdpt there by default (src/prepare/prepare.c; test_render
  * checks the bits): the sky's set named keeps its intermediate strategies,
  * which are compared here. */
 static void test_window_room_sun(void **state)
@@ -177,7 +177,7 @@ static void test_window_room_sun(void **state)
 	unsetenv("AJAR_PORTAL_SET");
 }
 /* A sun of 0.57 degrees sampled through the planes' tables of 512 cells a
- * side, as pt takes them under skies of 2048 columns or more (src/prepare.c,
+ * side, as pt takes them under skies of 2048 columns or more (src/prepare/prepare.c,
  * sky_table_res; test_render checks that choice), here for all three on a
  * smaller image. */
 static void test_window_room_small_sun(void **state)
@@ -197,7 +197,7 @@ static void test_atrium_forest(void **state)
 	compare(SCENE("atrium-forest/atrium-forest.gltf"), 24, 24, 64, 16);
 }
 /* door-ajar with a point lamp for its emitter: portal's long halves at
- * rate 1 (a lamp behind a portal counts as an emitter, src/prepare.c). */
+ * rate 1 (a lamp behind a portal counts as an emitter, src/prepare/prepare.c). */
 static void test_door_ajar_lamp(void **state)
 {
 	compare(SCENE("door-ajar-lamp/door-ajar-lamp.gltf"), 24, 24, 512, 128);

@@ -1,10 +1,10 @@
 /* test_layout.c — the device compiler lays out every shared struct exactly
  * as the host does: a probe kernel reports sizes and offsets in the order
- * of kernels/layout.h, compared with the host's (src/layout.c). */
+ * of kernels/base/layout.h, compared with the host's (src/device/layout_check.c). */
 #include <stdlib.h>
 
-#include "device.h"
-#include "kernel_source.h"
+#include "device/device.h"
+#include "device/kernel_source.h"
 #include "testutil.h"
 
 extern const unsigned ajar_layout_host[];
@@ -33,7 +33,7 @@ static void test_probe_matches_host(void **state)
 			 CL_SUCCESS);
 	for (unsigned i = 0; i < ajar_layout_count; i++)
 		if (dev[i] != ajar_layout_host[i])
-			fail_msg("layout entry %u (kernels/layout.h order): device %u, host %u", i, dev[i],
+			fail_msg("layout entry %u (kernels/base/layout.h order): device %u, host %u", i, dev[i],
 				 ajar_layout_host[i]);
 	clReleaseMemObject(buf);
 	clReleaseKernel(k);

@@ -1,5 +1,5 @@
-/* test_lights.c — the light tables (src/lights.c) and light sampling
- * (kernels/lights.h): environment orientation, env_sample against
+/* test_lights.c — the light tables (src/prepare/light_tables.c) and light sampling
+ * (kernels/light/lights.h): environment orientation, env_sample against
  * env_pdf_w, emitter selection by power and uniform points on emitters,
  * portal selection by area, and light_sample's solid-angle density against
  * light_pdf_w with environment and emitters mixed, all by chi-square
@@ -11,11 +11,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "lights.h"
-#include "portal_flux.h"
-#include "portal_sky.h"
-#include "scene.h"
-#include "../kernels/lights.h"
+#include "prepare/light_tables.h"
+#include "prepare/portal_flux.h"
+#include "prepare/sky_tables.h"
+#include "scene/scene.h"
+#include "light/lights.h"
 
 static uint64_t rng_state;
 
@@ -106,7 +106,7 @@ static void lit_build(Lit *l)
 	l->sky = NULL;
 }
 
-/* Planar portals with sky tables (src/portal_sky.c) from the portal
+/* Planar portals with sky tables (src/prepare/sky_tables.c) from the portal
  * triangles' sky sides as they are now; returns how many. */
 static int lit_planes(Lit *l)
 {
@@ -201,7 +201,7 @@ static V3 uv_dir(float u, float v)
 
 /* A window quad at z = 1 (1.6 x 1.2) whose sky lies on its -z side, seen
  * through it from z > 1, and the table of light subpaths' directions
- * through it (src/portal_flux.c, portal_sky_lines_build). */
+ * through it (src/prepare/portal_flux.c, portal_sky_lines_build). */
 static void add_line_window(Lit *l)
 {
 	float pos[] = {-0.8f, -0.4f, 1, 0.8f, -0.4f, 1, 0.8f, 0.8f, 1, -0.8f, 0.8f, 1};
@@ -942,12 +942,12 @@ static void add_window_portals(Lit *l)
 	lit_build(l);
 }
 
-/* Environment sampling through portals (kernels/env_portal.h) from x =
+/* Environment sampling through portals (kernels/light/env_portal.h) from x =
  * (0.1, 0.2, 0.05) among the emitters above and an environment image:
  * a window in front of x, a second one behind it that overlaps it as seen
  * from x, a triangle so far away that it is sampled by area, one that
  * shows x no sky (x is on its sky side) and one with no sky behind it.
- * The sky sides are set by hand here; src/portal_flux.c finds them in real
+ * The sky sides are set by hand here; src/prepare/portal_flux.c finds them in real
  * scenes (test_portal.c). */
 static void test_light_sample_env_portals(void **state)
 {
@@ -1061,7 +1061,7 @@ static void test_light_sample_env_portal_grid(void **state)
 	lit_free(&l);
 }
 
-/* ---- Sky images through planar portals (kernels/portal_sky.h) ---------- */
+/* ---- Sky images through planar portals (kernels/light/portal_sky.h) ---------- */
 
 /* Plane k's (U, V) sampler from x against its density, exactly: the
  * density is constant on each table cell within x's rectangle, so a bin
@@ -1354,7 +1354,7 @@ int main(void)
 		cmocka_unit_test(test_sky_pdf_views),
 	};
 	/* test_lights_fine (Makefile): the planes' tables at PORTAL_SKY_RES
-	 * cells a side, as pt takes them under large skies (src/prepare.c,
+	 * cells a side, as pt takes them under large skies (src/prepare/prepare.c,
 	 * sky_table_res): the sky-through-planes tests alone, the last three. */
 	enum { NT = sizeof tests / sizeof tests[0], FINE = 3 };
 	if (PORTAL_SKY_RES != 128)

@@ -25,7 +25,7 @@
 #include <unistd.h>
 
 #include "ajar.h"
-#include "checkpoint.h"
+#include "render/checkpoint_file.h"
 #include "testutil.h"
 
 /* The image size: 32x32, 64x64 for the test that must render long enough. */

@@ -442,7 +442,7 @@ static const float wr_p[3] = {1.0f, 2.2f, 2.0f}, wr_q[3] = {3.0f, 2.5f, 1.5f};
 
 /* Opens a scene where portal renders as bdpt by default (light subpaths
  * bring the light in: a sky image with a sun, punctual lights on the
- * camera's side; src/prepare.c) with the sky's set named, 1,2,1,3,1, the
+ * camera's side; src/prepare/prepare.c) with the sky's set named, 1,2,1,3,1, the
  * default there before: an explicit AJAR_PORTAL_SET keeps the
  * intermediate strategies, which these tests check. */
 static void open_portal_kept(HostScene *h, const char *path, Scene *built, uint32_t w, uint32_t hgt, int depth)
@@ -579,7 +579,7 @@ static void test_bdpt_weight_shortcut(void **state)
 			int fast = 0, full = 0;
 			check_bdpt_weights(&h, 150, &fast, &full);
 			if (i == 2) {
-				assert_true(h.data.params->light_paths); /* a sky image's (src/prepare.c) */
+				assert_true(h.data.params->light_paths); /* a sky image's (src/prepare/prepare.c) */
 				set_portal_set(&h, 1, 2, 1, 3, 0, 0.3f);
 				check_bdpt_weights(&h, 150, &fast, &full);
 				set_portal_set(&h, 1, 2, 3, 4, 0, 1.0f);
@@ -804,7 +804,7 @@ static void test_groups_unbiased_window_room(void **state)
 }
 
 /* The same under skies with a sun, high and low: next-event samples
- * through the portal by the sky's radiance (kernels/portal_sky.h), <-
+ * through the portal by the sky's radiance (kernels/light/portal_sky.h), <-
  * halves guided toward the sun. The sun's light is noisier: 1024 spp
  * (and 512 for pt) keep the combined standard error near 1% of the mean
  * (1.1% at most), so a bias of about 5.5% is caught. */
@@ -975,7 +975,7 @@ static void test_directions_window_room(void **state)
 	(void)state;
 	HostScene h;
 	host_scene_open(&h, SCENE("window-room/window-room.gltf"), NULL, 8, 8, INTEGRATOR_PORTAL, 8);
-	/* The sky side found by src/portal_flux.c is the one away from the
+	/* The sky side found by src/prepare/portal_flux.c is the one away from the
 	 * camera, which is in the room. */
 	for (int j = 0; j < h.view.params->num_portals; j++) {
 		GLOBAL const PortalTri *pt = &h.view.portals[j];
@@ -1043,7 +1043,7 @@ static void test_directions_window_room_sun(void **state)
 
 /* The share of intermediate subpaths that are wasted (a half escapes, or
  * a guided direction misses its light point), with the tables from
- * src/portal_flux.c and with the choices of before it (area, both sides
+ * src/prepare/portal_flux.c and with the choices of before it (area, both sides
  * alike, no sky side), both measured here. */
 static double wasted(HostScene *h, int n)
 {
@@ -1144,7 +1144,7 @@ static Scene *window_room_lamp_at(float x, float y, float z, float range)
  * portal renders as bdpt; a point light behind a portal counts as an
  * emitter (the long set at rate 1); constant skies, a sky without a sun
  * (no light subpaths, test_sky_sun_share) and emitters keep their intermediate subpaths,
- * and so does an explicit AJAR_PORTAL_SET (src/prepare.c). */
+ * and so does an explicit AJAR_PORTAL_SET (src/prepare/prepare.c). */
 static void test_portal_as_bdpt(void **state)
 {
 	(void)state;
@@ -1199,9 +1199,9 @@ static float whole_sky_share(const HostScene *h)
 	return env_sun_share_weighted(h->data.env + ENV_PIXELS(w, hh), w, hh, NULL, NULL);
 }
 
-/* The sun's share of a sky image's power (src/lights.c, env_sun_share_weighted),
- * of the sky light through the portals (src/portal_flux.c,
- * portal_sun_share) and what portal makes of it (src/prepare.c,
+/* The sun's share of a sky image's power (src/prepare/light_tables.c, env_sun_share_weighted),
+ * of the sky light through the portals (src/prepare/portal_flux.c,
+ * portal_sun_share) and what portal makes of it (src/prepare/prepare.c,
  * SKY_SUN_SHARE): a uniform sky with a disc 5000 times as bright covering
  * 0.008% of the sphere gets the share the texels' solid angles give
  * exactly; behind the wall, the disc brings no light subpaths, and turned
@@ -1343,7 +1343,7 @@ static void test_portal_rate(void **state)
 
 /* Scenes lit by punctual lights without emitters (window-room-sun,
  * window-room-lamp): light subpaths on, the sky's strategy set and rate
- * (src/prepare.c); the guided <- direction never lost to a punctual light
+ * (src/prepare/prepare.c); the guided <- direction never lost to a punctual light
  * (guided_env_share): under the sun lamp and a constant sky every guided
  * pick is a sky direction; and the direction density against its sampling
  * (chi-square) there and in door-ajar with a sun, a point light and a spot

@@ -19,9 +19,9 @@
 #include <string.h>
 
 #include "ajar.h"
-#include "device.h"
-#include "exr.h"
-#include "prepare.h"
+#include "device/device.h"
+#include "image/exr.h"
+#include "prepare/prepare.h"
 #include "testutil.h"
 
 #include <unistd.h>
@@ -165,7 +165,7 @@ static void add_sphere(ajar_scene *s, uint32_t mat)
 
 /* White furnace: a white sphere (base colour 1) under a white sky (1)
  * vanishes: every facet reflects all the light at every angle, which the
- * energy compensation of kernels/bsdf.h (metal multiple scattering, the
+ * energy compensation of kernels/material/bsdf.h (metal multiple scattering, the
  * base under the dielectric coat) makes true for every roughness. The
  * image must average 1 within 4 standard errors plus 3e-3, the
  * tables' interpolation error at grazing angles (test_bsdf measures it);
@@ -202,7 +202,7 @@ static void test_furnace_white(void **state)
 		}
 }
 
-/* The device turns the sky as the host code does (kernels/env.h): a 4 x 2
+/* The device turns the sky as the host code does (kernels/light/env.h): a 4 x 2
  * sky whose columns have red 1..4 and whose rows have green 1, 2; a narrow
  * camera at each column centre's horizontal direction sees, with the sky
  * turned by `deg`, the column found by turning the view back by -deg
@@ -413,7 +413,7 @@ static void test_kernel_features(void **state)
 
 /* Without portals the portal integrator is bdpt, sample for sample. Where
  * light subpaths bring the light in through them (a sky image with a sun,
- * a sun lamp, a lamp in the room; src/prepare.c) it is bdpt joining eye
+ * a sun lamp, a lamp in the room; src/prepare/prepare.c) it is bdpt joining eye
  * vertices to the first PORTAL_BDPT_CONN light vertices (AJAR_BDPT_CONN
  * sets bdpt's set); under a constant sky it is neither. */
 static void test_portal_as_bdpt(void **state)
@@ -515,7 +515,7 @@ static void test_mis_auto(void **state)
 }
 
 /* The planes' sky tables: 512 cells a side for pt under a sky of 2048
- * columns, 256 under a shipped 1k sky (src/prepare.c, sky_table_res), 128
+ * columns, 256 under a shipped 1k sky (src/prepare/prepare.c, sky_table_res), 128
  * for bdpt; each default compared bit for bit with AJAR_SKY_RES naming the
  * resolution, and pt's with 128. */
 static void render_sky_res(ajar_scene *s, ajar_integrator integ, const char *res, float *img)

@@ -1,13 +1,13 @@
-/* test_sampling.c — kernels/sampling.h and kernels/rng.h on the host.
+/* test_sampling.c — kernels/sample/sampling.h and kernels/sample/rng.h on the host.
  *
  * Every warp is histogrammed and compared with its density by a chi-square
  * test (cells whose exact probability is known in closed form); sample_cdf
  * against its discrete probabilities, zero-width buckets included; the RNG
  * for determinism, range, uniformity and decorrelation of neighbours; the
- * polynomial log, exp, atan2 and sin/cos of kernels/fastmath.h against
+ * polynomial log, exp, atan2 and sin/cos of kernels/base/fastmath.h against
  * double precision over the ranges they promise; Russian roulette
- * (kernels/roulette.h) for its survival probability and an unchanged
- * expected throughput; the low-discrepancy numbers of kernels/qmc.h and
+ * (kernels/sample/roulette.h) for its survival probability and an unchanged
+ * expected throughput; the low-discrepancy numbers of kernels/sample/qmc.h and
  * rng.h for their net structure, uniformity and independence. */
 #include "testutil.h"
 
@@ -17,11 +17,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../kernels/fastmath.h"
-#include "../kernels/rng.h"
-#include "../kernels/roulette.h"
-#include "../kernels/sampling.h"
-#include "../kernels/texture.h"
+#include "base/fastmath.h"
+#include "sample/rng.h"
+#include "sample/roulette.h"
+#include "sample/sampling.h"
+#include "material/texture.h"
 
 #define N_SAMPLES 1000000
 #define N_TESTS 13 /* chi-square tests in this file, for the Sidak correction */

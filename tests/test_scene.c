@@ -17,8 +17,8 @@
 #include <unistd.h>
 
 #include "ajar.h"
-#include "scene.h"
-#include "../kernels/surface.h"
+#include "scene/scene.h"
+#include "geom/surface.h"
 
 #define EPS 1e-5f
 

@@ -4,19 +4,19 @@
  * runs the trace_closest kernel as the device compiler built it, which may
  * differ (OpenCL C contracts a * b - c * d into a fused multiply-add unless
  * told not to, and then the two triangles of an edge no longer compute
- * exactly opposite edge functions; kernels/bvh.h). Without the pragma
+ * exactly opposite edge functions; kernels/geom/bvh.h). Without the pragma
  * that forbids it, PoCL's build missed 159 of these 103,680 rays. */
 #include <math.h>
 #include <stdlib.h>
 
 #include "ajar.h"
-#include "device.h"
-#include "kernel_source.h"
-#include "prepare.h"
-#include "scene.h"
+#include "device/device.h"
+#include "device/kernel_source.h"
+#include "prepare/prepare.h"
+#include "scene/scene.h"
 #include "testutil.h"
-#include "upload.h"
-#include "../kernels/bvh.h"
+#include "device/upload.h"
+#include "geom/bvh.h"
 
 #define GRID 24 /* quads per cube face edge */
 

@@ -19,7 +19,7 @@ double chi2_test(const double *observed, const double *expected, int ncells, dou
 /* Upper tail of the chi-square distribution with `dof` degrees of freedom. */
 double chi2_sf(double x, double dof);
 
-/* A w x h equirectangular sky (linear RGB, malloc'd; kernels/env.h's
+/* A w x h equirectangular sky (linear RGB, malloc'd; kernels/light/env.h's
  * convention): a smooth gradient, brighter and bluer toward the zenith,
  * dim below the horizon, and a small, very bright sun disc of radiance
  * sun_l and angular radius `radius` about the unit direction (sun_x,

@@ -9,8 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "device.h"
-#include "kernel_source.h"
+#include "device/device.h"
+#include "device/kernel_source.h"
 
 int main(int argc, char **argv)
 {

@@ -24,7 +24,7 @@ for t in test_layout test_traversal test_subpaths test_render test_integrators; 
 done
 ${CC:-cc} -std=c11 -O2 -Wall -Wextra -Werror -Iinclude -o "$C/bin/exr_compare" tests/gpu/exr_compare.c \
 	build/release/libajar.a $(pkg-config --libs OpenEXR OpenCL tinygltf stb) -lz -lstdc++ -lm -lpthread
-${CC:-cc} -std=c11 -D_GNU_SOURCE -O2 -Wall -Wextra -Werror -Iinclude -Isrc -o "$C/bin/kernel_info" \
+${CC:-cc} -std=c11 -D_GNU_SOURCE -O2 -Wall -Wextra -Werror -Iinclude -Isrc -Ikernels -o "$C/bin/kernel_info" \
 	tests/gpu/kernel_info.c build/release/libajar.a $(pkg-config --libs OpenEXR OpenCL tinygltf stb) -lz -lstdc++ -lm \
 	-lpthread
 for b in "$C"/bin/*; do ldd "$b"; done | awk '/=> \// {print $3}' | sort -u |

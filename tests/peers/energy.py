@@ -1,6 +1,6 @@
 """energy.py — image means of Ajar and Cycles on interiors with glTF's own
 materials (specular layers on), the check of Ajar's energy compensation
-(kernels/bsdf.h) against Blender's Principled BSDF.
+(kernels/material/bsdf.h) against Blender's Principled BSDF.
 
   build/peers/venv/bin/python tests/peers/energy.py
 

@@ -3,13 +3,13 @@
 Reads an Ajar glTF scene into world-space numpy triangles grouped by material,
 with what every peer renderer needs to rebuild the same scene: the camera,
 the uniform environment, emitters and the portal quads. It follows Ajar's
-loader (src/gltf.cpp) where that matters for matching:
+loader (src/scene/gltf.cpp) where that matters for matching:
   - nodes are walked depth first, parents before children, in file order, and
     the first perspective camera met sets the camera (forward = the node's
     -Z, up = its +Y, vertical field of view yfov; the aspect is the image's);
   - a node whose transform has a negative determinant has its winding
     reversed, so the front face (CCW, glTF's) stays the front face: emitters
-    emit from the front only (kernels/lights.h, emitter_radiance);
+    emit from the front only (kernels/light/lights.h, emitter_radiance);
   - a node with extras {"portal": true} (or a non-zero number) is a portal:
     its triangles are not geometry;
   - emission = emissiveFactor x KHR_materials_emissive_strength;
@@ -17,7 +17,7 @@ loader (src/gltf.cpp) where that matters for matching:
     uniform environment of radiance color x strength; {"environment":
     {"image": "sky.exr", "strength": s, "rotation": a}} a sky image (path
     relative to the glTF), turned by a degrees about +Y, right-handed
-    (counter-clockwise seen from above; kernels/env.h);
+    (counter-clockwise seen from above; kernels/light/env.h);
   - KHR_lights_punctual lights on nodes: position the node's origin,
     direction its -Z, colour x intensity (lux for directional, candela for
     point and spot), spot cones in radians; range ignored (Ajar's, and

@@ -1,0 +1,139 @@
+/* pt.h — the unidirectional path tracer, the reference every other
+ * integrator is checked against.
+ *
+ * Next-event estimation to emitters and the environment, combined with BSDF
+ * sampling by the power heuristic; Russian roulette (roulette.h) from vertex
+ * rr_depth on scales only the throughput, so it enters neither strategy's
+ * density and the MIS weights stay consistent (design.md, Pitfalls).
+ * max_depth counts path segments, camera segment included (Mitsuba's
+ * max_depth); paths of fewer than min_depth segments are left out, so
+ * max_depth = min_depth = k gives the image of paths of exactly k segments,
+ * which each bidirectional strategy must reproduce. With Params.cross_filter (a test mode) each
+ * path counts as many times as it crosses portals on the edges that one
+ * group of intermediate-subpath strategies can sample (pt_cross_weight):
+ * the image those strategies must reproduce. */
+
+#ifndef AJAR_PT_H
+#define AJAR_PT_H
+#include "material/bsdf.h"
+#include "geom/bvh.h"
+#include "geom/camera.h"
+#include "light/lights.h"
+#include "mis/mis.h"
+#include "geom/portal_crossing.h"
+#include "sample/rng.h"
+#include "sample/roulette.h"
+#include "geom/surface.h"
+
+#define PT_CROSS_EDGES 33
+
+/* The test mode's weight of a path of n segments whose eye-side edges
+ * (edge 0 leaves the camera) cross portals cnt[j] times; `last` replaces
+ * cnt[n - 1] (a next-event edge). 1 when the mode is off. */
+INLINE float pt_cross_weight(GLOBAL const Params *prm, const int *cnt, int n, int last)
+{
+	if (!prm->cross_filter)
+		return 1.0f;
+	int w = 0;
+	for (int j = prm->cross_lo; j <= n - 1 - prm->cross_hi; j++)
+		w += j == n - 1 ? last : (j < PT_CROSS_EDGES ? cnt[j] : 0);
+	return (float)w;
+}
+
+INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
+{
+	GLOBAL const Params *prm = sc->params;
+	V3 L = v3(0.0f, 0.0f, 0.0f), beta = v3(1.0f, 1.0f, 1.0f);
+	float prev_pdf_w = 0.0f;
+	int prev_delta = 1; /* the camera ray counts emission in full */
+	V3 prev_p = o, prev_n = v3(0.0f, 0.0f, 0.0f); /* prev_n: vertex_nee_normal's */
+	float beta_ref = 1.0f;
+	int cnt[PT_CROSS_EDGES];
+	for (int depth = 0;; depth++) {
+		Hit h;
+		int hit = bvh_intersect(sc, o, d, AJAR_INF, &h);
+		int c_edge = 0;
+		if (prm->cross_filter)
+			c_edge = hit ? portal_crossings(sc, o, v3_add(o, v3_scale(d, h.t)), 0) : portal_crossings(sc, o, d, 1);
+		if (depth < PT_CROSS_EDGES)
+			cnt[depth] = c_edge;
+		if (!hit) {
+			float pe;
+			V3 Le = env_radiance_pdf(sc, d, &pe);
+			if (!v3_is_zero(Le)) {
+				float w = prev_delta ? 1.0f : mis_power(prev_pdf_w, light_env_pdf_w(sc, prev_p, prev_n, d, pe));
+				w *= pt_cross_weight(prm, cnt, depth + 1, c_edge);
+				if (depth + 1 >= prm->min_depth)
+					L = v3_add(L, v3_scale(v3_mul(beta, Le), w));
+			}
+			break;
+		}
+		Surface s;
+		surface_from_hit(sc, &h, &s);
+		V3 wo = v3_neg(d);
+		if (sc->tris[s.tri].emitter >= 0 && depth + 1 >= prm->min_depth) {
+			V3 Le = emitter_radiance(sc, s.tri, s.p, wo);
+			if (!v3_is_zero(Le)) {
+				float w = 1.0f;
+				if (!prev_delta) {
+					float cos_l = fabs(v3_dot(s.ng, wo));
+					w = mis_power(prev_pdf_w, light_pdf_w(sc, prev_p, prev_n, d, s.tri, h.t, cos_l));
+				}
+				w *= pt_cross_weight(prm, cnt, depth + 1, c_edge);
+				L = v3_add(L, v3_scale(v3_mul(beta, Le), w));
+			}
+		}
+		/* The next vertex would make depth + 2 segments. */
+		if (depth + 2 > prm->max_depth)
+			break;
+		Bsdf bs;
+		surface_bsdf(sc, &s, surface_base_color(sc, &s), &bs);
+		/* The normal next-event samples are weighed by (env_portal.h): turned
+		 * toward wo here; pt's two densities at a vertex both read n_nee. */
+		V3 n_nee = v3_dot(s.ns, wo) < 0.0f ? v3_neg(s.ns) : s.ns;
+		if (!bsdf_is_delta(&bs) && depth + 2 >= prm->min_depth) {
+			LightSample ls;
+			float u0, u1, u2;
+			rng_nee3(rng, &u0, &u1, &u2);
+			if (light_sample(sc, s.p, n_nee, u0, u1, u2, &ls) && ls.pdf_w > 0.0f && !v3_is_zero(ls.Le)) {
+				float pdf_bsdf_w;
+				V3 f = bsdf_eval_fwd(&bs, wo, ls.wi, BSDF_RADIANCE, &pdf_bsdf_w);
+				if (!v3_is_zero(f)) {
+					int far = ls.is_env || !(ls.dist < AJAR_INF); /* the sky, a directional light */
+					int clear = far ? !bvh_occluded(sc, ray_offset(s.p, s.ng, ls.wi), ls.wi, AJAR_INF)
+							: segment_clear(sc, s.p, s.ng, ls.p, ls.n);
+					if (clear) {
+						int c_nee = !prm->cross_filter ? 0
+								: far ? portal_crossings(sc, s.p, ls.wi, 1)
+									    : portal_crossings(sc, s.p, ls.p, 0);
+						/* A punctual light is sampled by next-event estimation alone. */
+						float w = (ls.delta ? 1.0f : mis_power(ls.pdf_w, pdf_bsdf_w)) *
+							  pt_cross_weight(prm, cnt, depth + 2, c_nee);
+						float k = fabs(v3_dot(s.ns, ls.wi)) * w / ls.pdf_w;
+						L = v3_add(L, v3_scale(v3_mul(v3_mul(beta, f), ls.Le), k));
+					}
+				}
+			}
+		}
+		BsdfSample bsm;
+		float u0, u1, u2;
+		rng_f3(rng, &u0, &u1, &u2);
+		if (!bsdf_sample_fwd(&bs, wo, u0, u1, u2, BSDF_RADIANCE, &bsm) || !(bsm.pdf_w > 0.0f))
+			break;
+		beta = v3_mul(beta, v3_scale(bsm.f, fabs(v3_dot(s.ns, bsm.wi)) / bsm.pdf_w));
+		prev_pdf_w = bsm.pdf_w;
+		prev_delta = bsm.delta;
+		prev_p = s.p;
+		prev_n = n_nee;
+		o = ray_offset(s.p, s.ng, bsm.wi);
+		d = bsm.wi;
+		if (depth == 0)
+			beta_ref = fmax(v3_maxc(beta), 1e-30f); /* roulette.h */
+		else if (depth + 1 >= prm->rr_depth && !rr_survive(&beta, beta_ref, RR_BOOST, rng))
+			break;
+		if (v3_is_zero(beta))
+			break;
+	}
+	return L;
+}
+#endif

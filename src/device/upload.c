@@ -1,0 +1,37 @@
+/* upload.c — copies SceneData to one device, one read-only buffer per array. */
+#include "device/upload.h"
+
+#include <string.h>
+
+ajar_status upload_scene(Device *d, const SceneData *sd, SceneBuffers *b)
+{
+	ajar_status st;
+	memset(b, 0, sizeof *b);
+#define AJAR_UPLOAD(type, name)                                                                        \
+	if ((st = device_buffer(d, CL_MEM_READ_ONLY, sizeof(type) * sd->n_##name, sd->name,             \
+				&b->mem[b->count])) != AJAR_OK) {                                       \
+		upload_free(b);                                                                        \
+		return st;                                                                             \
+	}                                                                                              \
+	b->bytes += sizeof(type) * sd->n_##name;                                                       \
+	b->count++;
+	AJAR_SCENE_BUFFERS(AJAR_UPLOAD)
+#undef AJAR_UPLOAD
+	return AJAR_OK;
+}
+
+ajar_status upload_bind(Device *d, cl_kernel k, const SceneBuffers *b, cl_uint *next)
+{
+	for (int i = 0; i < b->count; i++)
+		CL_TRY(d, clSetKernelArg(k, (cl_uint)i, sizeof(cl_mem), &b->mem[i]));
+	*next = (cl_uint)b->count;
+	return AJAR_OK;
+}
+
+void upload_free(SceneBuffers *b)
+{
+	for (int i = 0; i < b->count; i++)
+		if (b->mem[i])
+			clReleaseMemObject(b->mem[i]);
+	memset(b, 0, sizeof *b);
+}

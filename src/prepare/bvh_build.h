@@ -1,0 +1,41 @@
+/* bvh_build.h — the bounding volume hierarchy over the scene's triangles, built
+ * on the host with binned SAH, collapsed to eight-wide nodes and flattened
+ * into the BvhNode array that kernels/geom/bvh.h traverses (layout in
+ * kernels/base/types.h).
+ *
+ * The build reorders triangles so every leaf covers a contiguous range;
+ * `order` says where each reordered triangle came from, so the caller can
+ * permute Tri and TriShade the same way before upload. The tree is at most
+ * BVH_MAX_DEPTH levels deep, which the device's fixed traversal stack
+ * relies on. */
+#ifndef AJAR_BVH_H
+#define AJAR_BVH_H
+#include <stddef.h>
+#include <stdint.h>
+
+#include "ajar.h"
+#include "base/types.h"
+
+/* Deepest root-to-leaf path of the binary tree, counted in nodes. The
+ * eight-wide tree is at most half as deep, and its traversal pushes at most
+ * seven entries per level (BVH_STACK_SIZE in kernels/geom/bvh.h). */
+#define BVH_MAX_DEPTH 64
+/* Leaf slots encode 4 first + count - 1 in an int. */
+#define BVH_MAX_TRIS (1u << 29)
+
+typedef struct {
+	BvhNode *nodes;      /* BVH_WIDTH-wide */
+	uint32_t nnodes;
+	uint32_t *order;     /* order[i] = original index of reordered triangle i */
+	uint32_t ntris;
+	uint32_t depth;      /* binary tree: nodes on the longest root-to-leaf path */
+	uint32_t wide_depth; /* the wide tree: the same */
+} Bvh;
+
+/* ntris >= 1. On failure *out is left empty (safe to bvh_free). */
+ajar_status bvh_build(const Tri *tris, uint32_t ntris, Bvh *out);
+void bvh_free(Bvh *b);
+/* Bytes of nodes + order. */
+size_t bvh_memory(const Bvh *b);
+
+#endif

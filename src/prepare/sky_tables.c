@@ -1,0 +1,207 @@
+/* sky_tables.c — planar portals and their sky tables (see portal_sky.h and
+ * kernels/light/portal_sky.h). Each plane's frame has t along the longest edge of
+ * its triangles, so a rectangular window fills its bounding rectangle.
+ * A table cell (i, j) holds the integral over its (u, v) square of the
+ * sky's luminance times dw / (du dv), from SKY_SS x SKY_SS points (a sun
+ * of a few texels is caught), plus SKY_FLOOR times the mean cell, so that
+ * no direction in a rectangle has zero density; its summed-area table is
+ * summed in double and stored as float pairs (hi, lo). */
+#include "prepare/sky_tables.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "light/env.h"
+#include "light/portal_sky.h"
+
+#define SKY_SS 4
+#define SKY_FLOOR 1e-3
+
+static uint32_t find(uint32_t *parent, uint32_t a)
+{
+	while (parent[a] != a)
+		a = parent[a] = parent[parent[a]];
+	return a;
+}
+
+/* Whether sky-showing portal triangles a and b lie in one plane, face the
+ * sky the same way and share a corner (eps: a length tolerance). */
+static int same_plane(const PortalTri *a, const PortalTri *b, float eps)
+{
+	V3 na = v3_scale(a->n, (float)a->env_side), nb = v3_scale(b->n, (float)b->env_side);
+	if (!(v3_dot(na, nb) > 1.0f - 1e-4f) || !(fabsf(v3_dot(na, v3_sub(b->p0, a->p0))) < eps))
+		return 0;
+	const V3 pa[3] = {a->p0, a->p1, a->p2}, pb[3] = {b->p0, b->p1, b->p2};
+	for (int i = 0; i < 3; i++)
+		for (int j = 0; j < 3; j++)
+			if (v3_len(v3_sub(pa[i], pb[j])) < eps)
+				return 1;
+	return 0;
+}
+
+/* Frame and bounding rectangle of the triangles k with root[k] == g. */
+static int plane_frame(const PortalTri *portals, const uint32_t *root, uint32_t n, uint32_t g, PortalPlane *P)
+{
+	const PortalTri *first = &portals[g];
+	V3 nn = v3_scale(first->n, (float)first->env_side), t = v3(0, 0, 0);
+	float best = -1.0f;
+	for (uint32_t k = 0; k < n; k++) {
+		if (root[k] != g)
+			continue;
+		const V3 p[3] = {portals[k].p0, portals[k].p1, portals[k].p2};
+		for (int e = 0; e < 3; e++) {
+			V3 d = v3_sub(p[(e + 1) % 3], p[e]);
+			d = v3_sub(d, v3_scale(nn, v3_dot(d, nn)));
+			if (v3_len2(d) > best) {
+				best = v3_len2(d);
+				t = d;
+			}
+		}
+	}
+	if (!(best > 0.0f))
+		return 0;
+	memset(P, 0, sizeof *P);
+	P->o = first->p0;
+	P->n = nn;
+	P->t = v3_norm(t);
+	P->b = v3_cross(nn, P->t);
+	P->a0 = P->b0 = INFINITY;
+	P->a1 = P->b1 = -INFINITY;
+	for (uint32_t k = 0; k < n; k++) {
+		if (root[k] != g)
+			continue;
+		const V3 p[3] = {portals[k].p0, portals[k].p1, portals[k].p2};
+		for (int e = 0; e < 3; e++) {
+			float a = v3_dot(v3_sub(p[e], P->o), P->t), b = v3_dot(v3_sub(p[e], P->o), P->b);
+			P->a0 = fminf(P->a0, a);
+			P->a1 = fmaxf(P->a1, a);
+			P->b0 = fminf(P->b0, b);
+			P->b1 = fmaxf(P->b1, b);
+		}
+	}
+	/* A little margin, so rounding at the border loses no direction. */
+	float m = 1e-4f * fmaxf(P->a1 - P->a0, P->b1 - P->b0);
+	P->a0 -= m;
+	P->a1 += m;
+	P->b0 -= m;
+	P->b1 += m;
+	return P->a1 > P->a0 && P->b1 > P->b0;
+}
+
+static int plane_table(const SceneView *sc, const PortalPlane *P, int N, float *out)
+{
+	double *cell = malloc(sizeof(double) * N * N), sum = 0.0;
+	double *S = calloc((size_t)(N + 1) * (N + 1), sizeof(double));
+	if (!cell || !S) {
+		free(cell);
+		free(S);
+		return 0;
+	}
+	const double du = M_PI / N;
+	for (int j = 0; j < N; j++)
+		for (int i = 0; i < N; i++) {
+			double acc = 0.0;
+			for (int b = 0; b < SKY_SS; b++)
+				for (int a = 0; a < SKY_SS; a++) {
+					double u = -0.5 * M_PI + (i + (a + 0.5) / SKY_SS) * du;
+					double v = -0.5 * M_PI + (j + (b + 0.5) / SKY_SS) * du;
+					double X = tan(u), Y = tan(v), q = 1.0 + X * X + Y * Y;
+					V3 w = v3_norm(v3_add(v3_add(v3_scale(P->t, (float)X), v3_scale(P->b, (float)Y)), P->n));
+					double lum = v3_lum(env_radiance(sc, w));
+					acc += fmax(lum, 0.0) * (1.0 + X * X) * (1.0 + Y * Y) / (q * sqrt(q));
+				}
+			cell[j * N + i] = acc / (SKY_SS * SKY_SS) * du * du;
+			sum += cell[j * N + i];
+		}
+	double floor_mass = sum > 0.0 ? SKY_FLOOR * sum / (N * N) : du * du;
+	/* S(i, j) = sum over rows < j and columns < i, row by row. */
+	for (int j = 1; j <= N; j++) {
+		double row = 0.0;
+		for (int i = 1; i <= N; i++) {
+			row += cell[(j - 1) * N + (i - 1)] + floor_mass;
+			S[j * (N + 1) + i] = S[(j - 1) * (N + 1) + i] + row;
+		}
+	}
+	for (int k = 0; k < (N + 1) * (N + 1); k++) {
+		float hi = (float)S[k];
+		out[2 * k] = hi;
+		out[2 * k + 1] = (float)(S[k] - (double)hi);
+	}
+	free(cell);
+	free(S);
+	return 1;
+}
+
+ajar_status portal_sky_build(const SceneView *sc, const PortalTri *portals, uint32_t n, int res, PortalPlane **planes,
+			     size_t *nplanes, float **sky, size_t *nsky)
+{
+	const size_t floats = PORTAL_SKY_FLOATS_OF((size_t)res);
+	*planes = NULL;
+	*sky = NULL;
+	*nplanes = *nsky = 0;
+	if (n == 0 || sc->params->env_type != ENV_IMAGE)
+		return AJAR_OK;
+	uint32_t *root = malloc(sizeof *root * n);
+	if (!root)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "portals: out of memory grouping %u triangles", n);
+	V3 lo = portals[0].p0, hi = portals[0].p0;
+	for (uint32_t k = 0; k < n; k++) {
+		root[k] = k;
+		lo = v3_min(lo, v3_min(portals[k].p0, v3_min(portals[k].p1, portals[k].p2)));
+		hi = v3_max(hi, v3_max(portals[k].p0, v3_max(portals[k].p1, portals[k].p2)));
+	}
+	float eps = 1e-5f * fmaxf(v3_len(v3_sub(hi, lo)), 1e-6f);
+	for (uint32_t a = 0; a < n; a++)
+		for (uint32_t b = a + 1; b < n; b++)
+			if (portals[a].env_side != 0 && portals[b].env_side != 0 && same_plane(&portals[a], &portals[b], 10.0f * eps)) {
+				uint32_t ra = find(root, a), rb = find(root, b);
+				if (ra != rb)
+					root[ra > rb ? ra : rb] = ra > rb ? rb : ra;
+			}
+	uint32_t groups = 0;
+	for (uint32_t k = 0; k < n; k++) {
+		root[k] = find(root, k);
+		groups += root[k] == k && portals[k].env_side != 0;
+	}
+	if (groups == 0) {
+		free(root);
+		return AJAR_OK;
+	}
+	PortalPlane *pl = malloc(sizeof *pl * groups);
+	float *tab = malloc(sizeof *tab * groups * floats);
+	if (!pl || !tab) {
+		free(root);
+		free(pl);
+		free(tab);
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "portals: out of memory for %u sky tables", groups);
+	}
+	/* Whether the planes' tables also guide the <- halves of intermediate
+	 * subpaths (kernels/light/env_portal.h, portal_guide_plane): measured worse
+	 * per sample than the environment's importance folded onto the sky
+	 * side on all three sky scenes (kernels/sky_measurements.md,
+	 * "Measurements"), so only on request, for experiments. */
+	const char *g_env = getenv("AJAR_PORTAL_GUIDE_SKY");
+	int guide = g_env && strcmp(g_env, "1") == 0;
+	size_t np = 0;
+	for (uint32_t g = 0; g < n; g++) {
+		if (root[g] != g || portals[g].env_side == 0 || !plane_frame(portals, root, n, g, &pl[np]))
+			continue;
+		pl[np].table = (int)(np * floats);
+		pl[np].guide = guide;
+		if (!plane_table(sc, &pl[np], res, tab + np * floats)) {
+			free(root);
+			free(pl);
+			free(tab);
+			return err_set(AJAR_ERROR_OUT_OF_MEMORY, "portals: out of memory for a sky table");
+		}
+		np++;
+	}
+	free(root);
+	*planes = pl;
+	*sky = tab;
+	*nplanes = np;
+	*nsky = np * floats;
+	return AJAR_OK;
+}

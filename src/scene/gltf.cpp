@@ -1,0 +1,1358 @@
+/* gltf.cpp — the glTF 2.0 loader: tinygltf parses the file, this file turns
+ * its Model into a Scene (scene.h). The only C++ in Ajar; no exception
+ * leaves it (gltf_load catches everything and returns a status).
+ *
+ * tinygltf is used as Debian builds it (libtinygltf.so with its file system
+ * and stb_image loaders compiled in), so the header is included plainly,
+ * without TINYGLTF_IMPLEMENTATION or any option that changes its classes.
+ *
+ * tinygltf checks JSON syntax and loads buffers and images; it does not
+ * check that accessors and buffer views stay inside their data, so every
+ * read here is bounds-checked, and every message names the file and the
+ * element (`room.gltf: meshes[2].primitives[0]: accessors[7] (NORMAL): ...`).
+ * Geometry leaves in world space: positions by the node's world matrix,
+ * normals by its inverse transpose, winding reversed where it mirrors. */
+#include <tiny_gltf.h>
+
+#include <cerrno>
+#include <climits>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <cstring>
+#include <new>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <stdlib.h>
+#include <unistd.h>
+
+#include "core/error.h"
+#include "scene/gltf.h"
+#include "scene/tangents.h"
+
+namespace {
+
+namespace tg = tinygltf;
+
+/* Extensions whose meaning the loader implements; a file that requires any
+ * other cannot be shown correctly and is refused. */
+const char *const supported_extensions[] = {
+	"KHR_materials_emissive_strength", "KHR_materials_ior", "KHR_materials_specular",
+	"KHR_materials_transmission", "KHR_mesh_quantization", "KHR_lights_punctual", "KHR_texture_transform",
+};
+
+struct Loader {
+	const char *file;
+	std::string dir;
+	tg::Model model;
+	Scene *s = nullptr;
+	std::vector<uint32_t> material_ids; /* glTF material -> scene material */
+	int default_material = -1;
+	std::vector<int> image_textures;    /* glTF image -> scene texture or -1 */
+	bool allow_outside = false; /* files outside the scene's folder may be read */
+	std::string root;           /* the scene's folder, symbolic links resolved */
+	std::string refused;        /* the first message about a file outside root */
+};
+
+ajar_status fail(const Loader &L, ajar_status st, const char *fmt, ...) AJAR_PRINTF(3, 4);
+ajar_status fail(const Loader &L, ajar_status st, const char *fmt, ...)
+{
+	char buf[1536];
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(buf, sizeof buf, fmt, ap);
+	va_end(ap);
+	return err_set(st, "%s: %s", L.file, buf);
+}
+
+/* tinygltf's messages end in newlines and may hold several lines. */
+std::string one_line(std::string m)
+{
+	while (!m.empty() && (m.back() == '\n' || m.back() == '\r'))
+		m.pop_back();
+	for (char &c : m)
+		if (c == '\n')
+			c = ';';
+	return m;
+}
+
+/* ---- Files the scene names ------------------------------------------------
+ * A render farm or a web service renders files other people wrote, so by
+ * default every file a scene names (buffers, images, the environment image)
+ * must resolve, after `..` and symbolic links, inside the scene file's
+ * folder. The first refusal is kept in L.refused and becomes the load's
+ * error (tinygltf itself only says "File not found" or warns). */
+
+/* Whether `path` (which exists) lies inside L.root; sets L.refused if not.
+ * `uri` is how the scene named it, for the message. */
+bool confined(Loader &L, const std::string &path, const std::string &uri)
+{
+	if (L.allow_outside)
+		return true;
+	char real[PATH_MAX];
+	if (!realpath(path.c_str(), real))
+		return false;
+	size_t n = L.root.size();
+	bool inside = strncmp(real, L.root.c_str(), n) == 0 && (real[n] == '\0' || real[n] == '/' || L.root == "/");
+	if (!inside && L.refused.empty())
+		L.refused = "'" + uri + "' resolves to " + real + ", outside the scene's folder " + L.root +
+			    " (allow it with --allow-outside-files or ajar_load_options.allow_outside_files)";
+	return inside;
+}
+
+/* tinygltf joins its base directory (or ".") and the URI; the URI again. */
+std::string uri_of(const Loader &L, const std::string &joined)
+{
+	for (const std::string &base : {L.dir + "/", std::string("./")})
+		if (joined.compare(0, base.size(), base) == 0)
+			return joined.substr(base.size());
+	return joined;
+}
+
+/* An absolute URI is an absolute path, not one under the base directory. */
+std::string fs_expand(const std::string &joined, void *user)
+{
+	std::string uri = uri_of(*(const Loader *)user, joined);
+	return !uri.empty() && uri[0] == '/' ? uri : joined;
+}
+
+bool fs_exists(const std::string &path, void *user)
+{
+	Loader &L = *(Loader *)user;
+	return tg::FileExists(path, nullptr) && confined(L, path, uri_of(L, path));
+}
+
+bool fs_read(std::vector<unsigned char> *out, std::string *err, const std::string &path, void *user)
+{
+	Loader &L = *(Loader *)user;
+	if (!confined(L, path, uri_of(L, path))) {
+		if (err)
+			*err += "outside the scene's folder\n";
+		return false;
+	}
+	return tg::ReadWholeFile(out, err, path, nullptr);
+}
+
+/* ---- Accessors ---------------------------------------------------------- */
+
+int component_size(int type)
+{
+	switch (type) {
+	case TINYGLTF_COMPONENT_TYPE_BYTE:
+	case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+	case TINYGLTF_COMPONENT_TYPE_SHORT:
+	case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+	case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+	case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+	}
+	return 0;
+}
+
+int type_components(int type)
+{
+	switch (type) {
+	case TINYGLTF_TYPE_SCALAR: return 1;
+	case TINYGLTF_TYPE_VEC2: return 2;
+	case TINYGLTF_TYPE_VEC3: return 3;
+	case TINYGLTF_TYPE_VEC4: return 4;
+	}
+	return 0;
+}
+
+/* An accessor's elements, tightly packed, sparse substitution applied. */
+struct Packed {
+	std::vector<uint8_t> bytes;
+	size_t count = 0;
+	int ctype = 0, ncomp = 0;
+	bool normalized = false;
+};
+
+/* Points *p at bytes [offset, offset + need) of bufferViews[v], after checking
+ * that the view lies inside its buffer and the range inside the view. */
+ajar_status view_range(const Loader &L, const char *what, int v, size_t offset, size_t need, const uint8_t **p)
+{
+	const tg::Model &m = L.model;
+	if (v < 0 || (size_t)v >= m.bufferViews.size())
+		return fail(L, AJAR_ERROR_BAD_INPUT, "%s: bufferViews[%d] does not exist (%zu buffer views)", what, v,
+			    m.bufferViews.size());
+	const tg::BufferView &bv = m.bufferViews[(size_t)v];
+	if (bv.buffer < 0 || (size_t)bv.buffer >= m.buffers.size())
+		return fail(L, AJAR_ERROR_BAD_INPUT, "bufferViews[%d]: buffers[%d] does not exist (%zu buffers)", v,
+			    bv.buffer, m.buffers.size());
+	size_t have = m.buffers[(size_t)bv.buffer].data.size();
+	if (bv.byteLength > have || bv.byteOffset > have - bv.byteLength)
+		return fail(L, AJAR_ERROR_BAD_INPUT, "bufferViews[%d]: needs %zu bytes at offset %zu but buffers[%d] has %zu",
+			    v, bv.byteLength, bv.byteOffset, bv.buffer, have);
+	if (offset > bv.byteLength || need > bv.byteLength - offset)
+		return fail(L, AJAR_ERROR_BAD_INPUT, "%s: needs %zu bytes at offset %zu but bufferViews[%d] has %zu", what,
+			    need, offset, v, bv.byteLength);
+	*p = m.buffers[(size_t)bv.buffer].data.data() + bv.byteOffset + offset;
+	return AJAR_OK;
+}
+
+/* Reads accessors[idx] (`attr` of `ctx`, for messages), which must have
+ * `ncomp` components, into p. */
+ajar_status accessor_read(const Loader &L, const std::string &ctx, const char *attr, int idx, int ncomp, Packed &p)
+{
+	const tg::Model &m = L.model;
+	if (idx < 0 || (size_t)idx >= m.accessors.size())
+		return fail(L, AJAR_ERROR_BAD_INPUT, "%s: %s: accessors[%d] does not exist (%zu accessors)", ctx.c_str(),
+			    attr, idx, m.accessors.size());
+	char what[512];
+	snprintf(what, sizeof what, "%s: accessors[%d] (%s)", ctx.c_str(), idx, attr);
+	const tg::Accessor &a = m.accessors[(size_t)idx];
+	int csize = component_size(a.componentType), nc = type_components(a.type);
+	if (!csize)
+		return fail(L, AJAR_ERROR_BAD_INPUT, "%s: unsupported componentType %d", what, a.componentType);
+	if (nc != ncomp)
+		return fail(L, AJAR_ERROR_BAD_INPUT, "%s: has type %d, expected %d components", what, a.type, ncomp);
+	if (a.count > (size_t)INT32_MAX)
+		return fail(L, AJAR_ERROR_BAD_INPUT, "%s: count %zu is too large", what, a.count);
+	size_t elem = (size_t)csize * (size_t)nc;
+	p.count = a.count;
+	p.ctype = a.componentType;
+	p.ncomp = nc;
+	p.normalized = a.normalized;
+
+	if (a.bufferView >= 0) {
+		if ((size_t)a.bufferView >= m.bufferViews.size())
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s: bufferViews[%d] does not exist (%zu buffer views)", what,
+				    a.bufferView, m.bufferViews.size());
+		size_t stride = m.bufferViews[(size_t)a.bufferView].byteStride;
+		if (stride == 0)
+			stride = elem;
+		/* glTF caps byteStride at 252; the cap also keeps the sizes below
+		 * far from overflow. */
+		if (stride < elem || stride > 252)
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s: byteStride %zu of bufferViews[%d] does not fit %zu-byte elements",
+				    what, stride, a.bufferView, elem);
+		size_t need = a.count ? stride * (a.count - 1) + elem : 0;
+		const uint8_t *src = nullptr;
+		ajar_status st = view_range(L, what, a.bufferView, a.byteOffset, need, &src);
+		if (st)
+			return st;
+		p.bytes.resize(a.count * elem);
+		for (size_t i = 0; i < a.count; i++)
+			memcpy(&p.bytes[i * elem], src + i * stride, elem);
+	} else {
+		/* No buffer view: all zeros, unless sparse values replace some. No
+		 * data bounds the count here, so a sanity limit does. */
+		if (a.count > ((size_t)1 << 24))
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s: %zu elements without a bufferView", what, a.count);
+		p.bytes.assign(a.count * elem, 0);
+	}
+
+	if (a.sparse.isSparse) {
+		const auto &sp = a.sparse;
+		int isize = component_size(sp.indices.componentType);
+		if (sp.count < 0 || (size_t)sp.count > a.count || sp.indices.byteOffset < 0 || sp.values.byteOffset < 0 ||
+		    isize == 0 || sp.indices.componentType == TINYGLTF_COMPONENT_TYPE_BYTE ||
+		    sp.indices.componentType == TINYGLTF_COMPONENT_TYPE_SHORT ||
+		    sp.indices.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT)
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s: invalid sparse (count %d, index type %d)", what, sp.count,
+				    sp.indices.componentType);
+		size_t n = (size_t)sp.count;
+		char swhat[600];
+		const uint8_t *isrc = nullptr, *vsrc = nullptr;
+		snprintf(swhat, sizeof swhat, "%s: sparse.indices", what);
+		ajar_status st = view_range(L, swhat, sp.indices.bufferView, (size_t)sp.indices.byteOffset,
+					    n * (size_t)isize, &isrc);
+		if (st)
+			return st;
+		snprintf(swhat, sizeof swhat, "%s: sparse.values", what);
+		st = view_range(L, swhat, sp.values.bufferView, (size_t)sp.values.byteOffset, n * elem, &vsrc);
+		if (st)
+			return st;
+		for (size_t k = 0; k < n; k++) {
+			uint32_t i = 0;
+			if (isize == 1) {
+				i = isrc[k];
+			} else if (isize == 2) {
+				uint16_t v;
+				memcpy(&v, isrc + 2 * k, 2);
+				i = v;
+			} else {
+				memcpy(&i, isrc + 4 * k, 4);
+			}
+			if (i >= a.count)
+				return fail(L, AJAR_ERROR_BAD_INPUT, "%s: sparse index %u out of range (%zu elements)", what, i,
+					    a.count);
+			memcpy(&p.bytes[i * elem], vsrc + k * elem, elem);
+		}
+	}
+	return AJAR_OK;
+}
+
+/* One component as a float; normalized integers map to [0, 1] or [-1, 1]
+ * as glTF specifies. */
+float component_float(const uint8_t *b, int ctype, bool normalized)
+{
+	switch (ctype) {
+	case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+		float f;
+		memcpy(&f, b, 4);
+		return f;
+	}
+	case TINYGLTF_COMPONENT_TYPE_BYTE: {
+		int8_t v;
+		memcpy(&v, b, 1);
+		return normalized ? std::fmax(v / 127.0f, -1.0f) : (float)v;
+	}
+	case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? b[0] / 255.0f : (float)b[0];
+	case TINYGLTF_COMPONENT_TYPE_SHORT: {
+		int16_t v;
+		memcpy(&v, b, 2);
+		return normalized ? std::fmax(v / 32767.0f, -1.0f) : (float)v;
+	}
+	case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+		uint16_t v;
+		memcpy(&v, b, 2);
+		return normalized ? v / 65535.0f : (float)v;
+	}
+	default: { /* UNSIGNED_INT */
+		uint32_t v;
+		memcpy(&v, b, 4);
+		return normalized ? (float)(v / 4294967295.0) : (float)v;
+	}
+	}
+}
+
+std::vector<float> to_floats(const Packed &p)
+{
+	int cs = component_size(p.ctype);
+	std::vector<float> out(p.count * (size_t)p.ncomp);
+	for (size_t i = 0; i < out.size(); i++)
+		out[i] = component_float(&p.bytes[i * (size_t)cs], p.ctype, p.normalized);
+	return out;
+}
+
+ajar_status to_indices(const Loader &L, const std::string &ctx, int acc, const Packed &p, std::vector<uint32_t> &out)
+{
+	if (p.ctype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && p.ctype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+	    p.ctype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+		return fail(L, AJAR_ERROR_BAD_INPUT, "%s: accessors[%d] (indices): componentType %d is not an unsigned integer",
+			    ctx.c_str(), acc, p.ctype);
+	int cs = component_size(p.ctype);
+	out.resize(p.count);
+	for (size_t i = 0; i < p.count; i++) {
+		const uint8_t *b = &p.bytes[i * (size_t)cs];
+		if (cs == 1) {
+			out[i] = b[0];
+		} else if (cs == 2) {
+			uint16_t v;
+			memcpy(&v, b, 2);
+			out[i] = v;
+		} else {
+			memcpy(&out[i], b, 4);
+		}
+	}
+	return AJAR_OK;
+}
+
+/* ---- Transforms (column-major 4x4, element (r, c) at [4c + r]) --------- */
+
+void mat_identity(double m[16])
+{
+	for (int i = 0; i < 16; i++)
+		m[i] = (i % 5 == 0) ? 1.0 : 0.0;
+}
+
+void mat_mul(const double a[16], const double b[16], double r[16])
+{
+	for (int c = 0; c < 4; c++)
+		for (int row = 0; row < 4; row++) {
+			double sum = 0.0;
+			for (int k = 0; k < 4; k++)
+				sum += a[4 * k + row] * b[4 * c + k];
+			r[4 * c + row] = sum;
+		}
+}
+
+/* The node's local matrix: `matrix`, or T * R * S. */
+ajar_status node_local(const Loader &L, int i, double m[16])
+{
+	const tg::Node &n = L.model.nodes[(size_t)i];
+	if (!n.matrix.empty()) {
+		if (n.matrix.size() != 16)
+			return fail(L, AJAR_ERROR_BAD_INPUT, "nodes[%d]: matrix has %zu numbers, expected 16", i,
+				    n.matrix.size());
+		for (int k = 0; k < 16; k++)
+			m[k] = n.matrix[(size_t)k];
+		return AJAR_OK;
+	}
+	if ((!n.translation.empty() && n.translation.size() != 3) || (!n.rotation.empty() && n.rotation.size() != 4) ||
+	    (!n.scale.empty() && n.scale.size() != 3))
+		return fail(L, AJAR_ERROR_BAD_INPUT, "nodes[%d]: translation, rotation or scale has the wrong length", i);
+	double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
+	for (int k = 0; k < 3 && !n.translation.empty(); k++)
+		t[k] = n.translation[(size_t)k];
+	for (int k = 0; k < 4 && !n.rotation.empty(); k++)
+		q[k] = n.rotation[(size_t)k];
+	for (int k = 0; k < 3 && !n.scale.empty(); k++)
+		s[k] = n.scale[(size_t)k];
+	double ql = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+	if (!(ql > 0.0))
+		return fail(L, AJAR_ERROR_BAD_INPUT, "nodes[%d]: rotation is a zero quaternion", i);
+	double x = q[0] / ql, y = q[1] / ql, z = q[2] / ql, w = q[3] / ql;
+	double r[3][3] = {
+		{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
+		{2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
+		{2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)},
+	};
+	for (int c = 0; c < 3; c++) {
+		for (int row = 0; row < 3; row++)
+			m[4 * c + row] = r[row][c] * s[c];
+		m[4 * c + 3] = 0.0;
+	}
+	m[12] = t[0];
+	m[13] = t[1];
+	m[14] = t[2];
+	m[15] = 1.0;
+	return AJAR_OK;
+}
+
+/* Inverse transpose of the upper 3x3 (cofactors over the determinant),
+ * row-major nm[r][c]; returns the determinant. */
+double normal_matrix(const double m[16], double nm[3][3])
+{
+	double a[3][3];
+	for (int r = 0; r < 3; r++)
+		for (int c = 0; c < 3; c++)
+			a[r][c] = m[4 * c + r];
+	for (int r = 0; r < 3; r++)
+		for (int c = 0; c < 3; c++) {
+			int r1 = (r + 1) % 3, r2 = (r + 2) % 3, c1 = (c + 1) % 3, c2 = (c + 2) % 3;
+			nm[r][c] = a[r1][c1] * a[r2][c2] - a[r1][c2] * a[r2][c1];
+		}
+	double det = a[0][0] * nm[0][0] + a[0][1] * nm[0][1] + a[0][2] * nm[0][2];
+	if (det != 0.0)
+		for (int r = 0; r < 3; r++)
+			for (int c = 0; c < 3; c++)
+				nm[r][c] /= det;
+	return det;
+}
+
+/* ---- Extras and extensions ----------------------------------------------- */
+
+const tg::Value *value_member(const tg::Value &v, const char *key)
+{
+	if (!v.IsObject() || !v.Has(key))
+		return nullptr;
+	return &v.Get(key);
+}
+
+/* Portal markers: true, or a non-zero number (Blender custom properties). */
+bool value_truthy(const tg::Value *v)
+{
+	if (!v)
+		return false;
+	if (v->IsBool())
+		return v->Get<bool>();
+	if (v->IsNumber())
+		return v->GetNumberAsDouble() != 0.0;
+	return false;
+}
+
+/* extensions[ext][key] as a number in [lo, hi], or `def` if absent. */
+ajar_status ext_number(const Loader &L, int mi, const tg::ExtensionMap &exts, const char *ext, const char *key,
+		       double def, double lo, double hi, double *out)
+{
+	*out = def;
+	auto it = exts.find(ext);
+	if (it == exts.end())
+		return AJAR_OK;
+	const tg::Value *v = value_member(it->second, key);
+	if (!v)
+		return AJAR_OK;
+	if (!v->IsNumber() || !(v->GetNumberAsDouble() >= lo && v->GetNumberAsDouble() <= hi))
+		return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d]: %s.%s must be a number in [%g, %g]", mi, ext, key, lo,
+			    hi);
+	*out = v->GetNumberAsDouble();
+	return AJAR_OK;
+}
+
+/* A member of extensions[ext] that Ajar does not read (a texture, a tint):
+ * one warning naming it and what is used instead. */
+void ext_unread(const Loader &L, int mi, const tg::ExtensionMap &exts, const char *ext, const char *key,
+		const char *instead)
+{
+	auto it = exts.find(ext);
+	if (it != exts.end() && value_member(it->second, key))
+		log_msg(AJAR_LOG_WARNING, "%s: materials[%d]: %s.%s is not supported; %s", L.file, mi, ext, key, instead);
+}
+
+/* KHR_materials_specular's specularColorFactor, if it is not white. */
+bool specular_tinted(const tg::ExtensionMap &exts)
+{
+	auto it = exts.find("KHR_materials_specular");
+	const tg::Value *c = it == exts.end() ? nullptr : value_member(it->second, "specularColorFactor");
+	if (!c || !c->IsArray())
+		return false;
+	for (size_t i = 0; i < c->ArrayLen(); i++)
+		if (!c->Get((int)i).IsNumber() || c->Get((int)i).GetNumberAsDouble() != 1.0)
+			return true;
+	return false;
+}
+
+/* "resolution": [w, h] in an extras object, if there. */
+ajar_status read_resolution(Loader &L, const tg::Value &extras, const char *where)
+{
+	const tg::Value *r = value_member(extras, "resolution");
+	if (!r || L.s->width)
+		return AJAR_OK;
+	if (!r->IsArray() || r->ArrayLen() != 2 || !r->Get(0).IsNumber() || !r->Get(1).IsNumber() ||
+	    !(r->Get(0).GetNumberAsDouble() >= 1 && r->Get(0).GetNumberAsDouble() <= 65536) ||
+	    !(r->Get(1).GetNumberAsDouble() >= 1 && r->Get(1).GetNumberAsDouble() <= 65536))
+		return fail(L, AJAR_ERROR_BAD_INPUT, "%s.extras.resolution must be [width, height] in 1..65536", where);
+	L.s->width = (uint32_t)r->Get(0).GetNumberAsDouble();
+	L.s->height = (uint32_t)r->Get(1).GetNumberAsDouble();
+	return AJAR_OK;
+}
+
+ajar_status read_environment(Loader &L, const tg::Value &extras, const char *where)
+{
+	const tg::Value *env = value_member(extras, "environment");
+	if (!env)
+		return AJAR_OK;
+	if (!env->IsObject())
+		return fail(L, AJAR_ERROR_BAD_INPUT, "%s.extras.environment is not an object", where);
+	double strength = 1.0;
+	if (const tg::Value *v = value_member(*env, "strength")) {
+		if (!v->IsNumber() || !(v->GetNumberAsDouble() >= 0.0) || !std::isfinite(v->GetNumberAsDouble()))
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s.extras.environment.strength must be a number >= 0", where);
+		strength = v->GetNumberAsDouble();
+	}
+	if (const tg::Value *v = value_member(*env, "rotation")) {
+		if (!v->IsNumber() || !std::isfinite(v->GetNumberAsDouble()))
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s.extras.environment.rotation must be a number (degrees)",
+				    where);
+		ajar_status st = scene_set_env_rotation(L.s, v->GetNumberAsDouble());
+		if (st)
+			return st;
+	}
+	if (const tg::Value *img = value_member(*env, "image")) {
+		if (!img->IsString() || img->Get<std::string>().empty())
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s.extras.environment.image is not a file name", where);
+		std::string name = img->Get<std::string>();
+		std::string path = name[0] == '/' ? name : L.dir + "/" + name;
+		if (access(path.c_str(), F_OK) == 0 && !confined(L, path, name))
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s.extras.environment.image: %s", where, L.refused.c_str());
+		ajar_status st = scene_load_env_image(L.s, path.c_str(), (float)strength);
+		if (st) {
+			std::string msg = ajar_last_error();
+			return fail(L, st, "%s.extras.environment.image: %s", where, msg.c_str());
+		}
+		return AJAR_OK;
+	}
+	const tg::Value *col = value_member(*env, "color");
+	float rgb[3];
+	if (!col || !col->IsArray() || col->ArrayLen() != 3)
+		return fail(L, AJAR_ERROR_BAD_INPUT, "%s.extras.environment needs \"color\": [r, g, b] or \"image\"", where);
+	for (int c = 0; c < 3; c++) {
+		const tg::Value &v = col->Get(c);
+		if (!v.IsNumber() || !(v.GetNumberAsDouble() >= 0.0) || !std::isfinite(v.GetNumberAsDouble()))
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s.extras.environment.color must be 3 numbers >= 0", where);
+		rgb[c] = (float)(v.GetNumberAsDouble() * strength);
+	}
+	scene_set_env_color(L.s, v3(rgb[0], rgb[1], rgb[2]));
+	return AJAR_OK;
+}
+
+/* ---- Materials and textures ---------------------------------------------- */
+
+/* images[i] as a scene texture (RGBA8), converted once. */
+ajar_status image_texture(Loader &L, int i, int *id)
+{
+	if (L.image_textures[(size_t)i] >= 0) {
+		*id = L.image_textures[(size_t)i];
+		return AJAR_OK;
+	}
+	const tg::Image &im = L.model.images[(size_t)i];
+	int bytes = im.bits == 16 ? 2 : im.bits == 8 ? 1 : 0;
+	if (im.width <= 0 || im.height <= 0 || im.component < 1 || im.component > 4 || !bytes)
+		return fail(L, AJAR_ERROR_BAD_INPUT, "images[%d]: not decoded (%dx%d, %d channels of %d bits)", i, im.width,
+			    im.height, im.component, im.bits);
+	size_t n = (size_t)im.width * (size_t)im.height, comp = (size_t)im.component;
+	if (im.image.size() < n * comp * (size_t)bytes)
+		return fail(L, AJAR_ERROR_BAD_INPUT, "images[%d]: %zu bytes of pixels, expected %zu", i, im.image.size(),
+			    n * comp * (size_t)bytes);
+	std::vector<uint8_t> rgba(n * 4);
+	for (size_t p = 0; p < n; p++) {
+		uint8_t v[4] = {0, 0, 0, 255};
+		for (size_t c = 0; c < comp; c++) {
+			if (bytes == 1) {
+				v[c] = im.image[p * comp + c];
+			} else {
+				uint16_t w;
+				memcpy(&w, &im.image[2 * (p * comp + c)], 2);
+				v[c] = (uint8_t)(w >> 8);
+			}
+		}
+		uint8_t *d = &rgba[4 * p];
+		if (comp <= 2) { /* grey, grey + alpha */
+			d[0] = d[1] = d[2] = v[0];
+			d[3] = comp == 2 ? v[1] : 255;
+		} else {
+			memcpy(d, v, 4);
+		}
+	}
+	uint32_t tid;
+	ajar_status st = scene_add_texture(L.s, (uint32_t)im.width, (uint32_t)im.height, rgba.data(), &tid);
+	if (st)
+		return st;
+	L.image_textures[(size_t)i] = (int)tid;
+	*id = (int)tid;
+	return AJAR_OK;
+}
+
+/* A number, or a JSON array of n numbers, of a KHR_texture_transform. */
+bool transform_numbers(const tg::Value &ext, const char *key, int n, double *out)
+{
+	const tg::Value *v = value_member(ext, key);
+	if (!v)
+		return true;
+	if (n == 1) {
+		if (!v->IsNumber() || !std::isfinite(v->GetNumberAsDouble()))
+			return false;
+		out[0] = v->GetNumberAsDouble();
+		return true;
+	}
+	if (!v->IsArray() || v->ArrayLen() != (size_t)n)
+		return false;
+	for (int i = 0; i < n; i++) {
+		if (!v->Get(i).IsNumber() || !std::isfinite(v->Get(i).GetNumberAsDouble()))
+			return false;
+		out[i] = v->Get(i).GetNumberAsDouble();
+	}
+	return true;
+}
+
+int wrap_mode(int gl)
+{
+	return gl == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE     ? TEX_WRAP_CLAMP
+	       : gl == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT ? TEX_WRAP_MIRROR
+							     : TEX_WRAP_REPEAT;
+}
+
+/* materials[mi]'s texture `slot` (textures[index], coordinate set
+ * texcoord, the textureInfo's extensions) as a scene texture: the image's
+ * texels, the sampler's wrap modes and magnification filter (there are no
+ * mipmaps: pixel sampling filters), the coordinate set and
+ * KHR_texture_transform (T R S, its texCoord replacing the set). *id is -1
+ * where there is no texture. */
+ajar_status texture_use(Loader &L, int mi, const char *slot, int index, int texcoord, const tg::ExtensionMap &exts,
+			int *id)
+{
+	*id = -1;
+	if (index < 0)
+		return AJAR_OK;
+	const tg::Model &m = L.model;
+	if ((size_t)index >= m.textures.size())
+		return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d].%s: textures[%d] does not exist (%zu textures)", mi, slot,
+			    index, m.textures.size());
+	const tg::Texture &tex = m.textures[(size_t)index];
+	if (tex.source < 0 || (size_t)tex.source >= m.images.size())
+		return fail(L, AJAR_ERROR_BAD_INPUT, "textures[%d]: images[%d] does not exist (%zu images)", index,
+			    tex.source, m.images.size());
+	int flags = 0;
+	if (tex.sampler >= 0) {
+		if ((size_t)tex.sampler >= m.samplers.size())
+			return fail(L, AJAR_ERROR_BAD_INPUT, "textures[%d]: samplers[%d] does not exist (%zu samplers)", index,
+				    tex.sampler, m.samplers.size());
+		const tg::Sampler &sm = m.samplers[(size_t)tex.sampler];
+		flags |= wrap_mode(sm.wrapS) | wrap_mode(sm.wrapT) << 2;
+		if (sm.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST)
+			flags |= TEX_NEAREST;
+	}
+	float xf[6] = {1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f};
+	auto it = exts.find("KHR_texture_transform");
+	if (it != exts.end()) {
+		double off[2] = {0.0, 0.0}, rot = 0.0, sc[2] = {1.0, 1.0}, tc = texcoord;
+		if (!transform_numbers(it->second, "offset", 2, off) || !transform_numbers(it->second, "rotation", 1, &rot) ||
+		    !transform_numbers(it->second, "scale", 2, sc) || !transform_numbers(it->second, "texCoord", 1, &tc) ||
+		    !(tc >= 0.0 && tc == std::floor(tc)))
+			return fail(L, AJAR_ERROR_BAD_INPUT,
+				    "materials[%d].%s.extensions.KHR_texture_transform: offset and scale must be 2 numbers, "
+				    "rotation a number, texCoord an integer >= 0",
+				    mi, slot);
+		/* uv' = T(offset) R(rotation) S(scale) uv with R = [cos sin;
+		 * -sin cos] in (u, v): counter-clockwise as the image is seen
+		 * (v grows downwards), which TextureTransformTest's markers
+		 * confirm (the other sign hits its red "opposite" marker). */
+		double c = std::cos(rot), sn = std::sin(rot);
+		xf[0] = (float)(c * sc[0]);
+		xf[1] = (float)(sn * sc[1]);
+		xf[2] = (float)off[0];
+		xf[3] = (float)(-sn * sc[0]);
+		xf[4] = (float)(c * sc[1]);
+		xf[5] = (float)off[1];
+		texcoord = (int)std::fmin(tc, 1e6);
+	}
+	if (texcoord > 1) {
+		log_msg(AJAR_LOG_WARNING, "%s: materials[%d].%s uses TEXCOORD_%d; only TEXCOORD_0 and _1 are supported, texture ignored",
+			L.file, mi, slot, texcoord);
+		return AJAR_OK;
+	}
+	if (texcoord == 1)
+		flags |= TEX_UV1;
+	int img = -1;
+	ajar_status st = image_texture(L, tex.source, &img);
+	uint32_t tid;
+	if (!st)
+		st = scene_add_texture_use(L.s, (uint32_t)img, flags, xf, &tid);
+	if (!st)
+		*id = (int)tid;
+	return st;
+}
+
+ajar_status in_unit(const Loader &L, int mi, const char *name, double v)
+{
+	if (!(v >= 0.0 && v <= 1.0))
+		return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d]: %s %g is not in [0, 1]", mi, name, v);
+	return AJAR_OK;
+}
+
+ajar_status load_material(Loader &L, int mi, uint32_t *id)
+{
+	const tg::Material &gm = L.model.materials[(size_t)mi];
+	const tg::PbrMetallicRoughness &pbr = gm.pbrMetallicRoughness;
+	::Material m;
+	memset(&m, 0, sizeof m);
+	ajar_status st = AJAR_OK;
+	if (pbr.baseColorFactor.size() != 4)
+		return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d]: baseColorFactor has %zu numbers, expected 4", mi,
+			    pbr.baseColorFactor.size());
+	for (int c = 0; c < 4 && !st; c++)
+		st = in_unit(L, mi, "baseColorFactor", pbr.baseColorFactor[(size_t)c]);
+	if (!st)
+		st = in_unit(L, mi, "metallicFactor", pbr.metallicFactor);
+	if (!st)
+		st = in_unit(L, mi, "roughnessFactor", pbr.roughnessFactor);
+	if (st)
+		return st;
+	m.base_color = v3((float)pbr.baseColorFactor[0], (float)pbr.baseColorFactor[1], (float)pbr.baseColorFactor[2]);
+	m.metallic = (float)pbr.metallicFactor;
+	m.roughness = (float)pbr.roughnessFactor;
+	m.base_tex = -1;
+
+	double strength, transmission, ior, specular;
+	if ((st = ext_number(L, mi, gm.extensions, "KHR_materials_emissive_strength", "emissiveStrength", 1.0, 0.0,
+			     1e30, &strength)) ||
+	    (st = ext_number(L, mi, gm.extensions, "KHR_materials_transmission", "transmissionFactor", 0.0, 0.0, 1.0,
+			     &transmission)) ||
+	    (st = ext_number(L, mi, gm.extensions, "KHR_materials_ior", "ior", 1.5, 1.0, 10.0, &ior)) ||
+	    (st = ext_number(L, mi, gm.extensions, "KHR_materials_specular", "specularFactor", 1.0, 0.0, 1.0,
+			     &specular)))
+		return st;
+	ext_unread(L, mi, gm.extensions, "KHR_materials_transmission", "transmissionTexture",
+		   "transmissionFactor alone is used");
+	ext_unread(L, mi, gm.extensions, "KHR_materials_specular", "specularTexture", "specularFactor alone is used");
+	ext_unread(L, mi, gm.extensions, "KHR_materials_specular", "specularColorTexture", "ignored");
+	if (specular_tinted(gm.extensions))
+		log_msg(AJAR_LOG_WARNING, "%s: materials[%d]: KHR_materials_specular.specularColorFactor is not supported; white is used",
+			L.file, mi);
+	if (!gm.emissiveFactor.empty()) {
+		if (gm.emissiveFactor.size() != 3)
+			return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d]: emissiveFactor has %zu numbers, expected 3", mi,
+				    gm.emissiveFactor.size());
+		for (int c = 0; c < 3 && !st; c++)
+			st = in_unit(L, mi, "emissiveFactor", gm.emissiveFactor[(size_t)c]);
+		if (st)
+			return st;
+		m.emission = v3((float)(gm.emissiveFactor[0] * strength), (float)(gm.emissiveFactor[1] * strength),
+				(float)(gm.emissiveFactor[2] * strength));
+	}
+	m.transmission = (float)transmission;
+	m.ior = (float)ior;
+	m.specular = (float)specular;
+	m.flags = gm.doubleSided ? MATERIAL_DOUBLE_SIDED : 0;
+	m.alpha_cutoff = (float)gm.alphaCutoff;
+	m.base_alpha = (float)pbr.baseColorFactor[3];
+	if (gm.alphaMode == "MASK")
+		m.flags |= MATERIAL_ALPHA_MASK;
+	else if (gm.alphaMode == "BLEND")
+		m.flags |= MATERIAL_ALPHA_BLEND;
+	else if (gm.alphaMode != "OPAQUE" && !gm.alphaMode.empty())
+		return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d]: alphaMode \"%s\" is not OPAQUE, MASK or BLEND", mi,
+			    gm.alphaMode.c_str());
+
+	int base = -1, mr = -1, em = -1;
+	const tg::TextureInfo &bt = pbr.baseColorTexture, &mt = pbr.metallicRoughnessTexture, &et = gm.emissiveTexture;
+	if ((st = texture_use(L, mi, "baseColorTexture", bt.index, bt.texCoord, bt.extensions, &base)) ||
+	    (st = texture_use(L, mi, "metallicRoughnessTexture", mt.index, mt.texCoord, mt.extensions, &mr)) ||
+	    (st = texture_use(L, mi, "emissiveTexture", et.index, et.texCoord, et.extensions, &em)))
+		return st;
+	m.base_tex = base;
+	m.mr_tex = mr + 1;
+	m.emissive_tex = em + 1;
+	const tg::NormalTextureInfo &nt = gm.normalTexture;
+	int nrm = -1;
+	if ((st = texture_use(L, mi, "normalTexture", nt.index, nt.texCoord, nt.extensions, &nrm)))
+		return st;
+	if (!std::isfinite(nt.scale))
+		return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d]: normalTexture.scale is not finite", mi);
+	m.normal_tex = nrm + 1;
+	m.normal_scale = (float)nt.scale;
+	return scene_add_material(L.s, &m, id);
+}
+
+/* The glTF default material (spec 3.9.6): white, metallic 1, roughness 1. */
+ajar_status default_material(Loader &L, uint32_t *id)
+{
+	if (L.default_material < 0) {
+		::Material m;
+		memset(&m, 0, sizeof m);
+		m.base_color = v3(1.0f, 1.0f, 1.0f);
+		m.base_tex = -1;
+		m.metallic = 1.0f;
+		m.roughness = 1.0f;
+		m.ior = 1.5f;
+		m.specular = 1.0f;
+		m.alpha_cutoff = 0.5f;
+		uint32_t mid;
+		ajar_status st = scene_add_material(L.s, &m, &mid);
+		if (st)
+			return st;
+		L.default_material = (int)mid;
+	}
+	*id = (uint32_t)L.default_material;
+	return AJAR_OK;
+}
+
+/* ---- Meshes and nodes ---------------------------------------------------- */
+
+/* Triangles of a portal node, gathered over its primitives so the node is
+ * one portal. */
+struct PortalMesh {
+	std::vector<float> pos;
+	std::vector<uint32_t> idx;
+};
+
+/* The primitive's index list as triangles (strips and fans unrolled,
+ * their degenerate stitching triangles dropped). */
+ajar_status triangle_list(const Loader &L, const std::string &what, int mode, const std::vector<uint32_t> &in,
+			  std::vector<uint32_t> &out)
+{
+	size_t n = in.size();
+	if (mode == TINYGLTF_MODE_TRIANGLES) {
+		if (n % 3)
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s: %zu vertices do not make whole triangles", what.c_str(), n);
+		out = in;
+		return AJAR_OK;
+	}
+	out.clear();
+	for (size_t i = 0; i + 2 < n; i++) {
+		uint32_t a, b, c;
+		if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+			/* glTF 3.7.2.1: triangle i is (i, i + 1 + i%2, i + 2 - i%2). */
+			a = in[i];
+			b = in[i + 1 + i % 2];
+			c = in[i + 2 - i % 2];
+		} else {
+			a = in[i + 1];
+			b = in[i + 2];
+			c = in[0];
+		}
+		if (a == b || b == c || a == c)
+			continue;
+		out.push_back(a);
+		out.push_back(b);
+		out.push_back(c);
+	}
+	return AJAR_OK;
+}
+
+/* Tangents for a normal map where the mesh has none (tangents.c); the
+ * vertices it splits in two are appended to pos, nrm, uv and the other
+ * per-vertex arrays in `more` (each `width` floats a vertex). */
+struct VertexArray {
+	std::vector<float> *v;
+	size_t width;
+};
+
+ajar_status generate_tangents(const Loader &L, std::vector<float> &pos, std::vector<float> &nrm,
+			      std::vector<float> &uvs, std::vector<VertexArray> more, std::vector<uint32_t> &tri,
+			      std::vector<float> &tan)
+{
+	size_t nv = pos.size() / 3, total = 0;
+	std::vector<uint32_t> twin(nv);
+	float *t = nullptr;
+	if (tangents_generate(pos.data(), nrm.empty() ? nullptr : nrm.data(), uvs.data(), nv, tri.data(), tri.size() / 3,
+			      twin.data(), &t, &total) != AJAR_OK)
+		return fail(L, AJAR_ERROR_OUT_OF_MEMORY, "out of memory for tangents");
+	tan.assign(t, t + 4 * total);
+	free(t);
+	more.push_back({&pos, 3});
+	if (!nrm.empty())
+		more.push_back({&nrm, 3});
+	more.push_back({&uvs, 2});
+	for (const VertexArray &a : more) {
+		a.v->resize(total * a.width);
+		for (size_t v = 0; v < nv; v++)
+			if (twin[v] != UINT32_MAX)
+				for (size_t c = 0; c < a.width; c++)
+					(*a.v)[twin[v] * a.width + c] = (*a.v)[v * a.width + c];
+	}
+	return AJAR_OK;
+}
+
+ajar_status load_primitive(Loader &L, int mi, int pi, const double world[16], const double nm[3][3], bool flip,
+			   PortalMesh *portal)
+{
+	const tg::Primitive &pr = L.model.meshes[(size_t)mi].primitives[(size_t)pi];
+	char wbuf[64];
+	snprintf(wbuf, sizeof wbuf, "meshes[%d].primitives[%d]", mi, pi);
+	const std::string what = wbuf;
+	int mode = pr.mode < 0 ? TINYGLTF_MODE_TRIANGLES : pr.mode;
+	if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+	    mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+		log_msg(AJAR_LOG_WARNING, "%s: %s: mode %d (points or lines) skipped", L.file, what.c_str(), mode);
+		return AJAR_OK;
+	}
+	auto pit = pr.attributes.find("POSITION");
+	if (pit == pr.attributes.end()) {
+		log_msg(AJAR_LOG_WARNING, "%s: %s: no POSITION, skipped", L.file, what.c_str());
+		return AJAR_OK;
+	}
+	Packed pp;
+	ajar_status st = accessor_read(L, what, "POSITION", pit->second, 3, pp);
+	if (st)
+		return st;
+	size_t nv = pp.count;
+	std::vector<float> pos = to_floats(pp);
+
+	std::vector<uint32_t> idx, tri;
+	if (pr.indices >= 0) {
+		Packed pi_;
+		if ((st = accessor_read(L, what, "indices", pr.indices, 1, pi_)) ||
+		    (st = to_indices(L, what, pr.indices, pi_, idx)))
+			return st;
+	} else {
+		idx.resize(nv);
+		for (size_t i = 0; i < nv; i++)
+			idx[i] = (uint32_t)i;
+	}
+	for (size_t i = 0; i < idx.size(); i++)
+		if (idx[i] >= nv)
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s: index %u (at %zu) out of range (%zu vertices)", what.c_str(),
+				    idx[i], i, nv);
+	if ((st = triangle_list(L, what, mode, idx, tri)))
+		return st;
+	for (size_t v = 0; v < nv; v++)
+		for (int c = 0; c < 3; c++)
+			if (!std::isfinite(pos[3 * v + (size_t)c]))
+				return fail(L, AJAR_ERROR_BAD_INPUT, "%s: vertex %zu: position is not finite", what.c_str(), v);
+	if (flip)
+		for (size_t t = 0; t < tri.size(); t += 3)
+			std::swap(tri[t + 1], tri[t + 2]);
+	for (size_t v = 0; v < nv; v++) {
+		double p[3] = {pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]};
+		for (int r = 0; r < 3; r++)
+			pos[3 * v + (size_t)r] =
+				(float)(world[r] * p[0] + world[4 + r] * p[1] + world[8 + r] * p[2] + world[12 + r]);
+	}
+	uint32_t ntris = (uint32_t)(tri.size() / 3);
+
+	if (portal) {
+		uint32_t base = (uint32_t)(portal->pos.size() / 3);
+		portal->pos.insert(portal->pos.end(), pos.begin(), pos.end());
+		for (uint32_t k : tri)
+			portal->idx.push_back(base + k);
+		return AJAR_OK;
+	}
+
+	std::vector<float> nrm, uv;
+	auto nit = pr.attributes.find("NORMAL");
+	if (nit != pr.attributes.end()) {
+		Packed pn;
+		if ((st = accessor_read(L, what, "NORMAL", nit->second, 3, pn)))
+			return st;
+		if (pn.count != nv)
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s: NORMAL has %zu elements, POSITION %zu", what.c_str(),
+				    pn.count, nv);
+		nrm = to_floats(pn);
+		for (size_t v = 0; v < nv; v++) {
+			double n[3] = {nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2]};
+			for (int r = 0; r < 3; r++)
+				nrm[3 * v + (size_t)r] = (float)(nm[r][0] * n[0] + nm[r][1] * n[1] + nm[r][2] * n[2]);
+		}
+	}
+	std::vector<float> uv1, col;
+	const char *sets[2] = {"TEXCOORD_0", "TEXCOORD_1"};
+	for (int k = 0; k < 2; k++) {
+		auto uit = pr.attributes.find(sets[k]);
+		if (uit == pr.attributes.end())
+			continue;
+		Packed pu;
+		if ((st = accessor_read(L, what, sets[k], uit->second, 2, pu)))
+			return st;
+		if (pu.count != nv)
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s: %s has %zu elements, POSITION %zu", what.c_str(), sets[k],
+				    pu.count, nv);
+		(k ? uv1 : uv) = to_floats(pu);
+	}
+	/* COLOR_0: RGB or RGBA, float or normalized unsigned integers, linear. */
+	auto cit = pr.attributes.find("COLOR_0");
+	if (cit != pr.attributes.end()) {
+		int acc = cit->second;
+		int nc = acc >= 0 && (size_t)acc < L.model.accessors.size()
+				 ? type_components(L.model.accessors[(size_t)acc].type)
+				 : 4;
+		Packed pc;
+		if ((st = accessor_read(L, what, "COLOR_0", acc, nc == 3 ? 3 : 4, pc)))
+			return st;
+		if (pc.count != nv)
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s: COLOR_0 has %zu elements, POSITION %zu", what.c_str(),
+				    pc.count, nv);
+		if (pc.ctype != TINYGLTF_COMPONENT_TYPE_FLOAT && !pc.normalized)
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s: accessors[%d] (COLOR_0): integer components must be normalized",
+				    what.c_str(), acc);
+		std::vector<float> c = to_floats(pc);
+		col.assign(4 * nv, 1.0f);
+		for (size_t v = 0; v < nv; v++)
+			for (int j = 0; j < pc.ncomp; j++)
+				col[4 * v + (size_t)j] = std::fmin(std::fmax(c[(size_t)pc.ncomp * v + (size_t)j], 0.0f), 1.0f);
+	}
+	uint32_t mat = 0;
+	if (pr.material < 0) {
+		st = default_material(L, &mat);
+	} else if ((size_t)pr.material >= L.material_ids.size()) {
+		st = fail(L, AJAR_ERROR_BAD_INPUT, "%s: materials[%d] does not exist (%zu materials)", what.c_str(),
+			  pr.material, L.material_ids.size());
+	} else {
+		mat = L.material_ids[(size_t)pr.material];
+	}
+	if (st)
+		return st;
+	/* Tangents for a normal map: TANGENT (xyz by the node's matrix, w
+	 * turned over where it mirrors), else generated from the normal
+	 * map's coordinate set. */
+	std::vector<float> tan;
+	const ::Material &sm = L.s->materials[mat];
+	if (sm.normal_tex) {
+		auto tit = pr.attributes.find("TANGENT");
+		std::vector<float> &set = L.s->textures[sm.normal_tex - 1].flags & TEX_UV1 ? uv1 : uv;
+		if (tit != pr.attributes.end()) {
+			Packed pt;
+			if ((st = accessor_read(L, what, "TANGENT", tit->second, 4, pt)))
+				return st;
+			if (pt.count != nv)
+				return fail(L, AJAR_ERROR_BAD_INPUT, "%s: TANGENT has %zu elements, POSITION %zu", what.c_str(),
+					    pt.count, nv);
+			tan = to_floats(pt);
+			for (size_t v = 0; v < nv; v++) {
+				double t[3] = {tan[4 * v], tan[4 * v + 1], tan[4 * v + 2]};
+				for (int r = 0; r < 3; r++)
+					tan[4 * v + (size_t)r] = (float)(world[r] * t[0] + world[4 + r] * t[1] + world[8 + r] * t[2]);
+				if (flip)
+					tan[4 * v + 3] = -tan[4 * v + 3];
+			}
+		} else if (!set.empty()) {
+			std::vector<VertexArray> more;
+			std::vector<float> *other = &set == &uv ? &uv1 : &uv;
+			if (!other->empty())
+				more.push_back({other, 2});
+			if (!col.empty())
+				more.push_back({&col, 4});
+			if ((st = generate_tangents(L, pos, nrm, set, more, tri, tan)) != AJAR_OK)
+				return st;
+			nv = pos.size() / 3;
+		}
+	}
+	return scene_add_triangles_ex(L.s, what.c_str(), pos.data(), nrm.empty() ? nullptr : nrm.data(),
+				      uv.empty() ? nullptr : uv.data(), uv1.empty() ? nullptr : uv1.data(),
+				      col.empty() ? nullptr : col.data(), tan.empty() ? nullptr : tan.data(), (uint32_t)nv,
+				      tri.data(), ntris, mat);
+}
+
+ajar_status load_mesh_node(Loader &L, int ni, const double world[16])
+{
+	const tg::Node &n = L.model.nodes[(size_t)ni];
+	if ((size_t)n.mesh >= L.model.meshes.size())
+		return fail(L, AJAR_ERROR_BAD_INPUT, "nodes[%d]: meshes[%d] does not exist (%zu meshes)", ni, n.mesh,
+			    L.model.meshes.size());
+	double nm[3][3];
+	double det = normal_matrix(world, nm);
+	if (!(std::fabs(det) > 0.0) || !std::isfinite(det)) {
+		log_msg(AJAR_LOG_WARNING, "%s: nodes[%d]: transform is singular (zero scale), mesh skipped", L.file, ni);
+		return AJAR_OK;
+	}
+	bool is_portal = value_truthy(value_member(n.extras, "portal"));
+	PortalMesh portal;
+	const tg::Mesh &mesh = L.model.meshes[(size_t)n.mesh];
+	for (size_t p = 0; p < mesh.primitives.size(); p++) {
+		ajar_status st = load_primitive(L, n.mesh, (int)p, world, nm, det < 0.0, is_portal ? &portal : nullptr);
+		if (st)
+			return st;
+	}
+	if (!is_portal)
+		return AJAR_OK;
+	if (portal.idx.empty()) {
+		log_msg(AJAR_LOG_WARNING, "%s: nodes[%d]: portal has no triangles, ignored", L.file, ni);
+		return AJAR_OK;
+	}
+	char what[64];
+	snprintf(what, sizeof what, "nodes[%d] (portal)", ni);
+	return scene_add_portal(L.s, what, portal.pos.data(), (uint32_t)(portal.pos.size() / 3), portal.idx.data(),
+				(uint32_t)(portal.idx.size() / 3));
+}
+
+/* The first perspective camera of the traversal sets the scene's camera. */
+ajar_status load_camera_node(Loader &L, int ni, const double world[16])
+{
+	const tg::Node &n = L.model.nodes[(size_t)ni];
+	if ((size_t)n.camera >= L.model.cameras.size())
+		return fail(L, AJAR_ERROR_BAD_INPUT, "nodes[%d]: cameras[%d] does not exist (%zu cameras)", ni, n.camera,
+			    L.model.cameras.size());
+	const tg::Camera &c = L.model.cameras[(size_t)n.camera];
+	if (c.type != "perspective") {
+		log_msg(AJAR_LOG_INFO, "%s: cameras[%d]: %s camera skipped (only perspective is supported)", L.file,
+			n.camera, c.type.c_str());
+		return AJAR_OK;
+	}
+	double yfov = c.perspective.yfov, aspect = c.perspective.aspectRatio;
+	if (!(yfov > 0.0 && yfov < 3.14159265358979323846) || !(aspect >= 0.0))
+		return fail(L, AJAR_ERROR_BAD_INPUT, "cameras[%d]: yfov %g must be in (0, pi), aspectRatio %g positive",
+			    n.camera, yfov, aspect);
+	V3 pos = v3((float)world[12], (float)world[13], (float)world[14]);
+	V3 fwd = v3((float)-world[8], (float)-world[9], (float)-world[10]);
+	V3 up = v3((float)world[4], (float)world[5], (float)world[6]);
+	if (scene_set_camera(L.s, pos, fwd, up, (float)yfov, (float)aspect)) {
+		std::string msg = ajar_last_error();
+		return fail(L, AJAR_ERROR_BAD_INPUT, "nodes[%d]: unusable camera transform (%s)", ni, msg.c_str());
+	}
+	char where[64];
+	snprintf(where, sizeof where, "cameras[%d]", n.camera);
+	ajar_status st = read_resolution(L, c.extras, where);
+	snprintf(where, sizeof where, "nodes[%d]", ni);
+	return st ? st : read_resolution(L, n.extras, where);
+}
+
+/* A node's KHR_lights_punctual light: at the node's world position,
+ * pointing down its world -Z (scale affects neither the light's range nor
+ * its intensity). */
+ajar_status load_light_node(Loader &L, int ni, const double world[16])
+{
+	const tg::Node &n = L.model.nodes[(size_t)ni];
+	auto it = n.extensions.find("KHR_lights_punctual");
+	if (it == n.extensions.end())
+		return AJAR_OK;
+	const tg::Value *v = value_member(it->second, "light");
+	if (!v || !v->IsNumber())
+		return fail(L, AJAR_ERROR_BAD_INPUT, "nodes[%d]: KHR_lights_punctual has no light index", ni);
+	double li = v->GetNumberAsDouble();
+	if (!(li >= 0.0 && li < (double)L.model.lights.size()) || li != std::floor(li))
+		return fail(L, AJAR_ERROR_BAD_INPUT, "nodes[%d]: KHR_lights_punctual light %g does not exist (%zu lights)", ni,
+			    li, L.model.lights.size());
+	const tg::Light &gl = L.model.lights[(size_t)li];
+	ajar_light l;
+	memset(&l, 0, sizeof l);
+	l.color[0] = l.color[1] = l.color[2] = 1.0f; /* the spec's default */
+	if (gl.type == "directional")
+		l.type = AJAR_LIGHT_DIRECTIONAL;
+	else if (gl.type == "point")
+		l.type = AJAR_LIGHT_POINT;
+	else if (gl.type == "spot")
+		l.type = AJAR_LIGHT_SPOT;
+	else
+		return fail(L, AJAR_ERROR_BAD_INPUT, "KHR_lights_punctual.lights[%g]: unknown type '%s'", li, gl.type.c_str());
+	if (!gl.color.empty() && gl.color.size() != 3)
+		return fail(L, AJAR_ERROR_BAD_INPUT, "KHR_lights_punctual.lights[%g]: color has %zu numbers, expected 3", li,
+			    gl.color.size());
+	for (size_t k = 0; k < gl.color.size(); k++)
+		l.color[k] = (float)gl.color[k];
+	l.intensity = (float)gl.intensity;
+	l.range = (float)gl.range; /* tinygltf: 0 when absent (infinite) */
+	l.inner_cone = (float)gl.spot.innerConeAngle;
+	l.outer_cone = (float)gl.spot.outerConeAngle;
+	for (int k = 0; k < 3; k++) {
+		l.position[k] = (float)world[12 + k];
+		l.direction[k] = (float)-world[8 + k];
+	}
+	char what[96];
+	snprintf(what, sizeof what, "nodes[%d]: KHR_lights_punctual.lights[%g]", ni, li);
+	return scene_add_light(L.s, what, &l);
+}
+
+/* Depth-first, parents before children, in file order, so "the first
+ * camera" is well defined. */
+ajar_status walk_nodes(Loader &L, const std::vector<int> &roots, const char *roots_what)
+{
+	const size_t nn = L.model.nodes.size();
+	struct Item {
+		int node;
+		double parent[16];
+	};
+	std::vector<Item> stack;
+	std::vector<char> seen(nn, 0);
+	for (size_t r = roots.size(); r-- > 0;) {
+		if (roots[r] < 0 || (size_t)roots[r] >= nn)
+			return fail(L, AJAR_ERROR_BAD_INPUT, "%s: nodes[%d] does not exist (%zu nodes)", roots_what, roots[r],
+				    nn);
+		Item it;
+		it.node = roots[r];
+		mat_identity(it.parent);
+		stack.push_back(it);
+	}
+	while (!stack.empty()) {
+		Item it = stack.back();
+		stack.pop_back();
+		int ni = it.node;
+		if (seen[(size_t)ni])
+			return fail(L, AJAR_ERROR_BAD_INPUT, "nodes[%d]: reached twice (a node may have only one parent)", ni);
+		seen[(size_t)ni] = 1;
+		const tg::Node &n = L.model.nodes[(size_t)ni];
+		double local[16], world[16];
+		ajar_status st = node_local(L, ni, local);
+		if (st)
+			return st;
+		mat_mul(it.parent, local, world);
+		if (n.mesh >= 0 && (st = load_mesh_node(L, ni, world)))
+			return st;
+		if (n.camera >= 0 && !L.s->has_camera && (st = load_camera_node(L, ni, world)))
+			return st;
+		if ((st = load_light_node(L, ni, world)))
+			return st;
+		for (size_t k = n.children.size(); k-- > 0;) {
+			int ch = n.children[k];
+			if (ch < 0 || (size_t)ch >= nn)
+				return fail(L, AJAR_ERROR_BAD_INPUT, "nodes[%d]: child nodes[%d] does not exist (%zu nodes)", ni,
+					    ch, nn);
+			Item c;
+			c.node = ch;
+			memcpy(c.parent, world, sizeof world);
+			stack.push_back(c);
+		}
+	}
+	return AJAR_OK;
+}
+
+ajar_status read_file(const char *path, std::vector<unsigned char> &data)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f)
+		return err_set(AJAR_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
+	unsigned char buf[65536];
+	size_t got;
+	while ((got = fread(buf, 1, sizeof buf, f)) > 0)
+		data.insert(data.end(), buf, buf + got);
+	int bad = ferror(f), e = errno;
+	fclose(f);
+	if (bad)
+		return err_set(AJAR_ERROR_IO, "%s: cannot read: %s", path, strerror(e));
+	return AJAR_OK;
+}
+
+ajar_status load(Loader &L)
+{
+	std::vector<unsigned char> data;
+	ajar_status st = read_file(L.file, data);
+	if (st)
+		return st;
+	if (data.size() > 0xffffffffu)
+		return fail(L, AJAR_ERROR_BAD_INPUT, "file larger than 4 GiB");
+
+	tg::TinyGLTF loader;
+	std::string err, warn;
+	bool ok;
+	tg::FsCallbacks fs = {fs_exists, fs_expand, fs_read, tg::WriteWholeFile, &L};
+	loader.SetFsCallbacks(fs);
+	if (data.size() >= 4 && memcmp(data.data(), "glTF", 4) == 0)
+		ok = loader.LoadBinaryFromMemory(&L.model, &err, &warn, data.data(), (unsigned)data.size(), L.dir);
+	else
+		ok = loader.LoadASCIIFromString(&L.model, &err, &warn, (const char *)data.data(), (unsigned)data.size(),
+						L.dir);
+	if (!L.refused.empty())
+		return fail(L, AJAR_ERROR_BAD_INPUT, "%s", L.refused.c_str());
+	if (!warn.empty())
+		log_msg(AJAR_LOG_WARNING, "%s: %s", L.file, one_line(warn).c_str());
+	if (!ok)
+		return fail(L, AJAR_ERROR_BAD_INPUT, "%s", err.empty() ? "cannot parse glTF" : one_line(err).c_str());
+
+	const tg::Model &m = L.model;
+	for (const std::string &ext : m.extensionsRequired) {
+		bool known = false;
+		for (const char *s : supported_extensions)
+			known = known || ext == s;
+		if (!known)
+			return fail(L, AJAR_ERROR_BAD_INPUT, "extensionsRequired: %s is not supported", ext.c_str());
+	}
+
+	L.image_textures.assign(m.images.size(), -1);
+	L.material_ids.resize(m.materials.size());
+	for (size_t i = 0; i < m.materials.size(); i++)
+		if ((st = load_material(L, (int)i, &L.material_ids[i])))
+			return st;
+
+	std::vector<int> roots;
+	const tg::Value *scene_extras = nullptr;
+	char where[64] = "nodes";
+	if (!m.scenes.empty()) {
+		int si = m.defaultScene >= 0 ? m.defaultScene : 0;
+		if ((size_t)si >= m.scenes.size())
+			return fail(L, AJAR_ERROR_BAD_INPUT, "scene: scenes[%d] does not exist (%zu scenes)", si,
+				    m.scenes.size());
+		roots = m.scenes[(size_t)si].nodes;
+		scene_extras = &m.scenes[(size_t)si].extras;
+		snprintf(where, sizeof where, "scenes[%d]", si);
+	} else {
+		/* No scenes: every node nobody lists as a child is a root. */
+		std::vector<char> child(m.nodes.size(), 0);
+		for (const tg::Node &n : m.nodes)
+			for (int c : n.children)
+				if (c >= 0 && (size_t)c < m.nodes.size())
+					child[(size_t)c] = 1;
+		for (size_t i = 0; i < m.nodes.size(); i++)
+			if (!child[i])
+				roots.push_back((int)i);
+	}
+	if ((st = walk_nodes(L, roots, where)))
+		return st;
+	if (scene_extras &&
+	    ((st = read_resolution(L, *scene_extras, where)) || (st = read_environment(L, *scene_extras, where))))
+		return st;
+	if (L.s->ntris == 0)
+		return fail(L, AJAR_ERROR_BAD_INPUT, "%s: no triangles to render%s", where,
+			    L.s->nportal_tris ? " (portals do not count)" : "");
+	return AJAR_OK;
+}
+
+} // namespace
+
+extern "C" ajar_status gltf_load(const char *path, Scene **out) { return gltf_load_with(path, 0, out); }
+
+extern "C" ajar_status gltf_load_with(const char *path, int allow_outside_files, Scene **out)
+{
+	*out = nullptr;
+	Scene *s = nullptr;
+	ajar_status st = scene_new(path, &s);
+	if (st)
+		return st;
+	try {
+		Loader L;
+		L.file = path;
+		L.s = s;
+		const char *slash = strrchr(path, '/');
+		L.dir = slash ? std::string(path, (size_t)(slash - path)) : std::string(".");
+		if (L.dir.empty())
+			L.dir = "/";
+		L.allow_outside = allow_outside_files != 0;
+		char real[PATH_MAX];
+		L.root = realpath(L.dir.c_str(), real) ? real : L.dir;
+		st = load(L);
+	} catch (const std::bad_alloc &) {
+		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+	} catch (const std::exception &e) {
+		st = err_set(AJAR_ERROR_BAD_INPUT, "%s: %s", path, e.what());
+	} catch (...) {
+		st = err_set(AJAR_ERROR_BAD_INPUT, "%s: unexpected error while loading", path);
+	}
+	if (st) {
+		scene_free(s);
+		return st;
+	}
+	*out = s;
+	return AJAR_OK;
+}
