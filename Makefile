@@ -55,7 +55,7 @@ DEPS_test_lights_fine := $(DEPS_test_lights)
 DEPS_test_scene := $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_dwa image/exr_huf image/hdr)
 DEPS_test_exr := $(call obj,core/error image/exr image/exr_dwa image/exr_huf image/png)
 DEPS_test_confine := $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_dwa image/exr_huf image/hdr image/png)
-DEPS_test_bdpt := $(BUILD)/tests/kernel_host.o $(BUILD)/tests/mis_oracle.o $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_dwa image/exr_huf image/hdr prepare/bvh_build prepare/light_tables prepare/prepare prepare/portal_flux prepare/sky_tables)
+DEPS_test_bdpt := $(BUILD)/tests/kernel_host.o $(BUILD)/tests/mis_oracle.o $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_dwa image/exr_huf image/hdr prepare/bvh_build prepare/light_tables prepare/prepare prepare/policy prepare/portal_flux prepare/sky_tables render/render_options)
 DEPS_test_portal := $(DEPS_test_bdpt)
 DEPS_test_punctual := $(DEPS_test_bdpt)
 # Tests that render need the whole library.
@@ -178,11 +178,17 @@ $(BUILD)/tests/test_%: $(BUILD)/tests/test_%.o $(BUILD)/tests/testutil.o $$(DEPS
 
 .SECONDARY:
 
+# The ajar command with faults injected from its environment, for tests
+# that run it in other processes (test_mpi).
+$(BUILD)/tests/ajar_faults: $(BUILD)/tests/ajar_faults.o $(filter-out $(BUILD)/cli/main.o,$(CLI_OBJS)) $(BUILD)/libajar.a
+	@echo "  LD      $@"
+	$(Q)$(CXX) $(LDFLAGS) -o $@ $^ $(LDLIBS)
+
 $(BUILD)/tests/bench: $(BUILD)/tests/bench.o $(BUILD)/libajar.a
 	@echo "  LD      $@"
 	$(Q)$(CXX) $(LDFLAGS) -o $@ $^ $(LDLIBS)
 
-tests: $(TESTS:%=$(BUILD)/tests/%) build/ajar
+tests: $(TESTS:%=$(BUILD)/tests/%) build/ajar $(BUILD)/tests/ajar_faults
 
 test:
 	$(Q)$(MAKE) --no-print-directory deps

@@ -118,8 +118,11 @@ static void bench_scene(const char *path, uint32_t spp)
 	double t0 = now();
 	check(ajar_scene_load(path, &s));
 	double load = now() - t0;
-	PrepareOptions po = {64, 64, 0, 64, 1, 0, 0, 0, 0, 0};
-	check(prepare_scene(s, &po, &sd));
+	ajar_options po;
+	ajar_options_default(&po);
+	po.max_depth = 64;
+	po.mis = AJAR_MIS_POWER;
+	check(prepare_scene(s, &po, 64, 64, NULL, &sd));
 	check(device_select(NULL, &plat, &id, 1, &ndev));
 	check(device_open(&d, plat, id));
 	check(device_build(&d, ajar_kernel_source, KERNEL_OPTIONS "0"));

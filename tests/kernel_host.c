@@ -10,6 +10,12 @@
 void host_scene_open(HostScene *h, const char *path, Scene *built, uint32_t w, uint32_t hgt, int integrator,
 		     int max_depth)
 {
+	host_scene_open_with(h, path, built, w, hgt, integrator, max_depth, NULL);
+}
+
+void host_scene_open_with(HostScene *h, const char *path, Scene *built, uint32_t w, uint32_t hgt, int integrator,
+			  int max_depth, const PolicyOverrides *over)
+{
 	memset(h, 0, sizeof *h);
 	if (path) {
 		if (ajar_scene_load(path, &h->scene) != AJAR_OK)
@@ -17,9 +23,17 @@ void host_scene_open(HostScene *h, const char *path, Scene *built, uint32_t w, u
 	} else {
 		h->scene = built;
 	}
+	ajar_options o;
+	ajar_options_default(&o);
+	o.integrator = (ajar_integrator)integrator;
+	o.max_depth = (uint32_t)max_depth;
+	o.mis = AJAR_MIS_POWER;
 	/* The kernels compiled here read sky tables of PORTAL_SKY_RES cells a side. */
-	PrepareOptions po = {w, hgt, integrator, (uint32_t)max_depth, 1, MIS_POWER, 0, 0, 0, PORTAL_SKY_RES};
-	if (prepare_scene(h->scene, &po, &h->data) != AJAR_OK)
+	PolicyOverrides po = {0};
+	if (over)
+		po = *over;
+	po.sky_res = PORTAL_SKY_RES;
+	if (prepare_scene(h->scene, &o, w, hgt, &po, &h->data) != AJAR_OK)
 		fail_msg("%s", ajar_last_error());
 #define HOST_VIEW(type, name) h->view.name = h->data.name;
 	AJAR_SCENE_BUFFERS(HOST_VIEW)

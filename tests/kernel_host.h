@@ -18,6 +18,9 @@ typedef struct {
  * width x height image; integrator settings go into the Params. */
 void host_scene_open(HostScene *h, const char *path, Scene *built, uint32_t w, uint32_t hgt, int integrator,
 		     int max_depth);
+/* The same with some of the policy's choices forced (NULL: none). */
+void host_scene_open_with(HostScene *h, const char *path, Scene *built, uint32_t w, uint32_t hgt, int integrator,
+			  int max_depth, const PolicyOverrides *over);
 void host_scene_close(HostScene *h);
 
 /* Renders spp samples per pixel: rgb gets the mean (3 floats per pixel);

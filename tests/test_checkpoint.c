@@ -9,8 +9,8 @@
  * and left untouched; a write that fails keeps the previous file; a device
  * lost mid-render leaves a checkpoint the render resumes from.
  *
- * The library's test hook AJAR_TEST_PASS_SPP=1 makes every pass one sample
- * per pixel, so there are many points to stop at; PoCL exposes two CPU
+ * Passes of one sample per pixel (render_faults.pass_spp, set in main) give
+ * the renders through the API many points to stop at; PoCL exposes two CPU
  * devices (POCL_DEVICES, set in main) for the device-loss test. */
 #include <fcntl.h>
 #include <signal.h>
@@ -25,6 +25,7 @@
 
 #include "ajar.h"
 #include "render/checkpoint_file.h"
+#include "render/render_overrides.h"
 #include "testutil.h"
 
 #define W 16
@@ -279,15 +280,18 @@ static void test_refused(void **state)
 	ck.integrator = AJAR_INTEGRATOR_PT;
 	ck.spp = 1; /* fewer than it holds */
 	refused(s, good, &ck, AJAR_ERROR_INVALID_ARGUMENT, "too few to continue it");
-	/* Another parameter set with the same options (an environment variable). */
+	/* Another parameter set with the same options (a forced policy choice). */
 	o.integrator = AJAR_INTEGRATOR_PORTAL;
+	const PolicyOverrides rate = {.portal_rate = 0.5f};
+	assert_int_equal(renderer_create_overridden(other, &o, &rate, &r), AJAR_OK);
+	assert_int_equal(ajar_renderer_render(r, NULL, NULL), AJAR_OK);
+	assert_int_equal(ajar_renderer_write_checkpoint(r, bad), AJAR_OK);
+	ajar_renderer_destroy(&r);
+	refused(other, bad, NULL, AJAR_ERROR_BAD_INPUT, "other render parameters");
 	assert_int_equal(ajar_renderer_create(other, &o, &r), AJAR_OK);
 	assert_int_equal(ajar_renderer_render(r, NULL, NULL), AJAR_OK);
 	assert_int_equal(ajar_renderer_write_checkpoint(r, good), AJAR_OK);
 	ajar_renderer_destroy(&r);
-	setenv("AJAR_PORTAL_RATE", "0.5", 1);
-	refused(other, good, NULL, AJAR_ERROR_BAD_INPUT, "other render parameters");
-	unsetenv("AJAR_PORTAL_RATE");
 	assert_int_equal(ajar_checkpoint_options(good, &ck, NULL), AJAR_OK);
 	ck.spp = 4;
 	assert_int_equal(ajar_renderer_resume(other, good, &ck, &r), AJAR_OK);
@@ -389,13 +393,12 @@ static void test_device_lost(void **state)
 	 * only on losses) holds exactly the first 5 samples, whatever the
 	 * machine's speed. (Two devices with one lost raced: the other could
 	 * take every remaining sample first, and no checkpoint was written.) */
-	setenv("AJAR_TEST_FAIL_DEVICE", "0:3", 1);
-	setenv("AJAR_TEST_PASS_SPP", "4", 1);
 	assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_OK);
-	unsetenv("AJAR_TEST_FAIL_DEVICE");
-	unsetenv("AJAR_TEST_PASS_SPP");
 	assert_int_equal(ajar_renderer_set_checkpoint(r, ck, 0), AJAR_OK);
+	RenderFaults before = render_faults;
+	render_faults = (RenderFaults){.device = 0, .pass = 3, .pass_spp = 4};
 	assert_int_equal(ajar_renderer_render(r, NULL, NULL), AJAR_ERROR_DEVICE);
+	render_faults = before;
 	ajar_renderer_destroy(&r);
 	/* The checkpoint written when the device was dropped resumes to the same bits. */
 	ajar_options ckopt;
@@ -574,7 +577,7 @@ int main(void)
 {
 	/* Before the OpenCL platform is first initialised. */
 	setenv("POCL_DEVICES", "pthread pthread", 1);
-	setenv("AJAR_TEST_PASS_SPP", "1", 1);
+	render_faults.pass_spp = 1; /* many passes: a render can stop at many points */
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_resume_pt),
 		cmocka_unit_test(test_resume_bdpt_layers),

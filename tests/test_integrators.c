@@ -18,10 +18,17 @@
 #include <string.h>
 
 #include "ajar.h"
+#include "render/render_overrides.h"
 #include "scene/scene.h"
 #include "testutil.h"
 
 #define BATCHES 16
+
+/* The policy's choices a test forces on every render (none by default). */
+static PolicyOverrides g_over;
+/* The sky's intermediate strategy set with light subpaths: portal keeps its
+ * intermediate strategies where it would render as bdpt. */
+static const PolicyOverrides SKY_SET = {.portal_set_given = 1, .portal_set = {1, 2, 1, 3, 1}};
 
 typedef struct {
 	double mean[3], se[3];
@@ -38,7 +45,7 @@ static void estimate(ajar_scene *s, ajar_integrator integ, uint32_t w, uint32_t 
 	o.spp = spp;
 	o.integrator = integ;
 	o.max_depth = depth;
-	if (ajar_renderer_create(s, &o, &r) != AJAR_OK)
+	if (renderer_create_overridden(s, &o, &g_over, &r) != AJAR_OK)
 		fail_msg("%s", ajar_last_error());
 	float *img = malloc(sizeof(float) * 4 * w * h);
 	double s1[3] = {0}, s2[3] = {0};
@@ -166,27 +173,26 @@ static void test_bathroom(void **state) { compare(SCENE("bathroom/bathroom.gltf"
 /* Under a sky with a sun through the window, high (the patch on the
  * floor) and low (on the far wall): next-event estimation through the
  * portal by the sky's radiance (kernels/light/portal_sky.h). */
-/* portal renders as bdpt there by default (src/prepare/prepare.c; test_render
+/* portal renders as bdpt there by default (src/prepare/policy.c; test_render
  * checks the bits): the sky's set named keeps its intermediate strategies,
  * which are compared here. */
 static void test_window_room_sun(void **state)
 {
-	setenv("AJAR_PORTAL_SET", "1,2,1,3,1", 1);
+	g_over = SKY_SET;
 	compare_sky(SCENE("window-room/window-room.gltf"), 0.84f, 32, 32, 64, 16);
 	compare_sky(SCENE("window-room/window-room.gltf"), 0.14f, 32, 32, 64, 16);
-	unsetenv("AJAR_PORTAL_SET");
+	g_over = (PolicyOverrides){0};
 }
 /* A sun of 0.57 degrees sampled through the planes' tables of 512 cells a
- * side, as pt takes them under skies of 2048 columns or more (src/prepare/prepare.c,
- * sky_table_res; test_render checks that choice), here for all three on a
+ * side, as pt takes them under skies of 2048 columns or more (src/prepare/policy.c,
+ * sky_res; test_render checks that choice), here for all three on a
  * smaller image. */
 static void test_window_room_small_sun(void **state)
 {
-	setenv("AJAR_PORTAL_SET", "1,2,1,3,1", 1);
-	setenv("AJAR_SKY_RES", "512", 1);
+	g_over = SKY_SET;
+	g_over.sky_res = 512;
 	compare_sky_image(SCENE("window-room/window-room.gltf"), 1024, 512, 0.84f, 0.01f, 32, 32, 64, 16);
-	unsetenv("AJAR_SKY_RES");
-	unsetenv("AJAR_PORTAL_SET");
+	g_over = (PolicyOverrides){0};
 }
 static void test_door_ajar(void **state) { compare(SCENE("door-ajar/door-ajar.gltf"), 24, 24, 512, 128); }
 /* The shipped atrium: the forest sky's sun down through a portal in the
@@ -197,7 +203,7 @@ static void test_atrium_forest(void **state)
 	compare(SCENE("atrium-forest/atrium-forest.gltf"), 24, 24, 64, 16);
 }
 /* door-ajar with a point lamp for its emitter: portal's long halves at
- * rate 1 (a lamp behind a portal counts as an emitter, src/prepare/prepare.c). */
+ * rate 1 (a lamp behind a portal counts as an emitter, src/prepare/policy.c). */
 static void test_door_ajar_lamp(void **state)
 {
 	compare(SCENE("door-ajar-lamp/door-ajar-lamp.gltf"), 24, 24, 512, 128);
@@ -219,10 +225,10 @@ static void test_cornell_punctual(void **state)
 static void test_window_room_punctual(void **state)
 {
 	const float sun[3] = {0.3f, -0.5f, 0.8f}, p[3] = {1.0f, 2.2f, 2.0f}, q[3] = {3.0f, 2.5f, 1.5f};
-	setenv("AJAR_PORTAL_SET", "1,2,1,3,1", 1);
+	g_over = SKY_SET;
 	compare_punctual(SCENE("window-room/window-room.gltf"), "window-room + sun + punctual lights", sun,
 			 683.0f * 10.0f, p, q, 683.0f, 32, 32, 64, 16);
-	unsetenv("AJAR_PORTAL_SET");
+	g_over = (PolicyOverrides){0};
 }
 
 /* A quad (corners a, a + e1, a + e1 + e2, a + e2; uv (0,0) (1,0) (1,1) (0,1);

@@ -113,9 +113,13 @@ static int lit_planes(Lit *l)
 	size_t np, ns;
 	free(l->planes);
 	free(l->sky);
-	assert_int_equal(portal_sky_build(&l->sc, l->s->portals, l->s->nportal_tris, PORTAL_SKY_RES, &l->planes, &np,
-					  &l->sky, &ns),
-			 AJAR_OK);
+	np = ns = 0;
+	l->planes = NULL;
+	l->sky = NULL;
+	if (l->prm.env_type == ENV_IMAGE) { /* prepare_scene builds planes under a sky image only */
+		assert_int_equal(portal_sky_planes(l->s->portals, l->s->nportal_tris, &l->planes, &np), AJAR_OK);
+		assert_int_equal(portal_sky_tables(&l->sc, l->planes, np, PORTAL_SKY_RES, &l->sky, &ns), AJAR_OK);
+	}
 	l->sc.portal_planes = l->planes;
 	l->sc.portal_sky = l->sky;
 	l->prm.num_portal_planes = (int)np;

@@ -7,12 +7,13 @@
  * identical devices the image must equal the one-device image bit for bit,
  * also after a device fails mid-render (its range, and its completed ones
  * when its film is untrusted, are rendered again by the other). Failures
- * are injected with the library's test hook AJAR_TEST_FAIL_DEVICE. */
+ * are injected through render_faults (src/render/render_overrides.h). */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "ajar.h"
+#include "render/render_overrides.h"
 #include "testutil.h"
 
 #define W 64
@@ -145,24 +146,24 @@ static void test_two_equal_one(void **state)
 }
 
 /* Device 1 fails at its second pass; device 0 finishes the same image. */
-static void fail_second_device(const char *hook)
+static void fail_second_device(int lost)
 {
 	ajar_scene *s = cornell();
 	float *one = render(s, "0:0", SPP);
-	setenv("AJAR_TEST_FAIL_DEVICE", hook, 1);
 	ajar_renderer *r = renderer(s, "0:0,0:1", SPP);
-	unsetenv("AJAR_TEST_FAIL_DEVICE");
 	logged.warnings = 0;
 	ajar_set_log_callback(on_log, NULL);
+	render_faults = (RenderFaults){.device = 1, .pass = 2, .lost = lost};
 	ajar_status st = ajar_renderer_render(r, NULL, NULL);
+	render_faults = (RenderFaults){0};
 	ajar_set_log_callback(NULL, NULL);
 	if (st != AJAR_OK)
-		fail_msg("render with %s: %s", hook, ajar_last_error());
+		fail_msg("render with device 1 %s at its second pass: %s", lost ? "lost" : "failing", ajar_last_error());
 	assert_int_equal(ajar_renderer_spp(r), SPP);
 	assert_int_equal(logged.warnings, 1);
 	print_message("warning: %s\n", logged.last);
 	assert_non_null(strstr(logged.last, "(0:1) dropped"));
-	assert_non_null(strstr(logged.last, "AJAR_TEST_FAIL_DEVICE"));
+	assert_non_null(strstr(logged.last, "an injected fault"));
 	ajar_device_stats ds;
 	assert_int_equal(ajar_renderer_device_stats(r, 1, &ds), AJAR_OK);
 	assert_true(ds.failed);
@@ -175,11 +176,11 @@ static void fail_second_device(const char *hook)
 }
 
 /* The launch fails: device 1's film still holds its first pass. */
-static void test_failed_launch_keeps_film(void **state) { fail_second_device("1:2"); }
+static void test_failed_launch_keeps_film(void **state) { fail_second_device(0); }
 
 /* The device is lost after its kernel ran: its film is untrusted and its
  * completed ranges are rendered again on device 0. */
-static void test_lost_device_rerendered(void **state) { fail_second_device("1:2:lost"); }
+static void test_lost_device_rerendered(void **state) { fail_second_device(1); }
 
 /* The only device fails: a device error, and the image of what was done
  * (the first pass is one sample per pixel) equals a 1-spp render. */
@@ -187,10 +188,10 @@ static void test_only_device_fails(void **state)
 {
 	ajar_scene *s = cornell();
 	float *first = render(s, "0:0", 1);
-	setenv("AJAR_TEST_FAIL_DEVICE", "0:2", 1);
 	ajar_renderer *r = renderer(s, "0:0", SPP);
-	unsetenv("AJAR_TEST_FAIL_DEVICE");
+	render_faults = (RenderFaults){.device = 0, .pass = 2};
 	assert_int_equal(ajar_renderer_render(r, NULL, NULL), AJAR_ERROR_DEVICE);
+	render_faults = (RenderFaults){0};
 	assert_non_null(strstr(ajar_last_error(), "no device left"));
 	assert_int_equal(ajar_renderer_spp(r), 1);
 	float *partial = image(r);

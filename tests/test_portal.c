@@ -440,16 +440,17 @@ static Scene *punctual_scene(const char *path, const float dir[3], int inside, c
 static const float sun_in[3] = {0.3f, -0.5f, 0.8f}; /* through window-room's window */
 static const float wr_p[3] = {1.0f, 2.2f, 2.0f}, wr_q[3] = {3.0f, 2.5f, 1.5f};
 
+/* The sky's strategy set with light subpaths, the default where portal now
+ * renders as bdpt: a forced set keeps the intermediate strategies. */
+static const PolicyOverrides SKY_SET = {.portal_set_given = 1, .portal_set = {1, 2, 1, 3, 1}};
+
 /* Opens a scene where portal renders as bdpt by default (light subpaths
  * bring the light in: a sky image with a sun, punctual lights on the
- * camera's side; src/prepare/prepare.c) with the sky's set named, 1,2,1,3,1, the
- * default there before: an explicit AJAR_PORTAL_SET keeps the
- * intermediate strategies, which these tests check. */
+ * camera's side; src/prepare/policy.c) with the sky's set forced, which
+ * keeps the intermediate strategies these tests check. */
 static void open_portal_kept(HostScene *h, const char *path, Scene *built, uint32_t w, uint32_t hgt, int depth)
 {
-	setenv("AJAR_PORTAL_SET", "1,2,1,3,1", 1);
-	host_scene_open(h, path, built, w, hgt, INTEGRATOR_PORTAL, depth);
-	unsetenv("AJAR_PORTAL_SET");
+	host_scene_open_with(h, path, built, w, hgt, INTEGRATOR_PORTAL, depth, &SKY_SET);
 	assert_int_equal(h->data.params->integrator, INTEGRATOR_PORTAL);
 }
 
@@ -1085,41 +1086,38 @@ static void check_wasted(const char *path, Scene *built, const char *name)
 	host_scene_close(&h);
 }
 
-/* The default strategy sets, and AJAR_PORTAL_SET taken whole or not at all. */
+/* The default strategy sets, and a forced set taken whole. */
 static void test_portal_set(void **state)
 {
 	HostScene h;
+	const int M = AJAR_BIDIR_MAX_DEPTH;
 	const struct {
-		const char *scene, *set;
+		const char *scene;
+		int forced, set[5];
 		int expect[5]; /* s, s', t', t, light paths */
 	} cases[] = {
-		{"window-room/window-room.gltf", NULL, {1, 2, 1, 3, 0}},
-		{"window-room-forest/window-room-forest.gltf", NULL, {1, 2, 1, 3, 1}}, /* a sky image: light subpaths */
-		{"window-room-forest/window-room-forest.gltf", "1,2,1,3,0", {1, 2, 1, 3, 0}},
-		{"door-ajar/door-ajar.gltf", NULL, {1, AJAR_BIDIR_MAX_DEPTH, AJAR_BIDIR_MAX_DEPTH, 1 << 20, 1}},
-		{"door-ajar/door-ajar.gltf", "2,4,5", {2, 4, 5, 1 << 20, 1}},
-		{"door-ajar/door-ajar.gltf", "1,2,2,4,0", {1, 2, 2, 4, 0}},
-		{"door-ajar/door-ajar.gltf", "2", {1, AJAR_BIDIR_MAX_DEPTH, AJAR_BIDIR_MAX_DEPTH, 1 << 20, 1}},     /* too short: ignored */
-		{"door-ajar/door-ajar.gltf", "1,0,1", {1, AJAR_BIDIR_MAX_DEPTH, AJAR_BIDIR_MAX_DEPTH, 1 << 20, 1}}, /* s' = 0: ignored */
-		{"window-room/window-room.gltf", "3,2,1", {1, 2, 1, 3, 0}},     /* s > 1 needs light subpaths */
+		{"window-room/window-room.gltf", 0, {0}, {1, 2, 1, 3, 0}},
+		{"window-room-forest/window-room-forest.gltf", 0, {0}, {1, 2, 1, 3, 1}}, /* a sky image: light subpaths */
+		{"window-room-forest/window-room-forest.gltf", 1, {1, 2, 1, 3, 0}, {1, 2, 1, 3, 0}},
+		{"door-ajar/door-ajar.gltf", 0, {0}, {1, M, M, 1 << 20, 1}},
+		{"door-ajar/door-ajar.gltf", 1, {2, 4, 5, 1 << 20, 1}, {2, 4, 5, 1 << 20, 1}},
+		{"door-ajar/door-ajar.gltf", 1, {1, 2, 2, 4, 0}, {1, 2, 2, 4, 0}},
+		{"window-room/window-room.gltf", 1, {3, 2, 1, 3, 0}, {1, 2, 1, 3, 0}}, /* s > 1 needs light subpaths */
 	};
 	for (unsigned i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-		if (cases[i].set)
-			setenv("AJAR_PORTAL_SET", cases[i].set, 1);
-		else
-			unsetenv("AJAR_PORTAL_SET");
+		PolicyOverrides over = {.portal_set_given = cases[i].forced};
+		memcpy(over.portal_set, cases[i].set, sizeof over.portal_set);
 		char path[256];
 		snprintf(path, sizeof path, SCENE("%s"), cases[i].scene);
-		host_scene_open(&h, path, NULL, 8, 8, INTEGRATOR_PORTAL, 8);
+		host_scene_open_with(&h, path, NULL, 8, 8, INTEGRATOR_PORTAL, 8, &over);
 		const Params *p = h.data.params;
 		int got[5] = {p->portal_s_max, p->portal_sp_max, p->portal_tp_max, p->portal_t_max, p->light_paths};
 		for (int j = 0; j < 5; j++)
 			if (got[j] != cases[i].expect[j])
-				fail_msg("%s, AJAR_PORTAL_SET=%s: field %d is %d, expected %d", cases[i].scene,
-					 cases[i].set ? cases[i].set : "(unset)", j, got[j], cases[i].expect[j]);
+				fail_msg("%s, case %u: field %d is %d, expected %d", cases[i].scene, i, j, got[j],
+					 cases[i].expect[j]);
 		host_scene_close(&h);
 	}
-	unsetenv("AJAR_PORTAL_SET");
 }
 
 /* A lamp at `pos` (range 0: unlimited) with window-room's constant sky. */
@@ -1144,7 +1142,7 @@ static Scene *window_room_lamp_at(float x, float y, float z, float range)
  * portal renders as bdpt; a point light behind a portal counts as an
  * emitter (the long set at rate 1); constant skies, a sky without a sun
  * (no light subpaths, test_sky_sun_share) and emitters keep their intermediate subpaths,
- * and so does an explicit AJAR_PORTAL_SET (src/prepare/prepare.c). */
+ * and so does a forced strategy set (src/prepare/policy.c). */
 static void test_portal_as_bdpt(void **state)
 {
 	(void)state;
@@ -1180,15 +1178,14 @@ static void test_portal_as_bdpt(void **state)
 		if (cases[i].long_set)
 			assert_float_equal(p->portal_rate, 1.0f, 0.0f);
 		/* as bdpt, eye vertices join the first light vertices only */
-		assert_int_equal(p->bdpt_conn, p->integrator == INTEGRATOR_BDPT ? PORTAL_BDPT_CONN : 0);
+		assert_int_equal(p->bdpt_conn, p->integrator == INTEGRATOR_BDPT ? POLICY_PORTAL_BDPT_CONN : 0);
 		host_scene_close(&h);
 	}
-	setenv("AJAR_PORTAL_SET", "1,2,1,3,1", 1);
 	HostScene h;
-	host_scene_open(&h, SCENE("window-room-forest/window-room-forest.gltf"), NULL, 8, 8, INTEGRATOR_PORTAL, 8);
+	host_scene_open_with(&h, SCENE("window-room-forest/window-room-forest.gltf"), NULL, 8, 8, INTEGRATOR_PORTAL, 8,
+			     &SKY_SET);
 	assert_int_equal(h.data.params->integrator, INTEGRATOR_PORTAL);
 	host_scene_close(&h);
-	unsetenv("AJAR_PORTAL_SET");
 }
 
 /* The whole sky's share of a sky image's power in its brightest texels. */
@@ -1309,8 +1306,8 @@ static void test_sky_sun_share(void **state)
 /* The rate of intermediate subpaths: 0.1 where a constant sky is the only
  * light and where a sky image is (with its light subpaths), 0.3 under a
  * sky image (sampled through planar portals) without light subpaths, 1
- * with emitters, AJAR_PORTAL_RATE in (0, 1] overriding it, anything else
- * ignored with a warning. */
+ * with emitters; a forced rate replaces it, and strategy layers without
+ * MIS weights take every intermediate subpath. */
 static void test_portal_rate(void **state)
 {
 	HostScene h;
@@ -1323,27 +1320,37 @@ static void test_portal_rate(void **state)
 	host_scene_open(&h, NULL, sun_room(0, 300.0f), 8, 8, INTEGRATOR_PORTAL, 8); /* a sky image */
 	assert_float_equal(h.data.params->portal_rate, 0.1f, 0.0f);
 	host_scene_close(&h);
-	setenv("AJAR_PORTAL_SET", "1,2,1,3,0", 1); /* without its light subpaths */
-	host_scene_open(&h, NULL, sun_room(0, 300.0f), 8, 8, INTEGRATOR_PORTAL, 8);
+	const PolicyOverrides no_lines = {.portal_set_given = 1, .portal_set = {1, 2, 1, 3, 0}};
+	host_scene_open_with(&h, NULL, sun_room(0, 300.0f), 8, 8, INTEGRATOR_PORTAL, 8, &no_lines);
 	assert_float_equal(h.data.params->portal_rate, 0.3f, 0.0f);
 	host_scene_close(&h);
-	unsetenv("AJAR_PORTAL_SET");
-	const char *rates[] = {"0.25", "1", "0", "1.5", "0.3x", ""};
-	const float expect[] = {0.25f, 1.0f, 0.1f, 0.1f, 0.1f, 0.1f};
-	for (int i = 0; i < 6; i++) {
-		setenv("AJAR_PORTAL_RATE", rates[i], 1);
-		host_scene_open(&h, SCENE("window-room/window-room.gltf"), NULL, 8, 8, INTEGRATOR_PORTAL, 8);
-		if (h.data.params->portal_rate != expect[i])
-			fail_msg("AJAR_PORTAL_RATE='%s': rate %g, expected %g", rates[i], h.data.params->portal_rate,
-				 expect[i]);
+	const float rates[] = {0.25f, 1.0f};
+	for (int i = 0; i < 2; i++) {
+		const PolicyOverrides over = {.portal_rate = rates[i]};
+		host_scene_open_with(&h, SCENE("window-room/window-room.gltf"), NULL, 8, 8, INTEGRATOR_PORTAL, 8, &over);
+		assert_float_equal(h.data.params->portal_rate, rates[i], 0.0f);
 		host_scene_close(&h);
 	}
-	unsetenv("AJAR_PORTAL_RATE");
+	/* Unweighted strategy layers (the strategy tests) take every intermediate subpath. */
+	const PolicyOverrides over = {.portal_rate = 0.25f};
+	Scene *s;
+	assert_int_equal(ajar_scene_load(SCENE("window-room/window-room.gltf"), &s), AJAR_OK);
+	ajar_options o;
+	ajar_options_default(&o);
+	o.integrator = AJAR_INTEGRATOR_PORTAL;
+	o.max_depth = 8;
+	o.strategy_len = 4;
+	o.strategy_unweighted = 1;
+	SceneData d;
+	assert_int_equal(prepare_scene(s, &o, 8, 8, &over, &d), AJAR_OK);
+	assert_float_equal(d.params->portal_rate, 1.0f, 0.0f);
+	prepare_free(&d);
+	ajar_scene_destroy(&s);
 }
 
 /* Scenes lit by punctual lights without emitters (window-room-sun,
  * window-room-lamp): light subpaths on, the sky's strategy set and rate
- * (src/prepare/prepare.c); the guided <- direction never lost to a punctual light
+ * (src/prepare/policy.c); the guided <- direction never lost to a punctual light
  * (guided_env_share): under the sun lamp and a constant sky every guided
  * pick is a sky direction; and the direction density against its sampling
  * (chi-square) there and in door-ajar with a sun, a point light and a spot
@@ -1355,8 +1362,6 @@ static void test_punctual_choices(void **state)
 	HostScene h;
 	const char *scenes[] = {SCENE("window-room-sun/window-room-sun.gltf"), SCENE("window-room-lamp/window-room-lamp.gltf")};
 	for (int i = 0; i < 2; i++) {
-		unsetenv("AJAR_PORTAL_SET");
-		unsetenv("AJAR_PORTAL_RATE");
 		host_scene_open(&h, scenes[i], NULL, 8, 8, INTEGRATOR_PORTAL, 8);
 		const Params *p = h.data.params;
 		int got[5] = {p->portal_s_max, p->portal_sp_max, p->portal_tp_max, p->portal_t_max, p->light_paths};

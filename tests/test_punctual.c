@@ -477,8 +477,12 @@ static void test_every_integrator_prepares(void **state)
 		if (portals)
 			assert_int_equal(ajar_scene_add_portal(s, &m), AJAR_OK);
 		for (int integ = INTEGRATOR_PT; integ <= INTEGRATOR_PORTAL; integ++) {
-			PrepareOptions po = {8, 8, integ, 8, 1, MIS_POWER, 0, 0, 0, 0};
-			if (prepare_scene(s, &po, &d) != AJAR_OK)
+			ajar_options po;
+			ajar_options_default(&po);
+			po.integrator = (ajar_integrator)integ;
+			po.max_depth = 8;
+			po.mis = AJAR_MIS_POWER;
+			if (prepare_scene(s, &po, 8, 8, NULL, &d) != AJAR_OK)
 				fail_msg("integrator %d, portals %d: %s", integ, portals, ajar_last_error());
 			assert_int_equal(d.params->num_lights, 1);
 			assert_true(d.params->light_paths);

@@ -22,6 +22,7 @@
 #include "device/device.h"
 #include "image/exr.h"
 #include "prepare/prepare.h"
+#include "render/render_overrides.h"
 #include "testutil.h"
 
 #include <unistd.h>
@@ -366,8 +367,11 @@ static unsigned scene_omit(const char *path)
 	SceneData d;
 	if (ajar_scene_load(path, &s) != AJAR_OK)
 		fail_msg("%s: %s", path, ajar_last_error());
-	PrepareOptions po = {8, 8, 0, 8, 1, 0, 0, 0, 0, 0};
-	if (prepare_scene(s, &po, &d) != AJAR_OK)
+	ajar_options po;
+	ajar_options_default(&po);
+	po.max_depth = 8;
+	po.mis = AJAR_MIS_POWER;
+	if (prepare_scene(s, &po, 8, 8, NULL, &d) != AJAR_OK)
 		fail_msg("%s: %s", path, ajar_last_error());
 	unsigned omit = d.kernel_omit;
 	prepare_free(&d);
@@ -413,9 +417,9 @@ static void test_kernel_features(void **state)
 
 /* Without portals the portal integrator is bdpt, sample for sample. Where
  * light subpaths bring the light in through them (a sky image with a sun,
- * a sun lamp, a lamp in the room; src/prepare/prepare.c) it is bdpt joining eye
- * vertices to the first PORTAL_BDPT_CONN light vertices (AJAR_BDPT_CONN
- * sets bdpt's set); under a constant sky it is neither. */
+ * a sun lamp, a lamp in the room; src/prepare/policy.c) it is bdpt joining eye
+ * vertices to the first POLICY_PORTAL_BDPT_CONN light vertices (bdpt with
+ * that connection set forced); under a constant sky it is neither. */
 static void test_portal_as_bdpt(void **state)
 {
 	static const char *scenes[] = {"cornell/cornell.gltf", "window-room-forest/window-room-forest.gltf",
@@ -435,12 +439,12 @@ static void test_portal_as_bdpt(void **state)
 		o.seed = 9;
 		for (int k = 0; k < 2; k++) {
 			o.integrator = k ? AJAR_INTEGRATOR_PORTAL : AJAR_INTEGRATOR_BDPT;
+			PolicyOverrides over = {0};
 			if (k == 0 && i >= 1 && i <= 3) {
-				char conn[2] = {(char)('0' + PORTAL_BDPT_CONN), 0};
-				setenv("AJAR_BDPT_CONN", conn, 1);
+				over.bdpt_conn_given = 1;
+				over.bdpt_conn = POLICY_PORTAL_BDPT_CONN;
 			}
-			assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_OK);
-			unsetenv("AJAR_BDPT_CONN");
+			assert_int_equal(renderer_create_overridden(s, &o, &over, &r), AJAR_OK);
 			assert_int_equal(ajar_renderer_render(r, NULL, NULL), AJAR_OK);
 			assert_int_equal(ajar_renderer_image(r, k ? b : a, NULL, NULL), AJAR_OK);
 			ajar_renderer_destroy(&r);
@@ -458,7 +462,7 @@ static void test_portal_as_bdpt(void **state)
  * alike), the power heuristic elsewhere: under a constant sky, a sun lamp,
  * and the same sunny sky with a lamp added. Compared bit for bit with the
  * heuristic named. */
-static void render_mis(ajar_scene *s, ajar_integrator integ, ajar_mis mis, float *img)
+static void render_with(ajar_scene *s, ajar_integrator integ, ajar_mis mis, const PolicyOverrides *over, float *img)
 {
 	ajar_renderer *r;
 	ajar_options o;
@@ -468,10 +472,15 @@ static void render_mis(ajar_scene *s, ajar_integrator integ, ajar_mis mis, float
 	o.seed = 5;
 	o.integrator = integ;
 	o.mis = mis;
-	assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_OK);
+	assert_int_equal(renderer_create_overridden(s, &o, over, &r), AJAR_OK);
 	assert_int_equal(ajar_renderer_render(r, NULL, NULL), AJAR_OK);
 	assert_int_equal(ajar_renderer_image(r, img, NULL, NULL), AJAR_OK);
 	ajar_renderer_destroy(&r);
+}
+
+static void render_mis(ajar_scene *s, ajar_integrator integ, ajar_mis mis, float *img)
+{
+	render_with(s, integ, mis, NULL, img);
 }
 
 static void test_mis_auto(void **state)
@@ -515,15 +524,13 @@ static void test_mis_auto(void **state)
 }
 
 /* The planes' sky tables: 512 cells a side for pt under a sky of 2048
- * columns, 256 under a shipped 1k sky (src/prepare/prepare.c, sky_table_res), 128
- * for bdpt; each default compared bit for bit with AJAR_SKY_RES naming the
- * resolution, and pt's with 128. */
-static void render_sky_res(ajar_scene *s, ajar_integrator integ, const char *res, float *img)
+ * columns, 256 under a shipped 1k sky (src/prepare/policy.c, sky_res), 128
+ * for bdpt; each default compared bit for bit with the resolution forced,
+ * and pt's with 128. */
+static void render_sky_res(ajar_scene *s, ajar_integrator integ, int res, float *img)
 {
-	if (res)
-		setenv("AJAR_SKY_RES", res, 1);
-	render_mis(s, integ, AJAR_MIS_AUTO, img);
-	unsetenv("AJAR_SKY_RES");
+	const PolicyOverrides over = {.sky_res = res};
+	render_with(s, integ, AJAR_MIS_AUTO, &over, img);
 }
 
 static void test_sky_table_res(void **state)
@@ -533,20 +540,20 @@ static void test_sky_table_res(void **state)
 	assert_int_equal(ajar_scene_load(SCENE("window-room/window-room.gltf"), &s), AJAR_OK);
 	float *sky = test_sun_sky(2048, 1024, 0.1f, 0.74f, -0.67f, 0.01f, 4800.0f);
 	assert_int_equal(scene_set_env_image(s, 2048, 1024, sky, 1.0f), AJAR_OK);
-	render_sky_res(s, AJAR_INTEGRATOR_PT, NULL, a);
-	render_sky_res(s, AJAR_INTEGRATOR_PT, "512", b);
+	render_sky_res(s, AJAR_INTEGRATOR_PT, 0, a);
+	render_sky_res(s, AJAR_INTEGRATOR_PT, 512, b);
 	assert_memory_equal(a, b, sizeof a);
-	render_sky_res(s, AJAR_INTEGRATOR_PT, "128", b);
+	render_sky_res(s, AJAR_INTEGRATOR_PT, 128, b);
 	assert_memory_not_equal(a, b, sizeof a);
-	render_sky_res(s, AJAR_INTEGRATOR_BDPT, NULL, a);
-	render_sky_res(s, AJAR_INTEGRATOR_BDPT, "128", b);
+	render_sky_res(s, AJAR_INTEGRATOR_BDPT, 0, a);
+	render_sky_res(s, AJAR_INTEGRATOR_BDPT, 128, b);
 	assert_memory_equal(a, b, sizeof a);
 	ajar_scene_destroy(&s);
 	assert_int_equal(ajar_scene_load(SCENE("window-room-forest/window-room-forest.gltf"), &s), AJAR_OK);
-	render_sky_res(s, AJAR_INTEGRATOR_PT, NULL, a);
-	render_sky_res(s, AJAR_INTEGRATOR_PT, "256", b);
+	render_sky_res(s, AJAR_INTEGRATOR_PT, 0, a);
+	render_sky_res(s, AJAR_INTEGRATOR_PT, 256, b);
 	assert_memory_equal(a, b, sizeof a);
-	render_sky_res(s, AJAR_INTEGRATOR_PT, "128", b);
+	render_sky_res(s, AJAR_INTEGRATOR_PT, 128, b);
 	assert_memory_not_equal(a, b, sizeof a);
 	ajar_scene_destroy(&s);
 }

@@ -87,8 +87,11 @@ static void test_closed_mesh_has_no_cracks(void **state)
 	ajar_camera cam = {{0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 1.0f, 0};
 	assert_int_equal(ajar_scene_set_camera(s, &cam), AJAR_OK);
 	SceneData sd;
-	PrepareOptions po = {16, 16, 0, 8, 1, 0, 0, 0, 0, 0};
-	assert_int_equal(prepare_scene(s, &po, &sd), AJAR_OK);
+	ajar_options po;
+	ajar_options_default(&po);
+	po.max_depth = 8;
+	po.mis = AJAR_MIS_POWER;
+	assert_int_equal(prepare_scene(s, &po, 16, 16, NULL, &sd), AJAR_OK);
 
 	/* Per triangle edge, rays toward its two ends and three points along
 	 * it, each from its own origin near the centre. */

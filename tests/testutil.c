@@ -131,6 +131,18 @@ const char *test_ajar_bin(void)
 	return b && b[0] ? b : "build/ajar";
 }
 
+const char *test_ajar_faults_bin(void)
+{
+	static char path[4096];
+	ssize_t n = readlink("/proc/self/exe", path, sizeof path - 32);
+	if (n <= 0)
+		return "build/release/tests/ajar_faults";
+	path[n] = '\0';
+	char *slash = strrchr(path, '/');
+	strcpy(slash ? slash + 1 : path, "ajar_faults");
+	return path;
+}
+
 float *test_sun_sky(uint32_t w, uint32_t h, float sun_x, float sun_y, float sun_z, float radius, float sun_l)
 {
 	float *rgb = malloc(sizeof(float) * 3 * w * h);

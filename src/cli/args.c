@@ -2,7 +2,7 @@
  * takes its value as the next argument or after '=' (`--spp 16`,
  * `--spp=16`), numbers are checked whole (no sign, no trailing text, in
  * range) and every error names the option it is about. */
-#include "args.h"
+#include "cli/args.h"
 
 #include <ctype.h>
 #include <errno.h>

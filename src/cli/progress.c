@@ -1,7 +1,7 @@
 /* progress.c — see progress.h. The terminal bar is redrawn after every pass
  * (passes are short); plain lines are rate-limited so that a log of a long
  * render stays readable. */
-#include "progress.h"
+#include "cli/progress.h"
 
 #include <string.h>
 #include <unistd.h>

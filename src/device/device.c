@@ -17,6 +17,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "core/env_vars.h"
 #include "core/error.h"
 #include "device/kernel_source.h"
 #include "light/portal_sky.h"
@@ -268,9 +269,9 @@ void device_close(Device *d)
 
 const char *device_cache_dir(char *buf, size_t cap)
 {
-	const char *env = getenv("AJAR_CACHE_DIR");
-	const char *xdg = getenv("XDG_CACHE_HOME");
-	const char *home = getenv("HOME");
+	const char *env = env_var(ENV_VAR_CACHE_DIR);
+	const char *xdg = env_var(ENV_VAR_XDG_CACHE_HOME);
+	const char *home = env_var(ENV_VAR_HOME);
 	if (env && !strcmp(env, "off"))
 		return NULL;
 	if (env && env[0])
@@ -436,9 +437,9 @@ void device_build_options(const Device *d, int integrator, const char *extra, ch
 }
 
 /* A positive integer from the environment: *out, 1 if set, -1 if malformed. */
-static int env_count(const char *name, unsigned long long *out)
+static int env_count(EnvVar name, unsigned long long *out)
 {
-	const char *v = getenv(name);
+	const char *v = env_var(name);
 	char *end;
 	if (!v || !v[0])
 		return 0;
@@ -470,34 +471,34 @@ ajar_status device_plan(const Device *d, int integrator, size_t npix, DevicePlan
 	 * units each hold about two work-groups of the largest size (an H100
 	 * SM: 2048 threads); a CPU's, one pixel at a time each. */
 	size_t flight = d->is_cpu ? 256 * (size_t)cu : 2 * (size_t)cu * max_wg;
-	const char *mode = getenv("AJAR_SUBPATHS");
-	int bidirectional = integrator != 0; /* INTEGRATOR_PT */
+	const char *mode = env_var(ENV_VAR_SUBPATHS);
+	int bidirectional = integrator != INTEGRATOR_PT;
 	if (mode && mode[0] && strcmp(mode, "private") && strcmp(mode, "global"))
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "AJAR_SUBPATHS='%s': expected private or global", mode);
 	p->soa = bidirectional && (mode && mode[0] ? !strcmp(mode, "global") : !d->is_cpu);
 	p->lanes = 1;
 	if (!d->is_cpu && npix > 0 && npix < flight)
 		p->lanes = (unsigned)((flight + npix - 1) / npix);
-	if ((got = env_count("AJAR_PASS_LANES", &v)) < 0 || (got && v > 1024))
+	if ((got = env_count(ENV_VAR_PASS_LANES, &v)) < 0 || (got && v > 1024))
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "AJAR_PASS_LANES='%s': expected 1 to 1024",
-			       getenv("AJAR_PASS_LANES"));
+			       env_var(ENV_VAR_PASS_LANES));
 	if (got)
 		p->lanes = (unsigned)v;
 	else if (p->lanes > 64)
 		p->lanes = 64;
 	while (p->lanes > 1 && (unsigned long long)npix * p->lanes >= 1ull << 31)
 		p->lanes--;
-	const char *feat = getenv("AJAR_KERNEL_FEATURES");
+	const char *feat = env_var(ENV_VAR_KERNEL_FEATURES);
 	if (feat && feat[0] && strcmp(feat, "all") && strcmp(feat, "scene"))
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "AJAR_KERNEL_FEATURES='%s': expected all or scene", feat);
 	p->general = feat && !strcmp(feat, "all");
-	if ((got = env_count("AJAR_SUBPATH_CAPACITY", &v)) < 0 || (got && v > (1ull << 31)))
+	if ((got = env_count(ENV_VAR_SUBPATH_CAPACITY, &v)) < 0 || (got && v > (1ull << 31)))
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "AJAR_SUBPATH_CAPACITY='%s': expected a work-item count",
-			       getenv("AJAR_SUBPATH_CAPACITY"));
+			       env_var(ENV_VAR_SUBPATH_CAPACITY));
 	if (!p->soa)
 		return AJAR_OK;
 	/* The slots of kernels/ajar.cl: light, eye and its next-event vertex, the two halves (portal). */
-	size_t item = (size_t)(integrator == 2 ? 4 * DEVICE_SUBPATH_MAX + 1 : 2 * DEVICE_SUBPATH_MAX + 1) *
+	size_t item = (size_t)(integrator == INTEGRATOR_PORTAL ? 4 * DEVICE_SUBPATH_MAX + 1 : 2 * DEVICE_SUBPATH_MAX + 1) *
 		      DEVICE_VERTEX_WORDS * 4;
 	cl_ulong budget = mem / 2 < max_alloc || !max_alloc ? mem / 2 : max_alloc;
 	size_t cap = (flight + 63) / 64 * 64;

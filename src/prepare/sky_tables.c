@@ -134,14 +134,11 @@ static int plane_table(const SceneView *sc, const PortalPlane *P, int N, float *
 	return 1;
 }
 
-ajar_status portal_sky_build(const SceneView *sc, const PortalTri *portals, uint32_t n, int res, PortalPlane **planes,
-			     size_t *nplanes, float **sky, size_t *nsky)
+ajar_status portal_sky_planes(const PortalTri *portals, uint32_t n, PortalPlane **planes, size_t *nplanes)
 {
-	const size_t floats = PORTAL_SKY_FLOATS_OF((size_t)res);
 	*planes = NULL;
-	*sky = NULL;
-	*nplanes = *nsky = 0;
-	if (n == 0 || sc->params->env_type != ENV_IMAGE)
+	*nplanes = 0;
+	if (n == 0)
 		return AJAR_OK;
 	uint32_t *root = malloc(sizeof *root * n);
 	if (!root)
@@ -170,12 +167,9 @@ ajar_status portal_sky_build(const SceneView *sc, const PortalTri *portals, uint
 		return AJAR_OK;
 	}
 	PortalPlane *pl = malloc(sizeof *pl * groups);
-	float *tab = malloc(sizeof *tab * groups * floats);
-	if (!pl || !tab) {
+	if (!pl) {
 		free(root);
-		free(pl);
-		free(tab);
-		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "portals: out of memory for %u sky tables", groups);
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "portals: out of memory for %u planes", groups);
 	}
 	/* Whether the planes' tables also guide the <- halves of intermediate
 	 * subpaths (kernels/light/env_portal.h, portal_guide_plane): measured worse
@@ -188,20 +182,38 @@ ajar_status portal_sky_build(const SceneView *sc, const PortalTri *portals, uint
 	for (uint32_t g = 0; g < n; g++) {
 		if (root[g] != g || portals[g].env_side == 0 || !plane_frame(portals, root, n, g, &pl[np]))
 			continue;
-		pl[np].table = (int)(np * floats);
 		pl[np].guide = guide;
-		if (!plane_table(sc, &pl[np], res, tab + np * floats)) {
-			free(root);
-			free(pl);
-			free(tab);
-			return err_set(AJAR_ERROR_OUT_OF_MEMORY, "portals: out of memory for a sky table");
-		}
 		np++;
 	}
 	free(root);
+	if (np == 0) {
+		free(pl);
+		pl = NULL;
+	}
 	*planes = pl;
-	*sky = tab;
 	*nplanes = np;
-	*nsky = np * floats;
+	return AJAR_OK;
+}
+
+ajar_status portal_sky_tables(const SceneView *sc, PortalPlane *planes, size_t nplanes, int res, float **sky,
+			      size_t *nsky)
+{
+	const size_t floats = PORTAL_SKY_FLOATS_OF((size_t)res);
+	*sky = NULL;
+	*nsky = 0;
+	if (nplanes == 0)
+		return AJAR_OK;
+	float *tab = malloc(sizeof *tab * nplanes * floats);
+	if (!tab)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "portals: out of memory for %zu sky tables", nplanes);
+	for (size_t k = 0; k < nplanes; k++) {
+		planes[k].table = (int)(k * floats);
+		if (!plane_table(sc, &planes[k], res, tab + k * floats)) {
+			free(tab);
+			return err_set(AJAR_ERROR_OUT_OF_MEMORY, "portals: out of memory for a sky table");
+		}
+	}
+	*sky = tab;
+	*nsky = nplanes * floats;
 	return AJAR_OK;
 }

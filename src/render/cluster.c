@@ -7,6 +7,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "core/env_vars.h"
 #include "core/error.h"
 
 #ifdef AJAR_MPI
@@ -22,7 +23,7 @@ static pthread_mutex_t g_lock = PTHREAD_MUTEX_INITIALIZER;
  * never initialises MPI, so it behaves exactly as a build without it. */
 static int launched(void)
 {
-	return getenv("OMPI_COMM_WORLD_SIZE") || getenv("PMIX_RANK") || getenv("PMI_RANK");
+	return env_var(ENV_VAR_MPI_WORLD_SIZE) || env_var(ENV_VAR_PMIX_RANK) || env_var(ENV_VAR_PMI_RANK);
 }
 
 int ajar_mpi_available(void) { return 1; }
@@ -224,6 +225,12 @@ ajar_status ajar_mpi_init(int *argc, char ***argv)
 {
 	(void)argc;
 	(void)argv;
+	const char *ranks = env_var(ENV_VAR_MPI_WORLD_SIZE);
+	if (ranks && atoi(ranks) > 1)
+		log_msg(AJAR_LOG_WARNING,
+			"this ajar was built without Open MPI: each of the %d processes mpirun started renders the "
+			"whole image alone",
+			atoi(ranks));
 	return AJAR_OK;
 }
 void ajar_mpi_finalize(void) {}

@@ -36,6 +36,7 @@
 #include "render/checkpoint_file.h"
 #include "render/cluster.h"
 #include "device/device.h"
+#include "core/env_vars.h"
 #include "core/error.h"
 #include "image/exr.h"
 #include "device/kernel_source.h"
@@ -43,6 +44,8 @@
 #include "scene/scene.h"
 #include "render/render_info.h"
 #include "render/render_internal.h"
+#include "render/render_options.h"
+#include "render/render_overrides.h"
 #include "device/upload.h"
 #include "film/aov_layout.h"
 #include "base/compat.h"
@@ -51,12 +54,8 @@
 
 #define DEFAULT_WIDTH 512
 
-/* Test hook: AJAR_TEST_FAIL_DEVICE=<index>:<pass>[:lost] makes pass number
- * <pass> (from 1) of the renderer's device <index> (from 0, in selection
- * order) fail: by default as if the kernel launch returned an error (the
- * film stays readable); with ":lost" after the kernel ran, as if the device
- * was lost mid-pass (the film is untrusted). Read once per renderer. */
-enum { FAIL_NONE, FAIL_LAUNCH, FAIL_LOST };
+/* Faults tests inject (render_overrides.h); none in the product. */
+RenderFaults render_faults;
 
 double render_seconds(void)
 {
@@ -82,53 +81,6 @@ int range_list_push(RangeList *l, Range g)
 	}
 	l->r[l->n++] = g;
 	return 1;
-}
-
-void ajar_options_default(ajar_options *o)
-{
-	memset(o, 0, sizeof *o);
-	o->spp = 64;
-	o->integrator = AJAR_INTEGRATOR_PT;
-	o->max_depth = 0; /* the integrator's default */
-	o->seed = 1;
-	o->mis = AJAR_MIS_AUTO;
-}
-
-/* Validates o into *out, with defaults resolved: max_depth 0 means 64 for
- * pt and AJAR_BIDIR_MAX_DEPTH for the bidirectional integrators. */
-static ajar_status check_options(const ajar_options *in, ajar_options *out)
-{
-	*out = *in;
-	ajar_options *o = out;
-	if (o->max_depth == 0)
-		o->max_depth = o->integrator == AJAR_INTEGRATOR_PT ? 64 : AJAR_BIDIR_MAX_DEPTH;
-	if (o->width > 16384 || o->height > 16384 || (o->width == 0) != (o->height == 0))
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "image size %ux%u: both must be in 1..16384",
-			       o->width, o->height);
-	if (o->integrator != AJAR_INTEGRATOR_PT && o->integrator != AJAR_INTEGRATOR_BDPT &&
-	    o->integrator != AJAR_INTEGRATOR_PORTAL)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "unknown integrator %d", (int)o->integrator);
-	if (o->max_depth < 1 || o->max_depth > 1024)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "max depth %u: must be in 1..1024", o->max_depth);
-	/* Bidirectional subpaths live in fixed-size private arrays (kernels/integrator/vertex.h). */
-	if (o->integrator != AJAR_INTEGRATOR_PT && o->max_depth > AJAR_BIDIR_MAX_DEPTH)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "max depth %u: bdpt and portal allow at most %d",
-			       o->max_depth, AJAR_BIDIR_MAX_DEPTH);
-	if (o->mis != AJAR_MIS_POWER && o->mis != AJAR_MIS_BALANCE && o->mis != AJAR_MIS_AUTO)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "unknown MIS heuristic %d", (int)o->mis);
-	if (o->min_depth > o->max_depth)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "min depth %u exceeds max depth %u", o->min_depth,
-			       o->max_depth);
-	if (o->strategy_len && (o->integrator == AJAR_INTEGRATOR_PT || o->strategy_len > 8))
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT,
-			       "strategy images need a bidirectional integrator and a length of 1..8");
-	if (o->spp == 0 && !(o->time_limit > 0))
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "set a sample count or a time limit");
-	if (o->time_limit < 0 || o->time_limit != o->time_limit)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "time limit must be positive");
-	if (o->aov & ~AJAR_AOV_ALL)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "aov: unknown bits 0x%x", o->aov & ~AJAR_AOV_ALL);
-	return AJAR_OK;
 }
 
 static void image_size(const Scene *s, const ajar_options *o, uint32_t *w, uint32_t *h)
@@ -173,7 +125,7 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 	size_t bytes = film_bytes(r), sbytes = splat_bytes(r);
 	/* One program per integrator (see PARAMS_INTEGRATOR), built with
 	 * device_build_options and what AJAR_CL_OPTIONS adds (kernels/gpu.md, "On GPUs"). */
-	const char *extra = getenv("AJAR_CL_OPTIONS");
+	const char *extra = env_var(ENV_VAR_CL_OPTIONS);
 	char options[768]; /* KERNEL_OPTIONS, the plan's, the -DAJAR_NO_* and 400 of AJAR_CL_OPTIONS */
 	if (extra && strlen(extra) > 400)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "AJAR_CL_OPTIONS is %zu characters long; at most 400",
@@ -258,17 +210,6 @@ static void device_teardown(RenderDevice *rd)
 	memset(rd, 0, sizeof *rd);
 }
 
-static void parse_fail_hook(RenderDevice *rd, uint32_t index)
-{
-	const char *env = getenv("AJAR_TEST_FAIL_DEVICE");
-	unsigned i, pass;
-	char mode[8] = "";
-	if (!env || sscanf(env, "%u:%u:%7s", &i, &pass, mode) < 2 || i != index)
-		return;
-	rd->fail_pass = (int)pass;
-	rd->fail_mode = strcmp(mode, "lost") ? FAIL_LAUNCH : FAIL_LOST;
-}
-
 /* Opens every selected device. With several, one that cannot be set up is
  * dropped with a warning; with none left, the last error stands. */
 static ajar_status open_devices(ajar_renderer *r, const char *selector)
@@ -293,7 +234,6 @@ static ajar_status open_devices(ajar_renderer *r, const char *selector)
 		}
 		rd->r = r;
 		rd->alive = 1;
-		parse_fail_hook(rd, r->ndev);
 		size_t len = strlen(r->device_names);
 		if (n == 1)
 			snprintf(r->device_names, sizeof r->device_names, "%s", rd->dev.name);
@@ -310,8 +250,8 @@ static ajar_status open_devices(ajar_renderer *r, const char *selector)
 /* ajar_renderer_create, and ajar_renderer_resume with the checkpoint c read
  * from `path`: refused after the scene is prepared (its hash), before any
  * kernel is built; applied once the films exist. */
-ajar_status renderer_new(const ajar_scene *scene, const ajar_options *opt, Checkpoint *ck,
-			 const char *ck_path, ajar_renderer **out)
+ajar_status renderer_new(const ajar_scene *scene, const ajar_options *opt, const PolicyOverrides *over,
+			 Checkpoint *ck, const char *ck_path, ajar_renderer **out)
 {
 	ajar_status st;
 	ajar_options defaults, resolved;
@@ -324,7 +264,7 @@ ajar_status renderer_new(const ajar_scene *scene, const ajar_options *opt, Check
 		ajar_options_default(&defaults);
 		opt = &defaults;
 	}
-	if ((st = check_options(opt, &resolved)) != AJAR_OK)
+	if ((st = options_resolve(opt, &resolved)) != AJAR_OK)
 		return st;
 	opt = &resolved;
 	ajar_renderer *r = calloc(1, sizeof *r);
@@ -345,16 +285,10 @@ ajar_status renderer_new(const ajar_scene *scene, const ajar_options *opt, Check
 	r->strategy_len = (int)opt->strategy_len;
 	r->opt = *opt;
 	r->opt.device = NULL;
-	/* Test hook: AJAR_TEST_PASS_SPP=N caps every pass at N samples per
-	 * pixel, so tests can stop a render at many points. */
-	const char *cap = getenv("AJAR_TEST_PASS_SPP");
-	r->pass_cap = cap ? (uint32_t)strtoul(cap, NULL, 10) : 0;
 	r->opt.width = r->width;
 	r->opt.height = r->height;
 	snprintf(r->scene_name, sizeof r->scene_name, "%s", scene->source ? scene->source : "");
-	PrepareOptions po = {r->width, r->height, (int)opt->integrator, opt->max_depth, opt->seed,
-			     (int)opt->mis, opt->min_depth, opt->strategy_len, opt->strategy_unweighted, 0};
-	if ((st = prepare_scene(scene, &po, &r->data)) != AJAR_OK)
+	if ((st = prepare_scene(scene, opt, r->width, r->height, over, &r->data)) != AJAR_OK)
 		goto fail;
 	if (ck && (st = render_checkpoint_check(r, ck, ck_path)) != AJAR_OK)
 		goto fail;
@@ -381,7 +315,13 @@ joined:
 
 ajar_status ajar_renderer_create(const ajar_scene *scene, const ajar_options *opt, ajar_renderer **out)
 {
-	return renderer_new(scene, opt, NULL, NULL, out);
+	return renderer_new(scene, opt, NULL, NULL, NULL, out);
+}
+
+ajar_status renderer_create_overridden(const ajar_scene *scene, const ajar_options *opt,
+				       const PolicyOverrides *over, ajar_renderer **out)
+{
+	return renderer_new(scene, opt, over, NULL, NULL, out);
 }
 
 void ajar_renderer_destroy(ajar_renderer **rp)
@@ -500,7 +440,8 @@ int render_run_pass(RenderDevice *rd, Range g, int *film_ok)
 	Device *d = &rd->dev;
 	cl_uint first = g.first, n = g.count;
 	cl_int err;
-	int inject = rd->fail_pass > 0 && ++rd->attempts == (uint32_t)rd->fail_pass;
+	uint32_t index = (uint32_t)(rd - r->devs);
+	int inject = ++rd->passes == render_faults.pass && index == render_faults.device;
 	*film_ok = 1;
 	if ((err = clSetKernelArg(rd->k_render, rd->arg_first + 2, sizeof first, &first)) != CL_SUCCESS ||
 	    (err = clSetKernelArg(rd->k_render, rd->arg_first + 3, sizeof n, &n)) != CL_SUCCESS)
@@ -510,8 +451,8 @@ int render_run_pass(RenderDevice *rd, Range g, int *film_ok)
 	 * scratch, launches of at most its capacity (device_plan). */
 	cl_uint lanes = rd->plan.lanes < n ? rd->plan.lanes : n;
 	size_t units = npix * lanes, step = rd->plan.soa ? rd->plan.capacity : units;
-	if (inject && rd->fail_mode == FAIL_LAUNCH)
-		return pass_failed(rd, "clEnqueueNDRangeKernel (test hook AJAR_TEST_FAIL_DEVICE)", CL_OUT_OF_RESOURCES);
+	if (inject && !render_faults.lost)
+		return pass_failed(rd, "clEnqueueNDRangeKernel (an injected fault)", CL_OUT_OF_RESOURCES);
 	if ((err = clSetKernelArg(rd->k_render, rd->arg_first + 6, sizeof lanes, &lanes)) != CL_SUCCESS)
 		return pass_failed(rd, "clSetKernelArg", err);
 	for (size_t u0 = 0; u0 < units; u0 += step) {
@@ -529,7 +470,7 @@ int render_run_pass(RenderDevice *rd, Range g, int *film_ok)
 		err = CL_DEVICE_NOT_AVAILABLE;
 	if (err != CL_SUCCESS) {
 		*film_ok = 0;
-		return pass_failed(rd, inject ? "clFinish (test hook AJAR_TEST_FAIL_DEVICE)" : "clFinish", err);
+		return pass_failed(rd, inject ? "clFinish (an injected fault)" : "clFinish", err);
 	}
 	return 1;
 }

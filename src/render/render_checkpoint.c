@@ -213,8 +213,8 @@ ajar_status render_checkpoint_check(ajar_renderer *r, const Checkpoint *c, const
 			       path, c->scene[0] ? c->scene : "?");
 	if (c->params_hash != r->params_hash)
 		return err_set(AJAR_ERROR_BAD_INPUT,
-			       "%s: checkpoint was made with other render parameters (the options agree, so an "
-			       "environment variable such as AJAR_PORTAL_RATE differs); it cannot be resumed here",
+			       "%s: checkpoint was made with other render parameters (the options agree, so the "
+			       "program that made it chose other strategies); it cannot be resumed here",
 			       path);
 	return AJAR_OK;
 }
@@ -274,7 +274,7 @@ ajar_status ajar_renderer_resume(const ajar_scene *scene, const char *path, cons
 		checkpoint_free(&c);
 		return st;
 	}
-	st = renderer_new(scene, &want, &c, path, out);
+	st = renderer_new(scene, &want, NULL, &c, path, out);
 	checkpoint_free(&c);
 	return st;
 }

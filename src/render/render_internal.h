@@ -39,8 +39,7 @@ typedef struct RenderDevice {
 	cl_mem scratch;      /* the subpaths when plan.soa, else a one-word stand-in */
 	pthread_t thread;
 	int started;              /* thread is running this render */
-	int fail_pass, fail_mode; /* the test hook */
-	uint32_t attempts;        /* passes started, for the test hook */
+	uint32_t passes;          /* passes started */
 	int rank;                 /* on rank 0: the rank this device renders on (0: here) */
 	uint32_t remote;          /* its index there; see render_job.c */
 	uint32_t job_ranges;      /* on rank 0, for a device of another rank: passes after its first, */
@@ -88,7 +87,6 @@ struct ajar_renderer {
 	int pausing;          /* under the lock: no device takes a new range */
 	int hashed;
 	uint64_t scene_hash, params_hash;
-	uint32_t pass_cap; /* test hook AJAR_TEST_PASS_SPP: at most this many samples per pass */
 	/* Several machines (Open MPI, render_job.c): */
 	long *remote, *remote_splat; /* rank 0: the other ranks' films, summed at the last gather */
 	int job_lost;                /* rank 0: a rank that stopped answering, or 0 */
@@ -100,8 +98,8 @@ double render_seconds(void); /* monotonic clock */
 int range_list_push(RangeList *l, Range g);
 size_t render_aov_offset(const ajar_renderer *r);
 size_t render_splat_count(const ajar_renderer *r);
-ajar_status renderer_new(const ajar_scene *scene, const ajar_options *opt, Checkpoint *ck, const char *ck_path,
-			 ajar_renderer **out);
+ajar_status renderer_new(const ajar_scene *scene, const ajar_options *opt, const PolicyOverrides *over,
+			 Checkpoint *ck, const char *ck_path, ajar_renderer **out);
 int render_run_pass(RenderDevice *rd, Range g, int *film_ok);
 int render_read_films(RenderDevice *rd, long **accum, long **splat);
 int render_salvage_add(ajar_renderer *r, const long *accum, const long *splat);

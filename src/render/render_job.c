@@ -167,7 +167,7 @@ ajar_status job_resume(const ajar_scene *scene, const char *path, const ajar_opt
 			checkpoint_free(&c);
 		return cluster_rank() == 0 ? st : err_set((ajar_status)msg.status, "rank 0: %s", msg.error);
 	}
-	st = renderer_new(scene, &msg.want, have ? &c : NULL, have ? path : NULL, out);
+	st = renderer_new(scene, &msg.want, NULL, have ? &c : NULL, have ? path : NULL, out);
 	if (have)
 		checkpoint_free(&c);
 	return st;

@@ -8,6 +8,7 @@
 #include <stdatomic.h>
 
 #include "render/render_internal.h"
+#include "render/render_overrides.h"
 
 #define PASS_SECONDS 0.25
 
@@ -52,8 +53,8 @@ int scheduler_take_range(ajar_renderer *r, RenderDevice *rd, Range *g)
 				count = (uint32_t)share;
 		}
 	}
-	if (r->pass_cap && count > r->pass_cap)
-		count = r->pass_cap;
+	if (render_faults.pass_spp && count > render_faults.pass_spp)
+		count = render_faults.pass_spp;
 	if (r->holes.n) {
 		Range *h = &r->holes.r[r->holes.n - 1];
 		g->first = h->first;

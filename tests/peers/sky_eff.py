@@ -14,8 +14,9 @@ measure of tests/bench.c without a reference), relvar x spp (the variance
 per sample), the CPU seconds per sample (user + system of the render minus
 that of a 1-spp render: set-up left out) and their product, the
 inefficiency (lower is better; relMSE at equal CPU time is proportional to
-it). VAR=VALUE pairs go into the renderer's environment (AJAR_PORTAL_RATE,
-AJAR_PORTAL_SET, AJAR_CL_OPTIONS, ...).
+it). VAR=VALUE pairs go into the renderer's environment (the device knobs of
+src/device/README.md, e.g. AJAR_CL_OPTIONS). To measure another strategy
+choice, change it in src/prepare/policy.c, rebuild, and run this again.
 """
 import os
 import resource
