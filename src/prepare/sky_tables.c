@@ -177,19 +177,11 @@ ajar_status portal_sky_build(const SceneView *sc, const PortalTri *portals, uint
 		free(tab);
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "portals: out of memory for %u sky tables", groups);
 	}
-	/* Whether the planes' tables also guide the <- halves of intermediate
-	 * subpaths (kernels/light/env_portal.h, portal_guide_plane): measured worse
-	 * per sample than the environment's importance folded onto the sky
-	 * side on all three sky scenes (kernels/sky_measurements.md,
-	 * "Measurements"), so only on request, for experiments. */
-	const char *g_env = getenv("AJAR_PORTAL_GUIDE_SKY");
-	int guide = g_env && strcmp(g_env, "1") == 0;
 	size_t np = 0;
 	for (uint32_t g = 0; g < n; g++) {
 		if (root[g] != g || portals[g].env_side == 0 || !plane_frame(portals, root, n, g, &pl[np]))
 			continue;
 		pl[np].table = (int)(np * floats);
-		pl[np].guide = guide;
 		if (!plane_table(sc, &pl[np], res, tab + np * floats)) {
 			free(root);
 			free(pl);
