@@ -213,59 +213,11 @@ static int emitter_at(const SceneView *sc, V3 p)
 	return -1;
 }
 
-/* Under a sky image: the solid-angle density of unit direction to (toward
- * the sky) by the whole table of the planar portal that portal triangle
- * pt lies in (kernels/light/env_portal.h, sky_behind_pdf_w), in double from the
- * summed-area table: the cell's share of the table over the cell's solid
- * angle in (u, v). *found = 0 if pt lies in no plane or its plane does
- * not guide (PortalPlane.guide). */
-static double sky_behind_pdf(const SceneView *sc, GLOBAL const PortalTri *pt, const double *to, int *found)
-{
-	*found = 0;
-	if (pt->env_side == 0)
-		return 0;
-	double n[3] = {pt->n.x * pt->env_side, pt->n.y * pt->env_side, pt->n.z * pt->env_side};
-	double c[3] = {(pt->p0.x + pt->p1.x + pt->p2.x) / 3, (pt->p0.y + pt->p1.y + pt->p2.y) / 3,
-		       (pt->p0.z + pt->p1.z + pt->p2.z) / 3};
-	for (int k = 0; k < sc->params->num_portal_planes; k++) {
-		GLOBAL const PortalPlane *P = &sc->portal_planes[k];
-		double d[3] = {c[0] - P->o.x, c[1] - P->o.y, c[2] - P->o.z};
-		double a = d[0] * P->t.x + d[1] * P->t.y + d[2] * P->t.z, b = d[0] * P->b.x + d[1] * P->b.y + d[2] * P->b.z;
-		double h = d[0] * P->n.x + d[1] * P->n.y + d[2] * P->n.z;
-		double ext = fmax(P->a1 - P->a0, P->b1 - P->b0);
-		if (n[0] * P->n.x + n[1] * P->n.y + n[2] * P->n.z <= 1 - 1e-4 || fabs(h) > 1e-3 * ext || a < P->a0 ||
-		    a > P->a1 || b < P->b0 || b > P->b1)
-			continue;
-		if (!P->guide)
-			return 0;
-		*found = 1;
-		double wt = to[0] * P->t.x + to[1] * P->t.y + to[2] * P->t.z;
-		double wb = to[0] * P->b.x + to[1] * P->b.y + to[2] * P->b.z;
-		double wn = to[0] * P->n.x + to[1] * P->n.y + to[2] * P->n.z;
-		if (!(wn > 0))
-			return 0;
-		enum { N = PORTAL_SKY_RES };
-		double cellw = M_PI / N;
-		int i = (int)((atan2(wt, wn) + M_PI / 2) / cellw), j = (int)((atan2(wb, wn) + M_PI / 2) / cellw);
-		i = i < 0 ? 0 : (i > N - 1 ? N - 1 : i);
-		j = j < 0 ? 0 : (j > N - 1 ? N - 1 : j);
-		GLOBAL const float *S = sc->portal_sky + P->table;
-#define SAT(ii, jj) ((double)S[2 * ((jj) * (N + 1) + (ii))] + (double)S[2 * ((jj) * (N + 1) + (ii)) + 1])
-		double cell = SAT(i + 1, j + 1) - SAT(i, j + 1) - SAT(i + 1, j) + SAT(i, j), total = SAT(N, N);
-#undef SAT
-		double X = wt / wn, Y = wb / wn, q = 1 + X * X + Y * Y;
-		double jac = (1 + X * X) * (1 + Y * Y) / (q * sqrt(q)) * cellw * cellw;
-		return cell / total / jac;
-	}
-	return 0;
-}
-
 /* Density per projected solid angle of the portal direction toward a
  * (x_m) from point w of portal triangle pt (design of kernels/integrator/portal.h):
  * half a side (+n with probability side_plus) and a cosine direction on
  * it; half a light sample from w that reached a, environment directions
- * by the sky behind pt's planar portal under a sky image, else folded
- * onto the portal's sky side. */
+ * folded onto the portal's sky side. */
 static double direction_psa(const SceneView *sc, GLOBAL const PortalTri *pt, const PathVertex *a, const double *w)
 {
 	double to[3], guided = 0, n[3] = {pt->n.x, pt->n.y, pt->n.z};
@@ -279,11 +231,8 @@ static double direction_psa(const SceneView *sc, GLOBAL const PortalTri *pt, con
 		to[0] = a->p.x, to[1] = a->p.y, to[2] = a->p.z;
 	} else if (a->type == VERTEX_ENV) {
 		to[0] = a->p.x, to[1] = a->p.y, to[2] = a->p.z;
-		int table;
-		double pe = sky_behind_pdf(sc, pt, to, &table);
-		if (!table)
-			pe = env_pdf_w(sc, a->p);
-		if (!table && pt->env_side != 0) {
+		double pe = env_pdf_w(sc, a->p);
+		if (pt->env_side != 0) {
 			double dn = to[0] * n[0] + to[1] * n[1] + to[2] * n[2];
 			V3 mirror = v3((float)(to[0] - 2 * dn * n[0]), (float)(to[1] - 2 * dn * n[1]), (float)(to[2] - 2 * dn * n[2]));
 			pe = dn * pt->env_side > 0 ? pe + env_pdf_w(sc, mirror) : 0;

@@ -48,5 +48,5 @@
 	X(Params, num_portal_planes) X(Params, env_rot_cos) X(Params, env_rot_sin)     \
 	X(Params, bdpt_conn) X(Params, env_lines)                                      \
 	X(PortalPlane, o) X(PortalPlane, a0) X(PortalPlane, t) X(PortalPlane, n)      \
-	X(PortalPlane, b1) X(PortalPlane, table) X(PortalPlane, guide)
+	X(PortalPlane, b1) X(PortalPlane, table)
 #endif

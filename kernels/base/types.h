@@ -138,8 +138,7 @@ typedef struct {
 	V3 n;
 	float b1;
 	int table;
-	int guide; /* whether its table guides intermediate subpaths (env_portal.h, portal_guide_plane) */
-	int pad1, pad2;
+	int pad0, pad1, pad2;
 } PortalPlane; /* 80 */
 
 /* KHR_lights_punctual light (src/prepare/light_tables.c converts glTF's photometric

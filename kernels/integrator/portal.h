@@ -37,9 +37,7 @@
 /* ---- The intermediate subpath -------------------------------------------- */
 
 /* A light sample from portal point w0 as the <- direction *wl: the
- * environment by the table of the sky behind pt's planar portal where the
- * host lets it (PortalPlane.guide, off by default), else by its
- * importance folded onto the portal's sky side; or an
+ * environment by its importance folded onto the portal's sky side, or an
  * emitter point at distance *dist facing w0 (union_mis.h,
  * portal_direction_psa). Returns 0 if there is none. */
 INLINE int portal_guided_sample(const SceneView *sc, GLOBAL const PortalTri *pt, V3 w0, float u_sel, float u1,
@@ -48,9 +46,6 @@ INLINE int portal_guided_sample(const SceneView *sc, GLOBAL const PortalTri *pt,
 	float ce, ps = guided_env_share(sc, &ce);
 	*is_env = u_sel < ps;
 	if (*is_env) {
-		int k = portal_guide_plane(sc, pt); /* the sky behind pt's plane (env_portal.h) */
-		if (k >= 0)
-			return sky_behind_sample(sc, k, u1, u2, wl);
 		float pdf_w;
 		env_sample(sc, u1, u2, wl, &pdf_w);
 		if (!(pdf_w > 0.0f))

@@ -97,10 +97,9 @@ INLINE float path_pr(const SceneView *sc, const PathRef *P, const MisVertex *mv,
  *     cosine direction on it (side / pi per projected solid angle);
  *   - the rest: a light sample from w, which only counts when the <- half
  *     reaches the sampled light point: x_m on an emitter's front face, or
- *     the environment: by the table of the sky behind the portal's plane
- *     where the host lets it (env_portal.h, portal_guide_plane), else by its
- *     importance folded onto the portal's sky side (a direction and its
- *     mirror image in the portal's plane both lead there). */
+ *     the environment by its importance folded onto the portal's sky side
+ *     (a direction and its mirror image in the portal's plane both lead
+ *     there). */
 #ifndef PORTAL_COSINE /* -D overrides it for experiments, as PORTAL_NEE_MIX */
 #define PORTAL_COSINE 0.5f
 #endif
@@ -114,10 +113,7 @@ INLINE float portal_direction_psa(const SceneView *sc, GLOBAL const PortalTri *p
 	float guided = 0.0f; /* never toward a punctual light (portal.h) */
 	if (vertex_infinite(xm)) {
 		to_m = xm->p;
-		int k = xm->type == VERTEX_ENV ? portal_guide_plane(sc, pt) : -1;
-		if (k >= 0) {
-			guided = ps * sky_behind_pdf_w(sc, k, to_m);
-		} else if (xm->type == VERTEX_ENV) {
+		if (xm->type == VERTEX_ENV) {
 			float pe = env_pdf_w(sc, to_m);
 			if (pt->env_side != 0)
 				pe = (float)pt->env_side * v3_dot(to_m, pt->n) > 0.0f

@@ -171,18 +171,10 @@ ajar_status portal_sky_planes(const PortalTri *portals, uint32_t n, PortalPlane 
 		free(root);
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "portals: out of memory for %u planes", groups);
 	}
-	/* Whether the planes' tables also guide the <- halves of intermediate
-	 * subpaths (kernels/light/env_portal.h, portal_guide_plane): measured worse
-	 * per sample than the environment's importance folded onto the sky
-	 * side on all three sky scenes (kernels/sky_measurements.md,
-	 * "Measurements"), so only on request, for experiments. */
-	const char *g_env = getenv("AJAR_PORTAL_GUIDE_SKY");
-	int guide = g_env && strcmp(g_env, "1") == 0;
 	size_t np = 0;
 	for (uint32_t g = 0; g < n; g++) {
 		if (root[g] != g || portals[g].env_side == 0 || !plane_frame(portals, root, n, g, &pl[np]))
 			continue;
-		pl[np].guide = guide;
 		np++;
 	}
 	free(root);
