@@ -542,6 +542,80 @@ static void test_read_dwa_corrupt(void **state)
 	free(dir);
 }
 
+/* Replaces the value of the header attribute `name` (of type `type`) in
+ * the file at `path` by the `n` bytes at `value`, its size unchanged. */
+static void patch_attr(const char *path, const char *name, const char *type, const void *value, size_t n)
+{
+	size_t len;
+	unsigned char *buf = slurp(path, &len);
+	char key[64];
+	size_t nk = (size_t)snprintf(key, sizeof key, "%s%c%s", name, '\0', type) + 1;
+	unsigned char *at = memmem(buf, len, key, nk);
+	assert_non_null(at);
+	at += nk;
+	uint32_t size = (uint32_t)at[0] | (uint32_t)at[1] << 8 | (uint32_t)at[2] << 16 | (uint32_t)at[3] << 24;
+	assert_int_equal(size, n);
+	memcpy(at + 4, value, n);
+	spill(path, buf, len);
+	free(buf);
+}
+
+/* Headers that declare more than the file could hold are refused as bad
+ * input, with what is wrong, before anything is allocated for them (not
+ * as "out of memory", which a failed allocation of 164 GB said before). */
+static void test_read_oversize(void **state)
+{
+	char *dir = test_tmpdir();
+	char *path = test_path(dir, "big.exr");
+	const float px[4] = {1, 2, 3, 4};
+	static const struct {
+		int32_t box[4]; /* min x, min y, max x, max y */
+		const char *what;
+	} cases[] = {
+		{{0, 0, 19935094, 514}, "too large"},    /* 19935095 x 515 */
+		{{0, 0, 65536, 0}, "too large"},         /* a side over 65536 */
+		{{0, 0, 40000, 40000}, "too large"},     /* 1.6e9 pixels */
+		{{0, 0, 0, 65535}, "offsets of its 4096"}, /* 4096 ZIP chunks in a few hundred bytes */
+		{{-5, 0, -5, 0}, NULL},                  /* 1 x 1 elsewhere: read */
+	};
+	for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+		assert_int_equal(ajar_write_exr(path, px, 1, 1, NULL, 0), AJAR_OK);
+		patch_attr(path, "dataWindow", "box2i", cases[k].box, sizeof cases[k].box);
+		if (cases[k].what) {
+			expect_refused(path, cases[k].what);
+			continue;
+		}
+		float *got;
+		uint32_t w, h;
+		assert_int_equal(ajar_read_exr(path, &got, &w, &h), AJAR_OK);
+		assert_int_equal(w, 1);
+		assert_int_equal(h, 1);
+		assert_memory_equal(got, px, sizeof px);
+		free(got);
+	}
+
+	/* Tiles larger than both the image and 1024 pixels a side. */
+	enum { W = 7, H = 5 };
+	float y[W * H];
+	for (int i = 0; i < W * H; i++)
+		y[i] = (float)i;
+	TestChannel chans[] = {{"Y", EXR_PIXEL_FLOAT, y}};
+	char *tiled = test_path(dir, "tiled.exr");
+	write_test_exr(tiled, chans, 1, W, H, 2, 3, EXR_COMPRESSION_ZIP);
+	const unsigned char wide[9] = {0, 0, 1, 0, 3, 0, 0, 0, 0};   /* 65536 x 3, one level */
+	patch_attr(tiled, "tiles", "tiledesc", wide, sizeof wide);
+	expect_refused(tiled, "tiles 65536 pixels wide");
+	write_test_exr(tiled, chans, 1, W, H, 2, 3, EXR_COMPRESSION_ZIP);
+	const unsigned char high[9] = {2, 0, 0, 0, 0, 0x10, 0, 0, 0}; /* 2 x 4096 */
+	patch_attr(tiled, "tiles", "tiledesc", high, sizeof high);
+	expect_refused(tiled, "tiles 4096 pixels high");
+
+	free(tiled);
+	free(path);
+	test_remove_tree(dir);
+	free(dir);
+}
+
 static void test_read_errors(void **state)
 {
 	char *dir = test_tmpdir();
@@ -762,6 +836,7 @@ int main(void)
 		cmocka_unit_test(test_read_dwa_fixtures),
 		cmocka_unit_test(test_read_four_half_one_skipped),
 		cmocka_unit_test(test_read_dwa_corrupt),
+		cmocka_unit_test(test_read_oversize),
 		cmocka_unit_test(test_read_errors),
 		cmocka_unit_test(test_write_errors),
 		cmocka_unit_test(test_png),

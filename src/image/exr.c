@@ -10,7 +10,8 @@
  * read side can then tell "cannot open" (an I/O error) from "not an EXR"
  * (bad input), and the write side creates the temporary file itself with
  * O_EXCL so two writers never share one. Core reads the header first
- * because it checks every size in it against the file's. */
+ * because it checks every size in it against the file's: the limits below
+ * are applied before the C++ library, which trusts them, allocates. */
 #include "image/exr.h"
 
 #include <errno.h>
@@ -319,6 +320,16 @@ static void exr_close(ExrReader *r)
 	close(r->stream.fd);
 }
 
+/* Limits on what a header may declare, checked before anything is
+ * allocated for it: a file of a few hundred bytes can declare any size, and
+ * its allocation failing would report "out of memory" for a bad file.
+ * 2^29 pixels is 8 GiB of float RGBA, a 32768 x 16384 sky. */
+#define EXR_MAX_SIDE 65536
+#define EXR_MAX_PIXELS ((int64_t)1 << 29)
+/* A tile may exceed the image (a 7 x 5 image in 64 x 64 tiles), not both
+ * this and the image's side: the C++ library allocates whole tiles. */
+#define EXR_MAX_TILE_SIDE 1024
+
 /* Which of the file's channels fill R, G, B, A: NULL leaves the slot to
  * ajar_read_exr (0 for a missing colour, 1 for a missing alpha, Y's grey). */
 typedef struct {
@@ -330,6 +341,8 @@ static ajar_status exr_map_channels(const char *path, const exr_attr_chlist_t *c
 {
 	static const char *const names[5] = {"R", "G", "B", "A", "Y"};
 	memset(m, 0, sizeof *m);
+	/* Each channel costs the C++ decoder a line buffer; 64 keeps those
+	 * within a small multiple of the image. */
 	if (cl->num_channels > 64)
 		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %d channels; at most 64 are supported", path,
 			       cl->num_channels);
@@ -359,6 +372,42 @@ static ajar_status exr_map_channels(const char *path, const exr_attr_chlist_t *c
 	return AJAR_OK;
 }
 
+/* The size checks: data window, tiles, and an offset table that the file
+ * is long enough to hold. */
+static ajar_status exr_check_size(const char *path, const ExrReader *r, exr_storage_t storage,
+				  const exr_attr_box2i_t *dw)
+{
+	int64_t w = (int64_t)dw->max.x - dw->min.x + 1, h = (int64_t)dw->max.y - dw->min.y + 1;
+	if (w <= 0 || h <= 0 || w > EXR_MAX_SIDE || h > EXR_MAX_SIDE || w * h > EXR_MAX_PIXELS)
+		return err_set(AJAR_ERROR_BAD_INPUT,
+			       "%s: data window [%d,%d]-[%d,%d] is empty or too large (at most %d pixels a side, "
+			       "%lld in all)",
+			       path, dw->min.x, dw->min.y, dw->max.x, dw->max.y, EXR_MAX_SIDE,
+			       (long long)EXR_MAX_PIXELS);
+	exr_result_t rv = EXR_ERR_SUCCESS;
+	if (storage == EXR_STORAGE_TILED) {
+		uint32_t tw, th;
+		rv = exr_get_tile_descriptor(r->ctxt, 0, &tw, &th, NULL, NULL);
+		if (rv == EXR_ERR_SUCCESS && ((int64_t)tw > w && tw > EXR_MAX_TILE_SIDE))
+			return err_set(AJAR_ERROR_BAD_INPUT, "%s: tiles %u pixels wide for an image %lld wide", path,
+				       tw, (long long)w);
+		if (rv == EXR_ERR_SUCCESS && ((int64_t)th > h && th > EXR_MAX_TILE_SIDE))
+			return err_set(AJAR_ERROR_BAD_INPUT, "%s: tiles %u pixels high for an image %lld high", path,
+				       th, (long long)h);
+	}
+	int32_t chunks = 0;
+	if (rv == EXR_ERR_SUCCESS)
+		rv = exr_get_chunk_count(r->ctxt, 0, &chunks);
+	if (rv != EXR_ERR_SUCCESS)
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: OpenEXR header: %s", path, exr_why(rv));
+	struct stat sb;
+	if (fstat(r->stream.fd, &sb) == 0 && (int64_t)chunks * 8 > (int64_t)sb.st_size)
+		return err_set(AJAR_ERROR_BAD_INPUT,
+			       "%s: truncated: %lld bytes cannot hold the offsets of its %d chunks", path,
+			       (long long)sb.st_size, chunks);
+	return AJAR_OK;
+}
+
 ajar_status ajar_read_exr(const char *path, float **rgba, uint32_t *width, uint32_t *height)
 {
 	if (!path || !rgba || !width || !height)
@@ -385,21 +434,14 @@ ajar_status ajar_read_exr(const char *path, float **rgba, uint32_t *width, uint3
 		st = err_set(AJAR_ERROR_BAD_INPUT, "%s: deep OpenEXR images are not supported", path);
 		goto done;
 	}
-	int64_t dw_w = (int64_t)dw.max.x - dw.min.x + 1, dw_h = (int64_t)dw.max.y - dw.min.y + 1;
-	if (dw_w <= 0 || dw_h <= 0 || dw_w > INT_MAX / 20 || dw_h > INT_MAX) {
-		st = err_set(AJAR_ERROR_BAD_INPUT, "%s: data window [%d,%d]-[%d,%d] is empty or too large", path,
-			     dw.min.x, dw.min.y, dw.max.x, dw.max.y);
+	st = exr_check_size(path, &r, storage, &dw);
+	if (st != AJAR_OK)
 		goto done;
-	}
 	ChannelMap map;
 	st = exr_map_channels(path, cl, &map);
 	if (st != AJAR_OK)
 		goto done;
 	uint32_t w = (uint32_t)((int64_t)dw.max.x - dw.min.x + 1), h = (uint32_t)((int64_t)dw.max.y - dw.min.y + 1);
-	if ((uint64_t)w * h > SIZE_MAX / (4 * sizeof(float))) {
-		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: %ux%u image too large", path, w, h);
-		goto done;
-	}
 	size_t n = (size_t)w * h;
 	float *px = calloc(n * 4, sizeof(float));
 	if (!px) {
