@@ -711,6 +711,10 @@ static void test_write_errors(void **state)
 
 	assert_int_equal(ajar_write_exr(out, px, 0, 2, NULL, 0), AJAR_ERROR_INVALID_ARGUMENT);
 	assert_int_equal(ajar_write_png(out, px, 2, 0), AJAR_ERROR_INVALID_ARGUMENT);
+	/* Beyond what stb_image_write's int sizes hold, refused before the
+	 * pixels are read. */
+	assert_int_equal(ajar_write_png(out, px, 20000, 20000), AJAR_ERROR_INVALID_ARGUMENT);
+	assert_non_null(strstr(ajar_last_error(), out));
 	assert_false(file_exists(out));
 
 	free(nodir);
