@@ -359,7 +359,8 @@ static void test_read_dwab(void **state)
 
 /* Small DWA files written by OpenEXR 3.1's C++ library (tests/data/dwa/
  * README.md says how), with the checksum of the float RGBA that library
- * decodes from each: our decoder must give the same bits. They cover
+ * decodes from each, as Ajar's own DWA decoder did before it was replaced
+ * by that library: ajar_read_exr must give the same bits. They cover
  * partial 8x8 blocks on both edges, an R, G, B triplet (Y'CbCr) of half,
  * of float and of mixed types, a lone lossy Y, lossless ("unknown") float
  * and uint channels, run-length alpha of half, float and uint, negative
@@ -385,8 +386,8 @@ static const DwaFixture dwa_fixtures[] = {
 	{"tests/data/dwa/dwab_y.exr", 21, 13, 0x1d52ace80144cfcaull, {0.75f, 0.75f, 0.75f, 100.0f},
 	 {-0.986328125f, -0.986328125f, -0.986328125f, 50.0f}},
 	/* Not DWA: four half channels, ZIP. OpenEXR Core 3.1 decodes these
-	 * with R and A, G and B swapped unless exr.c steers it off its
-	 * special-case routine. */
+	 * with R and A, G and B swapped (its special-case routine): a check
+	 * that pixels never go through it. */
 	{"tests/data/dwa/zip_rgba.exr", 37, 45, 0xe42ed678a5829efbull, {0.75f, 0.875f, 1.0f, 1.0f},
 	 {-0.876953125f, -1.0390625f, -0.987792969f, 1.0f}},
 };
@@ -413,7 +414,7 @@ static void test_read_dwa_fixtures(void **state)
 
 /* Four half channels of which one is skipped (R renamed Z, so the list
  * stays sorted): OpenEXR Core 3.1's special-case routine would write
- * through the skipped channel's NULL pointer. G, B, A are as before. */
+ * through the skipped channel's NULL pointer. G, B, A are as before, R 0. */
 static void test_read_four_half_one_skipped(void **state)
 {
 	size_t n;
@@ -446,21 +447,6 @@ static void test_read_four_half_one_skipped(void **state)
 	free(dir);
 }
 
-/* The nonlinear -> linear half table is computed at start-up; it must be
- * the table OpenEXR 3.1.5 ships (dwaLookups.h, hashed from its library). */
-static void test_dwa_to_linear_table(void **state)
-{
-	const uint16_t *t = exr_dwa_to_linear_table();
-	assert_int_equal(t[0x0000], 0x0000);
-	assert_int_equal(t[0x3c00], 0x3c00); /* 1 -> 1 */
-	assert_int_equal(t[0xbc00], 0xbc00); /* -1 -> -1 */
-	assert_int_equal(t[0x3800], 0x32f7); /* 0.5 -> 0.5^2.2 */
-	assert_int_equal(t[0x4000], 0x4883); /* 2 -> e^2.2 */
-	assert_int_equal(t[0x7c00], 0x0000); /* infinity -> 0 */
-	assert_int_equal(t[0x7e00], 0x0000); /* NaN -> 0 */
-	assert_true(fnv1a(t, 65536 * sizeof *t) == 0x2780dd5652990f07ull);
-}
-
 /* Expects `path` to be refused as bad input, naming itself (and, if
  * `what` is not NULL, saying `what`). */
 static void expect_refused(const char *path, const char *what)
@@ -474,9 +460,10 @@ static void expect_refused(const char *path, const char *what)
 }
 
 /* Cut and corrupted DWA chunks: every truncation is refused naming the
- * file; chosen header fields are refused with what is wrong; random byte
- * corruptions (bounded, fixed seed) either decode or are refused, never
- * read outside their buffers (make asan runs this). */
+ * file; chosen header fields are refused with what is wrong (in OpenEXR's
+ * C++ library's words); random byte corruptions (bounded, fixed seed)
+ * either decode or are refused as bad input, no exception escaping and
+ * nothing read outside a buffer (make asan runs this). */
 static void test_read_dwa_corrupt(void **state)
 {
 	char *dir = test_tmpdir();
@@ -498,13 +485,16 @@ static void test_read_dwa_corrupt(void **state)
 		spill(bad, orig, len);
 		expect_refused(bad, NULL);
 	}
-	/* Header fields: version, AC value count, AC coding. The chunk's
-	 * DWA header follows its y and size (8 bytes). */
+	/* Header fields: version, AC value count, AC coding, a section's
+	 * size. The chunk's DWA header follows its y and size (8 bytes). */
 	static const struct {
 		int field;
 		uint64_t value;
 		const char *what;
-	} fields[] = {{0, 3, "version 3"}, {8, 1ull << 40, "AC and"}, {10, 2, "AC coding 2"}, {3, 1ull << 50, "section of"}};
+	} fields[] = {{0, 3, "version"},
+		      {8, 1ull << 40, "corrupt header"},
+		      {10, 2, "AC Compression"},
+		      {3, 1ull << 50, "truncated"}};
 	for (size_t k = 0; k < sizeof fields / sizeof fields[0]; k++) {
 		memcpy(buf, orig, n);
 		for (int i = 0; i < 8; i++)
@@ -548,6 +538,80 @@ static void test_read_dwa_corrupt(void **state)
 	free(orig);
 	free(buf);
 	free(bad);
+	test_remove_tree(dir);
+	free(dir);
+}
+
+/* Replaces the value of the header attribute `name` (of type `type`) in
+ * the file at `path` by the `n` bytes at `value`, its size unchanged. */
+static void patch_attr(const char *path, const char *name, const char *type, const void *value, size_t n)
+{
+	size_t len;
+	unsigned char *buf = slurp(path, &len);
+	char key[64];
+	size_t nk = (size_t)snprintf(key, sizeof key, "%s%c%s", name, '\0', type) + 1;
+	unsigned char *at = memmem(buf, len, key, nk);
+	assert_non_null(at);
+	at += nk;
+	uint32_t size = (uint32_t)at[0] | (uint32_t)at[1] << 8 | (uint32_t)at[2] << 16 | (uint32_t)at[3] << 24;
+	assert_int_equal(size, n);
+	memcpy(at + 4, value, n);
+	spill(path, buf, len);
+	free(buf);
+}
+
+/* Headers that declare more than the file could hold are refused as bad
+ * input, with what is wrong, before anything is allocated for them (not
+ * as "out of memory", which a failed allocation of 164 GB said before). */
+static void test_read_oversize(void **state)
+{
+	char *dir = test_tmpdir();
+	char *path = test_path(dir, "big.exr");
+	const float px[4] = {1, 2, 3, 4};
+	static const struct {
+		int32_t box[4]; /* min x, min y, max x, max y */
+		const char *what;
+	} cases[] = {
+		{{0, 0, 19935094, 514}, "too large"},    /* 19935095 x 515 */
+		{{0, 0, 65536, 0}, "too large"},         /* a side over 65536 */
+		{{0, 0, 40000, 40000}, "too large"},     /* 1.6e9 pixels */
+		{{0, 0, 0, 65535}, "offsets of its 4096"}, /* 4096 ZIP chunks in a few hundred bytes */
+		{{-5, 0, -5, 0}, NULL},                  /* 1 x 1 elsewhere: read */
+	};
+	for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+		assert_int_equal(ajar_write_exr(path, px, 1, 1, NULL, 0), AJAR_OK);
+		patch_attr(path, "dataWindow", "box2i", cases[k].box, sizeof cases[k].box);
+		if (cases[k].what) {
+			expect_refused(path, cases[k].what);
+			continue;
+		}
+		float *got;
+		uint32_t w, h;
+		assert_int_equal(ajar_read_exr(path, &got, &w, &h), AJAR_OK);
+		assert_int_equal(w, 1);
+		assert_int_equal(h, 1);
+		assert_memory_equal(got, px, sizeof px);
+		free(got);
+	}
+
+	/* Tiles larger than both the image and 1024 pixels a side. */
+	enum { W = 7, H = 5 };
+	float y[W * H];
+	for (int i = 0; i < W * H; i++)
+		y[i] = (float)i;
+	TestChannel chans[] = {{"Y", EXR_PIXEL_FLOAT, y}};
+	char *tiled = test_path(dir, "tiled.exr");
+	write_test_exr(tiled, chans, 1, W, H, 2, 3, EXR_COMPRESSION_ZIP);
+	const unsigned char wide[9] = {0, 0, 1, 0, 3, 0, 0, 0, 0};   /* 65536 x 3, one level */
+	patch_attr(tiled, "tiles", "tiledesc", wide, sizeof wide);
+	expect_refused(tiled, "tiles 65536 pixels wide");
+	write_test_exr(tiled, chans, 1, W, H, 2, 3, EXR_COMPRESSION_ZIP);
+	const unsigned char high[9] = {2, 0, 0, 0, 0, 0x10, 0, 0, 0}; /* 2 x 4096 */
+	patch_attr(tiled, "tiles", "tiledesc", high, sizeof high);
+	expect_refused(tiled, "tiles 4096 pixels high");
+
+	free(tiled);
+	free(path);
 	test_remove_tree(dir);
 	free(dir);
 }
@@ -647,6 +711,10 @@ static void test_write_errors(void **state)
 
 	assert_int_equal(ajar_write_exr(out, px, 0, 2, NULL, 0), AJAR_ERROR_INVALID_ARGUMENT);
 	assert_int_equal(ajar_write_png(out, px, 2, 0), AJAR_ERROR_INVALID_ARGUMENT);
+	/* Beyond what stb_image_write's int sizes hold, refused before the
+	 * pixels are read. */
+	assert_int_equal(ajar_write_png(out, px, 20000, 20000), AJAR_ERROR_INVALID_ARGUMENT);
+	assert_non_null(strstr(ajar_last_error(), out));
 	assert_false(file_exists(out));
 
 	free(nodir);
@@ -770,9 +838,9 @@ int main(void)
 		cmocka_unit_test(test_read_tiled_y),
 		cmocka_unit_test(test_read_dwab),
 		cmocka_unit_test(test_read_dwa_fixtures),
-		cmocka_unit_test(test_dwa_to_linear_table),
 		cmocka_unit_test(test_read_four_half_one_skipped),
 		cmocka_unit_test(test_read_dwa_corrupt),
+		cmocka_unit_test(test_read_oversize),
 		cmocka_unit_test(test_read_errors),
 		cmocka_unit_test(test_write_errors),
 		cmocka_unit_test(test_png),

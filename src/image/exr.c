@@ -1,13 +1,17 @@
 /* exr.c — OpenEXR files through OpenEXR's C API (Core): writing the
- * renderer's float RGBA with string header attributes, reading RGB(A) or Y
- * images of any pixel type for environment maps and tests, and the atomic
+ * renderer's float RGBA with string header attributes, reading header
+ * attributes, the header half of reading RGB(A) or Y images for
+ * environment maps and tests (its pixels are decoded by OpenEXR's C++
+ * library, exr_read.cpp, as Core 3.1 cannot decompress DWA), and the atomic
  * write (temporary file next to the target, renamed on success) that PNG
  * output shares.
  *
  * Both directions use our own stream callbacks on a file descriptor: the
  * read side can then tell "cannot open" (an I/O error) from "not an EXR"
  * (bad input), and the write side creates the temporary file itself with
- * O_EXCL so two writers never share one. */
+ * O_EXCL so two writers never share one. Core reads the header first
+ * because it checks every size in it against the file's: the limits below
+ * are applied before the C++ library, which trusts them, allocates. */
 #include "image/exr.h"
 
 #include <errno.h>
@@ -38,10 +42,6 @@ static const char *exr_why(exr_result_t rv)
 {
 	return exr_msg[0] ? exr_msg : exr_get_default_error_message(rv);
 }
-
-/* Why our DWA decompressor (exr_dwa.c) refused a chunk, more specific than
- * the pipeline's "unable to decompress data". */
-static _Thread_local char dwa_msg[EXR_DWA_MSG];
 
 /* ---- Atomic output files ------------------------------------------------ */
 
@@ -320,125 +320,92 @@ static void exr_close(ExrReader *r)
 	close(r->stream.fd);
 }
 
-/* Where each channel of the file goes in our RGBA: 0..3 for R, G, B, A,
- * 0 also for a luminance-only Y, -1 for channels we skip. */
+/* Limits on what a header may declare, checked before anything is
+ * allocated for it: a file of a few hundred bytes can declare any size, and
+ * its allocation failing would report "out of memory" for a bad file.
+ * 2^29 pixels is 8 GiB of float RGBA, a 32768 x 16384 sky. */
+#define EXR_MAX_SIDE 65536
+#define EXR_MAX_PIXELS ((int64_t)1 << 29)
+/* A tile may exceed the image (a 7 x 5 image in 64 x 64 tiles), not both
+ * this and the image's side: the C++ library allocates whole tiles. */
+#define EXR_MAX_TILE_SIDE 1024
+
+/* Which of the file's channels fill R, G, B, A: NULL leaves the slot to
+ * ajar_read_exr (0 for a missing colour, 1 for a missing alpha, Y's grey). */
 typedef struct {
-	int slot[64];
-	int have_rgb, have_y, have_a;
-	/* Floats per decoded pixel: 4, or 5 for a part of four channels.
-	 * OpenEXR Core 3.1 has special routines for four half channels into
-	 * 16-byte pixels that put the channels in reverse order and, when one
-	 * channel is skipped, write through its NULL pointer (fixed in later
-	 * releases); a 20-byte pixel keeps Core on its generic routine, and
-	 * the image is packed to 4 floats after. */
-	int stride;
+	const char *name[4];
+	int have_rgb, have_a;
 } ChannelMap;
 
 static ajar_status exr_map_channels(const char *path, const exr_attr_chlist_t *cl, ChannelMap *m)
 {
 	static const char *const names[5] = {"R", "G", "B", "A", "Y"};
 	memset(m, 0, sizeof *m);
+	/* Each channel costs the C++ decoder a line buffer; 64 keeps those
+	 * within a small multiple of the image. */
 	if (cl->num_channels > 64)
 		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %d channels; at most 64 are supported", path,
 			       cl->num_channels);
+	const char *y = NULL;
 	for (int c = 0; c < cl->num_channels; c++) {
 		const exr_attr_chlist_entry_t *e = &cl->entries[c];
 		int k = 0;
 		while (k < 5 && strcmp(e->name.str, names[k]) != 0)
 			k++;
-		m->slot[c] = k < 4 ? k : (k == 4 ? 0 : -1);
 		if (k == 5)
 			continue;
 		if (e->x_sampling != 1 || e->y_sampling != 1)
 			return err_set(AJAR_ERROR_BAD_INPUT, "%s: channel %s is subsampled (%dx%d); not supported",
 				       path, e->name.str, e->x_sampling, e->y_sampling);
-		if (k < 3)
-			m->have_rgb = 1;
-		else if (k == 3)
-			m->have_a = 1;
+		if (k < 4)
+			m->name[k] = names[k];
 		else
-			m->have_y = 1;
+			y = names[4];
+		m->have_rgb |= k < 3;
+		m->have_a |= k == 3;
 	}
 	/* Y only matters when there is no colour: it becomes grey. */
-	if (m->have_rgb)
-		for (int c = 0; c < cl->num_channels; c++)
-			if (strcmp(cl->entries[c].name.str, "Y") == 0)
-				m->slot[c] = -1;
-	if (!m->have_rgb && !m->have_y)
+	if (!m->have_rgb)
+		m->name[0] = y;
+	if (!m->name[0] && !m->have_rgb)
 		return err_set(AJAR_ERROR_BAD_INPUT, "%s: no R, G, B or Y channel", path);
-	m->stride = cl->num_channels == 4 ? 5 : 4;
 	return AJAR_OK;
 }
 
-/* Decodes one chunk whose top-left pixel is (x0, y0) in the data window
- * into the RGBA image of width `width`. */
-static exr_result_t exr_decode_chunk(exr_context_t ctxt, const exr_chunk_info_t *cinfo, exr_decode_pipeline_t *dec,
-				     int *have_dec, const ChannelMap *m, float *rgba, uint32_t width, int32_t x0,
-				     int32_t y0)
+/* The size checks: data window, tiles, and an offset table that the file
+ * is long enough to hold. */
+static ajar_status exr_check_size(const char *path, const ExrReader *r, exr_storage_t storage,
+				  const exr_attr_box2i_t *dw)
 {
-	exr_result_t rv = *have_dec ? exr_decoding_update(ctxt, 0, cinfo, dec)
-				    : exr_decoding_initialize(ctxt, 0, cinfo, dec);
-	if (rv != EXR_ERR_SUCCESS)
-		return rv;
-	*have_dec = 1;
-	for (int c = 0; c < dec->channel_count; c++) {
-		exr_coding_channel_info_t *ch = &dec->channels[c];
-		int slot = m->slot[c];
-		if (slot < 0) {
-			ch->decode_to_ptr = NULL;
-			continue;
-		}
-		ch->user_pixel_stride = m->stride * (int32_t)sizeof(float);
-		ch->user_line_stride = (int32_t)(width * (uint32_t)m->stride * sizeof(float));
-		ch->user_bytes_per_element = sizeof(float);
-		ch->user_data_type = EXR_PIXEL_FLOAT;
-		ch->decode_to_ptr = (uint8_t *)(rgba + ((size_t)y0 * width + (size_t)x0) * (size_t)m->stride + slot);
+	int64_t w = (int64_t)dw->max.x - dw->min.x + 1, h = (int64_t)dw->max.y - dw->min.y + 1;
+	if (w <= 0 || h <= 0 || w > EXR_MAX_SIDE || h > EXR_MAX_SIDE || w * h > EXR_MAX_PIXELS)
+		return err_set(AJAR_ERROR_BAD_INPUT,
+			       "%s: data window [%d,%d]-[%d,%d] is empty or too large (at most %d pixels a side, "
+			       "%lld in all)",
+			       path, dw->min.x, dw->min.y, dw->max.x, dw->max.y, EXR_MAX_SIDE,
+			       (long long)EXR_MAX_PIXELS);
+	exr_result_t rv = EXR_ERR_SUCCESS;
+	if (storage == EXR_STORAGE_TILED) {
+		uint32_t tw, th;
+		rv = exr_get_tile_descriptor(r->ctxt, 0, &tw, &th, NULL, NULL);
+		if (rv == EXR_ERR_SUCCESS && ((int64_t)tw > w && tw > EXR_MAX_TILE_SIDE))
+			return err_set(AJAR_ERROR_BAD_INPUT, "%s: tiles %u pixels wide for an image %lld wide", path,
+				       tw, (long long)w);
+		if (rv == EXR_ERR_SUCCESS && ((int64_t)th > h && th > EXR_MAX_TILE_SIDE))
+			return err_set(AJAR_ERROR_BAD_INPUT, "%s: tiles %u pixels high for an image %lld high", path,
+				       th, (long long)h);
 	}
-	rv = exr_decoding_choose_default_routines(ctxt, 0, dec);
-	exr_compression_t comp;
-	if (rv == EXR_ERR_SUCCESS && exr_get_compression(ctxt, 0, &comp) == EXR_ERR_SUCCESS &&
-	    (comp == EXR_COMPRESSION_DWAA || comp == EXR_COMPRESSION_DWAB)) {
-		dec->decompress_fn = exr_dwa_decompress;
-		dec->decoding_user_data = dwa_msg;
-	}
+	int32_t chunks = 0;
 	if (rv == EXR_ERR_SUCCESS)
-		rv = exr_decoding_run(ctxt, 0, dec);
-	return rv;
-}
-
-static exr_result_t exr_read_pixels(exr_context_t ctxt, exr_storage_t storage, const exr_attr_box2i_t *dw,
-				    const ChannelMap *m, float *rgba, uint32_t width, uint32_t height)
-{
-	exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
-	int have_dec = 0;
-	exr_chunk_info_t cinfo;
-	exr_result_t rv;
-	if (storage == EXR_STORAGE_SCANLINE) {
-		int32_t lines;
-		rv = exr_get_scanlines_per_chunk(ctxt, 0, &lines);
-		for (int64_t y = dw->min.y; rv == EXR_ERR_SUCCESS && y <= dw->max.y; y += lines) {
-			rv = exr_read_scanline_chunk_info(ctxt, 0, (int)y, &cinfo);
-			if (rv == EXR_ERR_SUCCESS)
-				rv = exr_decode_chunk(ctxt, &cinfo, &dec, &have_dec, m, rgba, width, 0,
-						      cinfo.start_y - dw->min.y);
-		}
-	} else {
-		/* Tiled: only the full-resolution level (0, 0) is read. */
-		int32_t tw, th;
-		rv = exr_get_tile_sizes(ctxt, 0, 0, 0, &tw, &th);
-		if (rv == EXR_ERR_SUCCESS && (tw <= 0 || th <= 0))
-			rv = EXR_ERR_INVALID_ATTR;
-		for (int64_t ty = 0; rv == EXR_ERR_SUCCESS && ty * th < height; ty++)
-			for (int64_t tx = 0; rv == EXR_ERR_SUCCESS && tx * tw < width; tx++) {
-				rv = exr_read_tile_chunk_info(ctxt, 0, (int)tx, (int)ty, 0, 0, &cinfo);
-				if (rv == EXR_ERR_SUCCESS)
-					rv = exr_decode_chunk(ctxt, &cinfo, &dec, &have_dec, m, rgba, width,
-							      (int32_t)(tx * tw), (int32_t)(ty * th));
-			}
-	}
-	if (have_dec)
-		exr_decoding_destroy(ctxt, &dec);
-	return rv;
+		rv = exr_get_chunk_count(r->ctxt, 0, &chunks);
+	if (rv != EXR_ERR_SUCCESS)
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: OpenEXR header: %s", path, exr_why(rv));
+	struct stat sb;
+	if (fstat(r->stream.fd, &sb) == 0 && (int64_t)chunks * 8 > (int64_t)sb.st_size)
+		return err_set(AJAR_ERROR_BAD_INPUT,
+			       "%s: truncated: %lld bytes cannot hold the offsets of its %d chunks", path,
+			       (long long)sb.st_size, chunks);
+	return AJAR_OK;
 }
 
 ajar_status ajar_read_exr(const char *path, float **rgba, uint32_t *width, uint32_t *height)
@@ -467,56 +434,34 @@ ajar_status ajar_read_exr(const char *path, float **rgba, uint32_t *width, uint3
 		st = err_set(AJAR_ERROR_BAD_INPUT, "%s: deep OpenEXR images are not supported", path);
 		goto done;
 	}
-	int64_t w = (int64_t)dw.max.x - dw.min.x + 1, h = (int64_t)dw.max.y - dw.min.y + 1;
-	if (w <= 0 || h <= 0 || w > INT_MAX / 20 || h > INT_MAX) {
-		st = err_set(AJAR_ERROR_BAD_INPUT, "%s: data window [%d,%d]-[%d,%d] is empty or too large", path,
-			     dw.min.x, dw.min.y, dw.max.x, dw.max.y);
+	st = exr_check_size(path, &r, storage, &dw);
+	if (st != AJAR_OK)
 		goto done;
-	}
 	ChannelMap map;
 	st = exr_map_channels(path, cl, &map);
 	if (st != AJAR_OK)
 		goto done;
-	if ((uint64_t)w * (uint64_t)h > SIZE_MAX / (5 * sizeof(float))) {
-		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: %lldx%lld image too large", path, (long long)w,
-			     (long long)h);
-		goto done;
-	}
-	float *px = calloc((size_t)w * (size_t)h * (size_t)map.stride, sizeof(float));
+	uint32_t w = (uint32_t)((int64_t)dw.max.x - dw.min.x + 1), h = (uint32_t)((int64_t)dw.max.y - dw.min.y + 1);
+	size_t n = (size_t)w * h;
+	float *px = calloc(n * 4, sizeof(float));
 	if (!px) {
-		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory for a %lldx%lld image", path,
-			     (long long)w, (long long)h);
+		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory for a %ux%u image", path, w, h);
 		goto done;
 	}
-	exr_msg[0] = '\0';
-	dwa_msg[0] = '\0';
-	rv = exr_read_pixels(r.ctxt, storage, &dw, &map, px, (uint32_t)w, (uint32_t)h);
-	if (rv != EXR_ERR_SUCCESS) {
+	st = exr_decode_rgba(path, r.stream.fd, map.name, px, w, h);
+	if (st != AJAR_OK) {
 		free(px);
-		if (r.stream.io_errno)
-			st = err_set(AJAR_ERROR_IO, "%s: cannot read: %s", path, strerror(r.stream.io_errno));
-		else if (rv == EXR_ERR_OUT_OF_MEMORY)
-			st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory decoding pixels", path);
-		else
-			st = err_set(AJAR_ERROR_BAD_INPUT, "%s: truncated or corrupt pixel data: %s", path,
-				     dwa_msg[0] ? dwa_msg : exr_why(rv));
 		goto done;
 	}
-	for (size_t i = 0, n = (size_t)w * (size_t)h; i < n; i++) {
-		if (map.stride != 4) /* packing forward never overwrites what is still to come */
-			memmove(px + 4 * i, px + (size_t)map.stride * i, 4 * sizeof(float));
+	for (size_t i = 0; i < n; i++) {
 		if (!map.have_rgb)
 			px[4 * i + 1] = px[4 * i + 2] = px[4 * i];
 		if (!map.have_a)
 			px[4 * i + 3] = 1.0f;
 	}
-	if (map.stride != 4) {
-		float *packed = realloc(px, (size_t)w * (size_t)h * 4 * sizeof(float));
-		px = packed ? packed : px;
-	}
 	*rgba = px;
-	*width = (uint32_t)w;
-	*height = (uint32_t)h;
+	*width = w;
+	*height = h;
 done:
 	exr_close(&r);
 	return st;

@@ -1,4 +1,4 @@
-/* exr.h — internal helpers of the image-file modules (exr.c, png.c)
+/* exr.h — internal helpers of the image-file modules (exr.c, exr_read.cpp, png.c)
  * beyond the public ajar_write_exr / ajar_read_exr / ajar_write_png. */
 #ifndef AJAR_EXR_H
 #define AJAR_EXR_H
@@ -22,17 +22,15 @@ ajar_status exr_read_attr(const char *path, const char *name, char *value, size_
 ajar_status exr_write_channels(const char *path, const float *px, int nch, const char *const *names, uint32_t width,
 			       uint32_t height, const char *const *attrs, uint32_t nattrs);
 
-/* The decompress step of OpenEXR Core's decode pipeline for DWAA and DWAB
- * chunks, which Core 3.1 cannot decompress (exr_dwa.c): set it as the
- * pipeline's decompress_fn. It turns dec->packed_buffer into the chunk's
- * uncompressed layout in dec->unpacked_buffer; if dec->decoding_user_data
- * is not NULL it is a char[EXR_DWA_MSG] that gets why a chunk is refused.
- * Returns an exr_result_t. */
-#define EXR_DWA_MSG 192
-struct _exr_decode_pipeline;
-int32_t exr_dwa_decompress(struct _exr_decode_pipeline *dec);
-/* DWA's table from stored (nonlinear) half values to linear half values. */
-const uint16_t *exr_dwa_to_linear_table(void);
+/* Decodes the pixels of part 0 of the OpenEXR file open on `fd` with
+ * OpenEXR's C++ library (exr_read.cpp) into `rgba`, width x height float
+ * RGBA, top row first: channel[k] names the file's channel for R, G, B, A,
+ * or is NULL to leave that component as it is. The caller checked the
+ * header (sizes, channels); the file's data window must be width x height.
+ * Errors name `path`: bad input for a corrupt or truncated file, I/O for a
+ * failed read. */
+ajar_status exr_decode_rgba(const char *path, int fd, const char *const channel[4], float *rgba, uint32_t width,
+			    uint32_t height);
 
 /* Atomic output, shared by the EXR and PNG writers: image_tmp_open creates
  * a new file next to `path` (*tmp_path is malloc'd); image_tmp_finish
