@@ -41,20 +41,6 @@ typedef void (*ajar_log_fn)(ajar_log_level level, const char *message, void *use
 /* Process-wide; NULL restores the default (silence). */
 void ajar_set_log_callback(ajar_log_fn fn, void *user);
 
-/* ---- Devices ----------------------------------------------------------- */
-
-typedef struct {
-	char selector[32];  /* what --device / ajar_options.device accepts, e.g. "0:1" */
-	char platform[128];
-	char name[128];
-	char type[16];      /* "cpu", "gpu", "accelerator", "other" */
-	uint32_t compute_units;
-	uint64_t global_memory; /* bytes */
-} ajar_device_info;
-
-/* Lists every OpenCL device of every platform. *count may be 0. */
-ajar_status ajar_devices(ajar_device_info *out, uint32_t capacity, uint32_t *count);
-
 /* ---- Scenes ------------------------------------------------------------ */
 
 typedef struct ajar_scene ajar_scene;
@@ -62,6 +48,17 @@ typedef struct ajar_scene ajar_scene;
 /* Loads .gltf (with .bin, images) or .glb. Portals are mesh nodes with
  * extras {"portal": true}; the environment comes from scene extras. */
 ajar_status ajar_scene_load(const char *path, ajar_scene **out);
+/* How ajar_scene_load_with reads a scene. By default every file the scene
+ * names (buffer and image URIs, the environment image in its extras) must
+ * resolve, after ".." and symbolic links, inside the scene file's folder;
+ * anything else fails with AJAR_ERROR_BAD_INPUT naming the URI. A render
+ * service that renders other people's files keeps this default. */
+typedef struct {
+	int allow_outside_files; /* 1: files anywhere may be read (trusted scenes) */
+} ajar_load_options;
+void ajar_load_options_default(ajar_load_options *o);
+/* ajar_scene_load is ajar_scene_load_with(path, NULL, out): confined. */
+ajar_status ajar_scene_load_with(const char *path, const ajar_load_options *o, ajar_scene **out);
 /* An empty scene to be filled in code. */
 ajar_status ajar_scene_create(ajar_scene **out);
 void ajar_scene_destroy(ajar_scene **scene);
@@ -158,7 +155,7 @@ typedef struct {
 } ajar_scene_info;
 ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info);
 
-/* ---- Rendering --------------------------------------------------------- */
+/* ---- Render options ---------------------------------------------------- */
 
 typedef enum { AJAR_INTEGRATOR_PT = 0, AJAR_INTEGRATOR_BDPT = 1, AJAR_INTEGRATOR_PORTAL = 2 } ajar_integrator;
 /* The bidirectional integrators' MIS heuristic. AJAR_MIS_AUTO (the default):
@@ -167,6 +164,17 @@ typedef enum { AJAR_INTEGRATOR_PT = 0, AJAR_INTEGRATOR_BDPT = 1, AJAR_INTEGRATOR
 typedef enum { AJAR_MIS_POWER = 0, AJAR_MIS_BALANCE = 1, AJAR_MIS_AUTO = 2 } ajar_mis;
 /* Longest path (segments) the bidirectional integrators take. */
 #define AJAR_BIDIR_MAX_DEPTH 32
+
+/* ajar_options.aov bits. Each AOV is an unbiased pixel average (the same
+ * jittered camera rays as the image), identical across devices, passes,
+ * resumes and integrators. Albedo and normal are those of the first
+ * non-specular hit, through mirrors and smooth glass (as Open Image Denoise
+ * asks); an escaped ray adds zeros. */
+#define AJAR_AOV_ALBEDO 1u   /* base colour (textured), linear RGB */
+#define AJAR_AOV_NORMAL 2u   /* world-space shading normal, toward the viewer */
+#define AJAR_AOV_DEPTH 4u    /* distance from the camera to the first hit */
+#define AJAR_AOV_VARIANCE 8u /* variance of the pixel mean of the pixel's own samples */
+#define AJAR_AOV_ALL 15u
 
 typedef struct {
 	uint32_t width, height;  /* 0: scene's suggestion, else 512 x 512/aspect */
@@ -186,6 +194,8 @@ typedef struct {
 	uint32_t aov;            /* AJAR_AOV_* bits: first-hit outputs for denoisers */
 } ajar_options;
 void ajar_options_default(ajar_options *o);
+
+/* ---- Renderer ---------------------------------------------------------- */
 
 typedef struct {
 	uint64_t samples_done;   /* samples per pixel done, summed over all pixels / pixels */
@@ -222,6 +232,11 @@ uint32_t ajar_renderer_spp(const ajar_renderer *r);
 ajar_status ajar_renderer_image(ajar_renderer *r, float *rgba, uint32_t *width, uint32_t *height);
 ajar_status ajar_renderer_write_exr(ajar_renderer *r, const char *path);
 ajar_status ajar_renderer_write_png(ajar_renderer *r, const char *path);
+/* The AOV images: width * height * 10 floats, row-major, top row first:
+ * albedo RGB, normal XYZ, depth, variance RGB (zeros for AOVs not asked
+ * for). ajar_renderer_write_exr adds the asked ones to the EXR as
+ * albedo.R/G/B, normal.X/Y/Z, depth.Z, variance.R/G/B. */
+ajar_status ajar_renderer_aovs(ajar_renderer *r, float *px);
 /* The image plus one RGB layer per strategy of paths up to
  * options.strategy_len segments (bdpt, portal): "len<n>.s<s>t<t>.R" etc. for
  * bdpt's (s, t), "len<n>.portal.s<s>t<t>.R" for the portal integrator's
@@ -245,51 +260,7 @@ typedef struct {
 uint32_t ajar_renderer_device_count(const ajar_renderer *r);
 ajar_status ajar_renderer_device_stats(const ajar_renderer *r, uint32_t index, ajar_device_stats *out);
 
-/* ---- Images ------------------------------------------------------------ */
-
-/* Writes float RGBA (width * height * 4, top row first) as an OpenEXR file;
- * `attrs` are extra string header attributes as name/value pairs. */
-ajar_status ajar_write_exr(const char *path, const float *rgba, uint32_t width, uint32_t height,
-			   const char *const *attrs, uint32_t nattrs);
-/* Reads an OpenEXR's R, G, B (and A if present, else 1) into a new array
- * that the caller frees with free(). */
-ajar_status ajar_read_exr(const char *path, float **rgba, uint32_t *width, uint32_t *height);
-/* Tone-mapped (exposure, sRGB) 8-bit PNG of float RGBA. */
-ajar_status ajar_write_png(const char *path, const float *rgba, uint32_t width, uint32_t height);
-
-/* ---- Appended API: scene files kept in their folder ------------------------ */
-
-/* How ajar_scene_load_with reads a scene. By default every file the scene
- * names (buffer and image URIs, the environment image in its extras) must
- * resolve, after ".." and symbolic links, inside the scene file's folder;
- * anything else fails with AJAR_ERROR_BAD_INPUT naming the URI. A render
- * service that renders other people's files keeps this default. */
-typedef struct {
-	int allow_outside_files; /* 1: files anywhere may be read (trusted scenes) */
-} ajar_load_options;
-void ajar_load_options_default(ajar_load_options *o);
-/* ajar_scene_load is ajar_scene_load_with(path, NULL, out): confined. */
-ajar_status ajar_scene_load_with(const char *path, const ajar_load_options *o, ajar_scene **out);
-
-/* ---- Appended API: outputs a denoiser takes ------------------------------- */
-
-/* ajar_options.aov bits. Each AOV is an unbiased pixel average (the same
- * jittered camera rays as the image), identical across devices, passes,
- * resumes and integrators. Albedo and normal are those of the first
- * non-specular hit, through mirrors and smooth glass (as Open Image Denoise
- * asks); an escaped ray adds zeros. */
-#define AJAR_AOV_ALBEDO 1u   /* base colour (textured), linear RGB */
-#define AJAR_AOV_NORMAL 2u   /* world-space shading normal, toward the viewer */
-#define AJAR_AOV_DEPTH 4u    /* distance from the camera to the first hit */
-#define AJAR_AOV_VARIANCE 8u /* variance of the pixel mean of the pixel's own samples */
-#define AJAR_AOV_ALL 15u
-/* The AOV images: width * height * 10 floats, row-major, top row first:
- * albedo RGB, normal XYZ, depth, variance RGB (zeros for AOVs not asked
- * for). ajar_renderer_write_exr adds the asked ones to the EXR as
- * albedo.R/G/B, normal.X/Y/Z, depth.Z, variance.R/G/B. */
-ajar_status ajar_renderer_aovs(ajar_renderer *r, float *px);
-
-/* ---- Appended API: checkpoint and resume ----------------------------------- */
+/* ---- Checkpoints ------------------------------------------------------- */
 
 /* A checkpoint holds a render's films (integer sums, splats, strategy
  * layers), the sample ranges done, the seed, the options and hashes of the
@@ -319,6 +290,32 @@ ajar_status ajar_checkpoint_options(const char *path, ajar_options *o, uint32_t 
  * read. */
 ajar_status ajar_renderer_resume(const ajar_scene *scene, const char *path, const ajar_options *o,
 				 ajar_renderer **out);
+
+/* ---- Images ------------------------------------------------------------ */
+
+/* Writes float RGBA (width * height * 4, top row first) as an OpenEXR file;
+ * `attrs` are extra string header attributes as name/value pairs. */
+ajar_status ajar_write_exr(const char *path, const float *rgba, uint32_t width, uint32_t height,
+			   const char *const *attrs, uint32_t nattrs);
+/* Reads an OpenEXR's R, G, B (and A if present, else 1) into a new array
+ * that the caller frees with free(). */
+ajar_status ajar_read_exr(const char *path, float **rgba, uint32_t *width, uint32_t *height);
+/* Tone-mapped (exposure, sRGB) 8-bit PNG of float RGBA. */
+ajar_status ajar_write_png(const char *path, const float *rgba, uint32_t width, uint32_t height);
+
+/* ---- Devices ----------------------------------------------------------- */
+
+typedef struct {
+	char selector[32];  /* what --device / ajar_options.device accepts, e.g. "0:1" */
+	char platform[128];
+	char name[128];
+	char type[16];      /* "cpu", "gpu", "accelerator", "other" */
+	uint32_t compute_units;
+	uint64_t global_memory; /* bytes */
+} ajar_device_info;
+
+/* Lists every OpenCL device of every platform. *count may be 0. */
+ajar_status ajar_devices(ajar_device_info *out, uint32_t capacity, uint32_t *count);
 
 /* ---- Several machines (Open MPI) ---------------------------------------------
  * A program started by mpirun calls ajar_mpi_init first; every rank then
