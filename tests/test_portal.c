@@ -880,7 +880,9 @@ static PathVertex first_hit(const SceneView *sc, V3 w0, V3 n, V3 wl)
 	tmp[0].type = VERTEX_SURFACE;
 	tmp[0].p = w0;
 	tmp[0].ng = tmp[0].ns = n;
-	if (!vertex_trace(sc, tmp, 1, w0, wl, v3(1, 1, 1), 0.0f, 0, 0, 1)) {
+	tmp[0].material = tmp[0].tri = -1;
+	Rng rng = rng_init(5, 0, 0, 0); /* for panes, which these scenes have none of */
+	if (!vertex_trace(sc, tmp, 1, w0, wl, v3(1, 1, 1), 0.0f, 0, 0, 1, &rng)) {
 		tmp[1].type = VERTEX_ENV;
 		tmp[1].p = wl;
 		tmp[1].tri = -1;
