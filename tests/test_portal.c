@@ -366,6 +366,19 @@ static void test_mis_window_room(void **state)
 	host_scene_close(&h);
 }
 
+/* A pane 2 cm inside the window (the portal's plane is the opening's):
+ * paths cross it by null events, intermediate subpaths from the portal
+ * cross it on their -> half. */
+static void test_mis_glazed(void **state)
+{
+	HostScene h;
+	host_scene_open(&h, SCENE("window-room/window-room-glazed.gltf"), NULL, 24, 24, INTEGRATOR_PORTAL, 8);
+	assert_true(check_scene_mis(&h, 200).portal_paths > 100);
+	use_all_portal_strategies(&h);
+	assert_true(check_scene_mis(&h, 400).portal_paths > 200);
+	host_scene_close(&h);
+}
+
 static void test_mis_living_room(void **state)
 {
 	HostScene h;
@@ -1411,7 +1424,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_mis_window_room),
-		cmocka_unit_test(test_mis_living_room),
+		cmocka_unit_test(test_mis_glazed), cmocka_unit_test(test_mis_living_room),
 		cmocka_unit_test(test_mis_bathroom),
 		cmocka_unit_test(test_mis_door_ajar),
 		cmocka_unit_test(test_mis_portal_surface_portal),

@@ -20,7 +20,7 @@ import struct
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCENES = os.path.dirname(HERE)
-ROOMS = ["window-room-forest", "living-room-forest"]
+ROOMS = ["window-room", "window-room-forest", "living-room-forest"]
 INSET = 0.02  # metres from the portal into the room
 
 

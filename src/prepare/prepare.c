@@ -165,6 +165,9 @@ ajar_status prepare_scene(const Scene *s, const ajar_options *o, uint32_t width,
 			d->extra[i] = s->extra[d->bvh.order[i]];
 	}
 	d->n_tris = d->n_shade = n;
+	if (over && over->panes_opaque) /* a test's brute force: smooth thin glass is a delta surface */
+		for (uint32_t i = 0; i < n; i++)
+			d->tris[i].flags &= ~TRI_PANE;
 	if (s->nportal_tris)
 		memcpy(d->portals, s->portals, sizeof *d->portals * s->nportal_tris);
 	d->n_portals = s->nportal_tris;
