@@ -184,9 +184,9 @@ $(BUILD)/tests/ajar_faults: $(BUILD)/tests/ajar_faults.o $(filter-out $(BUILD)/c
 	@echo "  LD      $@"
 	$(Q)$(CXX) $(LDFLAGS) -o $@ $^ $(LDLIBS)
 
-$(BUILD)/tests/bench: $(BUILD)/tests/bench.o $(BUILD)/libajar.a
+$(BUILD)/tests/bench: $(BUILD)/tests/bench.o $(BUILD)/tests/testutil.o $(BUILD)/libajar.a
 	@echo "  LD      $@"
-	$(Q)$(CXX) $(LDFLAGS) -o $@ $^ $(LDLIBS)
+	$(Q)$(CXX) $(LDFLAGS) -o $@ $^ $(LDLIBS) -lcmocka
 
 tests: $(TESTS:%=$(BUILD)/tests/%) build/ajar $(BUILD)/tests/ajar_faults
 

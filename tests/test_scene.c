@@ -22,25 +22,15 @@
 
 #define EPS 1e-5f
 
-static char *tmpdir;
-
 static void assert_v3(V3 a, float x, float y, float z)
 {
 	if (fabsf(a.x - x) > EPS || fabsf(a.y - y) > EPS || fabsf(a.z - z) > EPS)
 		fail_msg("(%g, %g, %g) != (%g, %g, %g)", a.x, a.y, a.z, x, y, z);
 }
 
-static char *tmp_path(const char *name)
-{
-	char *p = malloc(strlen(tmpdir) + strlen(name) + 2);
-	assert_non_null(p);
-	sprintf(p, "%s/%s", tmpdir, name);
-	return p;
-}
-
 static void write_bytes(const char *name, const void *data, size_t n)
 {
-	char *p = tmp_path(name);
+	char *p = test_tmp(name);
 	FILE *f = fopen(p, "wb");
 	assert_non_null(f);
 	assert_int_equal(fwrite(data, 1, n, f), n);
@@ -52,7 +42,7 @@ static void write_text(const char *name, const char *text) { write_bytes(name, t
 
 static Scene *load_ok(const char *name)
 {
-	char *p = tmp_path(name);
+	char *p = test_tmp(name);
 	ajar_scene *s = NULL;
 	ajar_status st = ajar_scene_load(p, &s);
 	if (st)
@@ -65,7 +55,7 @@ static Scene *load_ok(const char *name)
  * `needle` (the element and what is wrong with it). */
 static void load_fails(const char *name, ajar_status status, const char *needle)
 {
-	char *p = tmp_path(name);
+	char *p = test_tmp(name);
 	static char sentinel;
 	ajar_scene *s = (ajar_scene *)(void *)&sentinel; /* must come back NULL */
 	ajar_status st = ajar_scene_load(p, &s);
@@ -824,7 +814,7 @@ static void test_environment_image(void **state)
 		rgba[4 * i + 2] = 0.25f * (float)(i % 8);
 		rgba[4 * i + 3] = 1.0f;
 	}
-	char *exr = tmp_path("sky.exr");
+	char *exr = test_tmp("sky.exr");
 	assert_int_equal(ajar_write_exr(exr, rgba, 8, 4, NULL, 0), AJAR_OK);
 	free(exr);
 	write_tri_gltf("envimg.gltf", "0", "{\"mesh\":0}",
@@ -852,7 +842,7 @@ static void write_sky(const char *name, float bad, const int *xy, int n)
 		rgba[i] = 0.5f;
 	for (int k = 0; k < n; k++)
 		rgba[4 * (xy[2 * k + 1] * 8 + xy[2 * k]) + (k % 3)] = bad;
-	char *exr = tmp_path(name);
+	char *exr = test_tmp(name);
 	assert_int_equal(ajar_write_exr(exr, rgba, 8, 4, NULL, 0), AJAR_OK);
 	free(exr);
 }
@@ -903,7 +893,7 @@ static void test_environment_pixels(void **state)
 	/* Through the API: the same check, and the scene keeps no sky. */
 	ajar_scene *as = NULL;
 	assert_int_equal(ajar_scene_create(&as), AJAR_OK);
-	char *nan_exr = tmp_path("nansky.exr");
+	char *nan_exr = test_tmp("nansky.exr");
 	assert_int_equal(ajar_scene_set_environment_image(as, nan_exr, 1.0f), AJAR_ERROR_BAD_INPUT);
 	if (!strstr(ajar_last_error(), "nansky.exr: environment: pixel (6, 2)"))
 		fail_msg("\"%s\"", ajar_last_error());
@@ -986,7 +976,7 @@ static void test_environment_hdr(void **state)
 	}
 	ajar_scene *as = NULL;
 	assert_int_equal(ajar_scene_create(&as), AJAR_OK);
-	char *p = tmp_path("sky.hdr");
+	char *p = test_tmp("sky.hdr");
 	assert_int_equal(ajar_scene_set_environment_image(as, p, 1.0f), AJAR_OK);
 	free(p);
 	assert_int_equal(as->env_width, 8);
@@ -1497,18 +1487,6 @@ static void test_api_lights(void **state)
 	ajar_scene_destroy(&s);
 }
 
-static int setup(void **state)
-{
-	(void)state;
-	return test_tmpdir_setup(&tmpdir);
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	return test_tmpdir_teardown(&tmpdir);
-}
-
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -1540,5 +1518,5 @@ int main(void)
 		cmocka_unit_test(test_lights_punctual),
 		cmocka_unit_test(test_api_lights),
 	};
-	return cmocka_run_group_tests(tests, setup, teardown);
+	return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);
 }
