@@ -43,7 +43,12 @@ LIB_CXX := $(foreach d,$(LIB_DIRS),$(wildcard src/$(d)/*.cpp))
 LIB_OBJS := $(LIB_C:src/%.c=$(BUILD)/src/%.o) $(LIB_CXX:src/%.cpp=$(BUILD)/src/%.o) $(BUILD)/kernel_source.o
 CLI_OBJS := $(patsubst src/cli/%.c,$(BUILD)/cli/%.o,$(wildcard src/cli/*.c))
 KERNELS := $(wildcard kernels/*.cl kernels/*/*.h)
-TESTS := $(patsubst tests/%.c,%,$(wildcard tests/test_*.c)) test_lights_fine
+# Tests in folders by what they need (tests/README.md): unit/ the host
+# alone (no OpenCL device), render/ an OpenCL device, api/ the library, the
+# program and Open MPI as a user meets them; bench/ is `make bench`, support/
+# the helpers they share. Objects and binaries stay flat in $(BUILD)/tests.
+UNIT_TESTS := $(notdir $(basename $(wildcard tests/unit/test_*.c))) test_lights_fine
+TESTS := $(UNIT_TESTS) $(notdir $(basename $(wildcard tests/render/test_*.c tests/api/test_*.c)))
 
 # One test binary per module, linking only what it tests (plus error.o).
 obj = $(addprefix $(BUILD)/src/,$(addsuffix .o,$(1)))
@@ -158,17 +163,27 @@ kernels/material/bsdf_tables.h: build/tools/bsdf_tables
 	@echo "  GEN     $@"
 	$(Q)$< > $@.tmp && mv $@.tmp $@
 
-$(BUILD)/tests/%.o: tests/%.c
-	@mkdir -p $(@D)
-	@echo "  CC      $<"
-	$(Q)$(CC) $(CPPFLAGS) -Itests $(PKG_CFLAGS) $(CFLAGS) -c -o $@ $<
+define compile_test
+@mkdir -p $(@D)
+@echo "  CC      $<$(if $(TEST_CFLAGS), ($(TEST_CFLAGS)))"
+$(Q)$(CC) $(CPPFLAGS) -Itests/support $(PKG_CFLAGS) $(CFLAGS) $(TEST_CFLAGS) -c -o $@ $<
+endef
+$(BUILD)/tests/%.o: tests/unit/%.c
+	$(compile_test)
+$(BUILD)/tests/%.o: tests/render/%.c
+	$(compile_test)
+$(BUILD)/tests/%.o: tests/api/%.c
+	$(compile_test)
+$(BUILD)/tests/%.o: tests/bench/%.c
+	$(compile_test)
+$(BUILD)/tests/%.o: tests/support/%.c
+	$(compile_test)
 
 # test_lights again with the planes' sky tables at 512 cells a side, as pt
 # takes them under skies of 2048 columns or more (src/prepare/prepare.c).
-$(BUILD)/tests/test_lights_fine.o: tests/test_lights.c
-	@mkdir -p $(@D)
-	@echo "  CC      $< (PORTAL_SKY_RES=512)"
-	$(Q)$(CC) $(CPPFLAGS) -Itests $(PKG_CFLAGS) $(CFLAGS) -DPORTAL_SKY_RES=512 -c -o $@ $<
+$(BUILD)/tests/test_lights_fine.o: TEST_CFLAGS := -DPORTAL_SKY_RES=512
+$(BUILD)/tests/test_lights_fine.o: tests/unit/test_lights.c
+	$(compile_test)
 
 # Test binaries link their module objects (secondary expansion of DEPS_*).
 .SECONDEXPANSION:
@@ -195,8 +210,8 @@ test:
 	$(Q)$(MAKE) --no-print-directory tests
 	$(Q)sh tests/run.sh $(BUILD) $(TESTS)
 
-# Host tests that need no OpenCL device, under ASan + UBSan.
-ASAN_TESTS := test_bsdf test_sampling test_bvh test_lights test_lights_fine test_scene test_exr test_bdpt test_portal test_confine test_punctual
+# Host tests that need no OpenCL device (tests/unit), under ASan + UBSan.
+ASAN_TESTS := $(UNIT_TESTS)
 asan:
 	$(Q)$(MAKE) --no-print-directory deps
 	$(Q)$(MAKE) --no-print-directory MODE=asan $(ASAN_TESTS:%=build/asan/tests/%)
@@ -242,5 +257,10 @@ uninstall:
 
 clean:
 	rm -rf build out
+
+# Where the test sources were before tests/ had folders, as older builds'
+# dependency files still name them: nothing to make, so make rebuilds the
+# objects from where the sources are now instead of stopping.
+$(addprefix tests/,$(notdir $(wildcard tests/*/*.c))):
 
 -include $(shell find build -name '*.d' 2>/dev/null)

@@ -1,5 +1,5 @@
 /* test_portal.c — the portal integrator, checked on the host with the
- * kernels' own code (tests/kernel_host.h), against design.md:
+ * kernels' own code (tests/support/kernel_host.h), against design.md:
  *   - MIS over the union: for random paths of every strategy (bdpt and
  *     intermediate) in scenes with one, two and four portals, the kernel's
  *     records equal an independent oracle's (densities, portal crossings

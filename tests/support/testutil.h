@@ -44,7 +44,7 @@ int test_group_teardown(void **state);
 char *test_tmp(const char *name);
 /* The ajar program the CLI tests run: $AJAR_BIN, else build/ajar. */
 const char *test_ajar_bin(void);
-/* tests/ajar_faults.c's program, beside the running test binary: the ajar
+/* tests/support/ajar_faults.c's program, beside the running test binary: the ajar
  * command with faults injected from AJAR_TEST_FAIL_DEVICE and
  * AJAR_TEST_PASS_SPP in its environment. */
 const char *test_ajar_faults_bin(void);
