@@ -47,7 +47,7 @@ KERNELS := $(wildcard kernels/*.cl kernels/*/*.h)
 # alone (no OpenCL device), render/ an OpenCL device, api/ the library, the
 # program and Open MPI as a user meets them; bench/ is `make bench`, support/
 # the helpers they share. Objects and binaries stay flat in $(BUILD)/tests.
-UNIT_TESTS := $(notdir $(basename $(wildcard tests/unit/test_*.c))) test_lights_fine
+UNIT_TESTS := $(notdir $(basename $(wildcard tests/unit/test_*.c))) test_lights_sky_planes_fine
 TESTS := $(UNIT_TESTS) $(notdir $(basename $(wildcard tests/render/test_*.c tests/api/test_*.c)))
 
 # One test binary per module, linking only what it tests (plus error.o).
@@ -55,8 +55,13 @@ obj = $(addprefix $(BUILD)/src/,$(addsuffix .o,$(1)))
 DEPS_test_bsdf := $(call obj,core/error)
 DEPS_test_sampling := $(call obj,core/error)
 DEPS_test_bvh := $(call obj,core/error scene/scene prepare/bvh_build scene/gltf scene/tangents image/exr image/exr_dwa image/exr_huf image/hdr)
-DEPS_test_lights := $(call obj,core/error scene/scene prepare/light_tables image/exr image/exr_dwa image/exr_huf image/hdr prepare/sky_tables prepare/portal_flux)
-DEPS_test_lights_fine := $(DEPS_test_lights)
+# The light tests share tests/support/lit.c (the kernels' light code inside).
+LIGHT_DEPS := $(BUILD)/tests/lit.o $(call obj,core/error scene/scene prepare/light_tables image/exr image/exr_dwa image/exr_huf image/hdr)
+DEPS_test_lights_env := $(LIGHT_DEPS) $(call obj,prepare/portal_flux)
+DEPS_test_lights_emitters := $(LIGHT_DEPS)
+DEPS_test_lights_sample := $(LIGHT_DEPS)
+DEPS_test_lights_sky_planes := $(LIGHT_DEPS) $(call obj,prepare/sky_tables)
+DEPS_test_lights_sky_planes_fine := $(patsubst %/lit.o,%/lit_fine.o,$(DEPS_test_lights_sky_planes))
 # The scene module: the loader, the API's scene calls, the images a scene reads.
 SCENE_DEPS := $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_dwa image/exr_huf image/hdr)
 DEPS_test_scene_shipped := $(BUILD)/tests/scene_files.o $(SCENE_DEPS)
@@ -185,10 +190,13 @@ $(BUILD)/tests/%.o: tests/bench/%.c
 $(BUILD)/tests/%.o: tests/support/%.c
 	$(compile_test)
 
-# test_lights again with the planes' sky tables at 512 cells a side, as pt
-# takes them under skies of 2048 columns or more (src/prepare/prepare.c).
-$(BUILD)/tests/test_lights_fine.o: TEST_CFLAGS := -DPORTAL_SKY_RES=512
-$(BUILD)/tests/test_lights_fine.o: tests/unit/test_lights.c
+# test_lights_sky_planes again with the planes' sky tables at 512 cells a
+# side, as pt takes them under skies of 2048 columns or more
+# (src/prepare/policy.c); lit.c holds the kernels' light code, so it too.
+$(BUILD)/tests/test_lights_sky_planes_fine.o $(BUILD)/tests/lit_fine.o: TEST_CFLAGS := -DPORTAL_SKY_RES=512
+$(BUILD)/tests/test_lights_sky_planes_fine.o: tests/unit/test_lights_sky_planes.c
+	$(compile_test)
+$(BUILD)/tests/lit_fine.o: tests/support/lit.c
 	$(compile_test)
 
 # Test binaries link their module objects (secondary expansion of DEPS_*).
