@@ -71,9 +71,16 @@ DEPS_test_scene_materials := $(BUILD)/tests/scene_files.o $(SCENE_DEPS)
 DEPS_test_scene_env := $(BUILD)/tests/scene_files.o $(SCENE_DEPS)
 DEPS_test_exr := $(call obj,core/error image/exr image/exr_dwa image/exr_huf image/png)
 DEPS_test_confine := $(SCENE_DEPS) $(call obj,image/png)
-DEPS_test_bdpt := $(BUILD)/tests/kernel_host.o $(BUILD)/tests/mis_oracle.o $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_dwa image/exr_huf image/hdr prepare/bvh_build prepare/light_tables prepare/prepare prepare/policy prepare/portal_flux prepare/sky_tables render/render_options)
-DEPS_test_portal := $(DEPS_test_bdpt)
-DEPS_test_punctual := $(DEPS_test_bdpt)
+# The kernels' integrators run on the host (tests/support/kernel_host.c) on
+# scenes as prepare_scene makes them; the MIS tests add the oracle.
+HOST_DEPS := $(BUILD)/tests/kernel_host.o $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_dwa image/exr_huf image/hdr prepare/bvh_build prepare/light_tables prepare/prepare prepare/policy prepare/portal_flux prepare/sky_tables render/render_options)
+DEPS_test_bdpt := $(BUILD)/tests/mis_oracle.o $(HOST_DEPS)
+DEPS_test_punctual := $(HOST_DEPS)
+PORTAL_DEPS := $(BUILD)/tests/portal_scenes.o $(HOST_DEPS)
+DEPS_test_portal_mis := $(BUILD)/tests/mis_oracle.o $(PORTAL_DEPS)
+DEPS_test_portal_groups := $(PORTAL_DEPS)
+DEPS_test_portal_sampling := $(PORTAL_DEPS)
+DEPS_test_portal_policy := $(PORTAL_DEPS)
 # Tests that render need the whole library.
 DEPS_test_layout := $(BUILD)/libajar.a
 DEPS_test_render := $(BUILD)/libajar.a
