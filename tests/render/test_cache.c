@@ -6,8 +6,9 @@
  * falls back to $XDG_CACHE_HOME/ajar, then ~/.cache/ajar; and the build
  * options each kind of device gets.
  *
- * Every test gets a fresh cache directory under one temporary root. PoCL
- * keeps a cache of its own, so POCL_CACHE_DIR points into the root too
+ * Every test gets a fresh cache directory under the group's temporary
+ * directory (test_dir). PoCL keeps a cache of its own, so POCL_CACHE_DIR
+ * points into test_dir too
  * (set before the first OpenCL call): the first build of the process is
  * cold in both caches, and the cold and cached build times printed are
  * measured, never asserted. */
@@ -28,7 +29,6 @@
 extern const unsigned ajar_layout_host[];
 extern const unsigned ajar_layout_count;
 
-static char *root; /* temporary root: every cache directory lives here */
 static unsigned next_dir;
 
 /* A fresh, not yet existing cache directory that AJAR_CACHE_DIR names
@@ -37,7 +37,7 @@ static char *fresh_cache_dir(void)
 {
 	char name[32];
 	snprintf(name, sizeof name, "cache%u", next_dir++);
-	char *dir = test_path(root, name);
+	char *dir = test_tmp(name);
 	assert_int_equal(setenv("AJAR_CACHE_DIR", dir, 1), 0);
 	return dir;
 }
@@ -256,7 +256,7 @@ static void test_corrupt_file_is_rebuilt(void **state)
 static void test_off_disables_the_cache(void **state)
 {
 	char *dir = fresh_cache_dir();
-	char *xdg = test_path(root, "xdg"), *home = test_path(root, "home");
+	char *xdg = test_tmp("xdg"), *home = test_tmp("home");
 	char names[4][256];
 	Device a, b;
 	build(&a, BASE_OPTIONS);
@@ -354,19 +354,23 @@ static void test_directory_fallbacks(void **state)
 	assert_null(device_cache_dir(buf, sizeof buf));
 }
 
-int main(void)
+/* The group's temporary directory, and the caches pointed into it. */
+static int setup(void **state)
 {
-	root = test_tmpdir();
-	if (!root) {
-		fprintf(stderr, "test_cache: cannot create a temporary directory\n");
-		return 1;
-	}
+	if (test_group_setup(state))
+		return -1;
 	/* Before any OpenCL call: PoCL reads it when the platform starts. */
-	char *pocl = test_path(root, "pocl");
+	char *pocl = test_tmp("pocl");
 	setenv("POCL_CACHE_DIR", pocl, 1);
+	free(pocl);
 	/* Every test names its own directory; until then nothing may touch
 	 * the user's cache. */
-	setenv("AJAR_CACHE_DIR", root, 1);
+	setenv("AJAR_CACHE_DIR", test_dir, 1);
+	return 0;
+}
+
+int main(void)
+{
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_second_build_loads_the_cache),
 		cmocka_unit_test(test_other_options_get_another_file),
@@ -376,9 +380,5 @@ int main(void)
 		cmocka_unit_test(test_build_options),
 		cmocka_unit_test(test_render_options),
 	};
-	int rc = cmocka_run_group_tests_name("cache", tests, NULL, NULL);
-	test_remove_tree(root);
-	free(pocl);
-	free(root);
-	return rc;
+	return cmocka_run_group_tests_name("cache", tests, setup, test_group_teardown);
 }

@@ -1,5 +1,5 @@
 /* test_bdpt.c — bidirectional path tracing, checked on the host with the
- * kernels' own code (tests/kernel_host.h):
+ * kernels' own code (tests/support/kernel_host.h):
  *   - MIS records: for random paths in the shipped scenes and a scene with
  *     glass, mirrors, an emitter and the sky, the densities bdpt_mis_path
  *     builds for a strategy equal those an independent oracle computes from

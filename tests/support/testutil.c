@@ -110,20 +110,26 @@ void test_remove_tree(const char *dir)
 	rmdir(dir);
 }
 
-int test_tmpdir_setup(char **dir)
+char *test_dir;
+
+int test_group_setup(void **state)
 {
-	*dir = test_tmpdir();
-	return *dir ? 0 : -1;
+	(void)state;
+	test_dir = test_tmpdir();
+	return test_dir ? 0 : -1;
 }
 
-int test_tmpdir_teardown(char **dir)
+int test_group_teardown(void **state)
 {
-	if (*dir)
-		test_remove_tree(*dir);
-	free(*dir);
-	*dir = NULL;
+	(void)state;
+	if (test_dir)
+		test_remove_tree(test_dir);
+	free(test_dir);
+	test_dir = NULL;
 	return 0;
 }
+
+char *test_tmp(const char *name) { return test_path(test_dir, name); }
 
 const char *test_ajar_bin(void)
 {

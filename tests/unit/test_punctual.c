@@ -1,5 +1,5 @@
 /* test_punctual.c — KHR_lights_punctual lights, checked on the host with
- * the kernels' own code (tests/kernel_host.h):
+ * the kernels' own code (tests/support/kernel_host.h):
  *   - analytic radiance of a Lambertian plane (albedo rho) lit by each
  *     light type, seen by a camera whose pixel covers a tiny patch: a
  *     directional light of illuminance E gives rho E cos(theta) / pi; a

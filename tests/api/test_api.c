@@ -32,8 +32,6 @@
  * sample count the mean is within about 10% of the reference's. */
 #define MEAN_TOLERANCE 0.25
 
-static char *tmpdir;
-
 /* Runs a shell command built printf-style; returns its exit status. */
 static int shell(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 static int shell(const char *fmt, ...)
@@ -51,17 +49,17 @@ static int shell(const char *fmt, ...)
 /* Prints a log file of a failed step into the test output. */
 static void show_log(const char *name)
 {
-	shell("sed 's/^/    /' '%s/%s' >&2", tmpdir, name);
+	shell("sed 's/^/    /' '%s/%s' >&2", test_dir, name);
 }
 
-/* README.md's example program, written to tmpdir/render.c. */
+/* README.md's example program, written to test_dir/render.c. */
 static void extract_example(void)
 {
 	FILE *in = fopen("README.md", "r");
 	if (!in)
 		fail_msg("README.md not found: run the test from the top of the source tree");
 	char path[512];
-	snprintf(path, sizeof path, "%s/render.c", tmpdir);
+	snprintf(path, sizeof path, "%s/render.c", test_dir);
 	FILE *out = fopen(path, "w");
 	assert_non_null(out);
 	char line[1024];
@@ -108,9 +106,9 @@ static void image_mean(const float *rgba, uint32_t w, uint32_t h, double mean[3]
 static float *render_and_check(const char *exe)
 {
 	char exr[512], log[64];
-	snprintf(exr, sizeof exr, "%s/%s.exr", tmpdir, exe);
+	snprintf(exr, sizeof exr, "%s/%s.exr", test_dir, exe);
 	snprintf(log, sizeof log, "%s.log", exe);
-	if (shell("'%s/%s' %s '%s' %d %d %d >'%s/%s' 2>&1", tmpdir, exe, CORNELL, exr, WIDTH, HEIGHT, SPP, tmpdir,
+	if (shell("'%s/%s' %s '%s' %d %d %d >'%s/%s' 2>&1", test_dir, exe, CORNELL, exr, WIDTH, HEIGHT, SPP, test_dir,
 		  log) != 0) {
 		show_log(log);
 		fail_msg("the README example (%s) failed", exe);
@@ -155,29 +153,29 @@ static void test_readme_example(void **state)
 	/* A make started by `make test` would inherit its MAKEFLAGS. */
 	if (shell("env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL make -s --no-print-directory install PREFIX='%s' "
 		  "MODE=release >'%s/install.log' 2>&1",
-		  tmpdir, tmpdir) != 0) {
+		  test_dir, test_dir) != 0) {
 		show_log("install.log");
-		fail_msg("make install PREFIX=%s MODE=release failed", tmpdir);
+		fail_msg("make install PREFIX=%s MODE=release failed", test_dir);
 	}
 
 	/* The README's two link lines. */
 	if (shell("cd '%s' && export PKG_CONFIG_PATH='%s/lib/pkgconfig' && "
 		  "cc -std=c11 -Wall -Wextra -Werror -o render_shared render.c $(pkg-config --cflags --libs ajar) "
 		  "-Wl,-rpath,'%s/lib' >cc_shared.log 2>&1",
-		  tmpdir, tmpdir, tmpdir) != 0) {
+		  test_dir, test_dir, test_dir) != 0) {
 		show_log("cc_shared.log");
 		fail_msg("cannot build the README example against libajar.so");
 	}
 	if (shell("cd '%s' && export PKG_CONFIG_PATH='%s/lib/pkgconfig' && "
 		  "cc -std=c11 -Wall -Wextra -Werror -o render_static render.c $(pkg-config --cflags ajar) "
 		  "$(pkg-config --static --libs ajar | sed 's/-lajar /-l:libajar.a /') >cc_static.log 2>&1",
-		  tmpdir, tmpdir) != 0) {
+		  test_dir, test_dir) != 0) {
 		show_log("cc_static.log");
 		fail_msg("cannot build the README example against libajar.a");
 	}
 	/* Linked as intended: one needs the installed libajar.so, the other not. */
-	assert_int_equal(shell("readelf -d '%s/render_shared' | grep -q 'NEEDED.*libajar\\.so\\.0'", tmpdir), 0);
-	assert_int_not_equal(shell("readelf -d '%s/render_static' | grep -q 'libajar'", tmpdir), 0);
+	assert_int_equal(shell("readelf -d '%s/render_shared' | grep -q 'NEEDED.*libajar\\.so\\.0'", test_dir), 0);
+	assert_int_not_equal(shell("readelf -d '%s/render_static' | grep -q 'libajar'", test_dir), 0);
 
 	float *shared = render_and_check("render_shared");
 	float *stat = render_and_check("render_static");
@@ -186,20 +184,8 @@ static void test_readme_example(void **state)
 	free(stat);
 }
 
-static int setup(void **state)
-{
-	(void)state;
-	return test_tmpdir_setup(&tmpdir);
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	return test_tmpdir_teardown(&tmpdir);
-}
-
 int main(void)
 {
 	const struct CMUnitTest tests[] = {cmocka_unit_test(test_readme_example)};
-	return cmocka_run_group_tests_name("api", tests, setup, teardown);
+	return cmocka_run_group_tests_name("api", tests, test_group_setup, test_group_teardown);
 }

@@ -32,7 +32,6 @@
 #define H 12
 #define SPP 16
 
-static char *tmpdir;
 static uint32_t lcg = 12345; /* the stop points: fixed seed */
 
 static uint32_t draw(uint32_t n)
@@ -72,8 +71,6 @@ static float *image(ajar_renderer *r)
 	return img;
 }
 
-static char *tmp(const char *name) { return test_path(tmpdir, name); }
-
 /* Passes may end faster than the callback runs: stop by samples done. */
 static uint32_t stop_at;
 static int stop_at_spp(const ajar_progress *p, void *user)
@@ -111,7 +108,7 @@ static void resume_equals_straight(const char *scene_path, ajar_integrator integ
 	ajar_scene *s = load(scene_path);
 	ajar_options o = options(integrator, strategy_len, aov);
 	ajar_renderer *r = NULL;
-	char *straight = tmp("straight.ck"), *ck = tmp("resumed.ck");
+	char *straight = test_tmp("straight.ck"), *ck = test_tmp("resumed.ck");
 	assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_OK);
 	assert_int_equal(ajar_renderer_render(r, NULL, NULL), AJAR_OK);
 	float *want = image(r);
@@ -225,7 +222,7 @@ static void test_refused(void **state)
 	ajar_options o = options(AJAR_INTEGRATOR_PT, 0, 0);
 	o.spp = 2;
 	ajar_renderer *r = NULL;
-	char *good = tmp("good.ck"), *bad = tmp("bad.ck");
+	char *good = test_tmp("good.ck"), *bad = test_tmp("bad.ck");
 	assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_OK);
 	assert_int_equal(ajar_renderer_render(r, NULL, NULL), AJAR_OK);
 	assert_int_equal(ajar_renderer_write_checkpoint(r, good), AJAR_OK);
@@ -326,7 +323,7 @@ static void test_failed_write_keeps_old(void **state)
 	ajar_options o = options(AJAR_INTEGRATOR_PT, 0, 0);
 	o.spp = 2;
 	ajar_renderer *r = NULL;
-	char *dir = tmp("keep"), *ck = test_path(dir, "render.ck");
+	char *dir = test_tmp("keep"), *ck = test_path(dir, "render.ck");
 	assert_int_equal(mkdir(dir, 0755), 0);
 	assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_OK);
 	assert_int_equal(ajar_renderer_render(r, NULL, NULL), AJAR_OK);
@@ -382,7 +379,7 @@ static void test_device_lost(void **state)
 	ajar_scene *s = load(SCENE("cornell/cornell.gltf"));
 	ajar_options o = options(AJAR_INTEGRATOR_PT, 0, 0);
 	ajar_renderer *r = NULL;
-	char *ck = tmp("lost.ck");
+	char *ck = test_tmp("lost.ck");
 	assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_OK);
 	assert_int_equal(ajar_renderer_render(r, NULL, NULL), AJAR_OK);
 	float *want = image(r);
@@ -420,7 +417,7 @@ static void test_device_lost(void **state)
 /* ---- The program, stopped by SIGINT ------------------------------------------ */
 
 /* Runs ajar with args; with delay_ms > 0 sends SIGINT after that long.
- * Returns the exit code; stderr goes to tmpdir/stderr.txt. */
+ * Returns the exit code; stderr goes to test_dir/stderr.txt. */
 static int run_ajar(const char *const *args, int delay_ms)
 {
 	const char *argv[40];
@@ -429,7 +426,7 @@ static int run_ajar(const char *const *args, int delay_ms)
 	for (; args[n - 1] && n < 39; n++)
 		argv[n] = args[n - 1];
 	argv[n] = NULL;
-	char *err = tmp("stderr.txt");
+	char *err = test_tmp("stderr.txt");
 	fflush(NULL);
 	pid_t pid = fork();
 	assert_true(pid >= 0);
@@ -454,7 +451,7 @@ static int run_ajar(const char *const *args, int delay_ms)
 
 static char *stderr_text(void)
 {
-	char *p = tmp("stderr.txt");
+	char *p = test_tmp("stderr.txt");
 	size_t n;
 	unsigned char *b = slurp(p, &n);
 	char *s = realloc(b, n + 1);
@@ -479,12 +476,12 @@ static void test_cli_sigint(void **state)
 	float *want = malloc(sizeof(float) * 4 * 24 * 24);
 	assert_non_null(want);
 	assert_int_equal(ajar_renderer_image(r, want, NULL, NULL), AJAR_OK);
-	char *straight = tmp("cli-straight.ck");
+	char *straight = test_tmp("cli-straight.ck");
 	assert_int_equal(ajar_renderer_write_checkpoint(r, straight), AJAR_OK);
 	ajar_renderer_destroy(&r);
 	ajar_scene_destroy(&s);
 
-	char *exr = tmp("cli.exr"), *strat = tmp("cli-strategies.exr"), *ck = tmp("cli.ck");
+	char *exr = test_tmp("cli.exr"), *strat = test_tmp("cli-strategies.exr"), *ck = test_tmp("cli.ck");
 	const char *first[] = {"render", SCENE("cornell/cornell.gltf"), "-o", exr, "--size", "24x24", "--spp", "1000",
 			       "--seed", "11", "--integrator", "bdpt", "--max-depth", "6", "--strategies", strat,
 			       "--strategy-len", "2", "--aov", "albedo,normal,depth,variance", "--checkpoint", ck, "-q", NULL};
@@ -561,18 +558,6 @@ static void test_cli_sigint(void **state)
 	free(ck);
 }
 
-static int setup(void **state)
-{
-	(void)state;
-	return test_tmpdir_setup(&tmpdir);
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	return test_tmpdir_teardown(&tmpdir);
-}
-
 int main(void)
 {
 	/* Before the OpenCL platform is first initialised. */
@@ -587,5 +572,5 @@ int main(void)
 		cmocka_unit_test(test_device_lost),
 		cmocka_unit_test(test_cli_sigint),
 	};
-	return cmocka_run_group_tests(tests, setup, teardown);
+	return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);
 }

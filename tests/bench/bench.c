@@ -17,6 +17,7 @@
 #include "prepare/prepare.h"
 #include "scene/scene.h"
 #include "device/upload.h"
+#include "testutil.h"
 
 static double now(void)
 {
@@ -299,8 +300,8 @@ int main(int argc, char **argv)
 			bench_scene(f, 1);
 		return 0;
 	}
-	char dir[] = "/tmp/ajar-bench-XXXXXX";
-	if (!mkdtemp(dir))
+	char *dir = test_tmpdir();
+	if (!dir)
 		return 1;
 	if (getenv("AJAR_BENCH_SCENES"))
 		goto equal_time;
@@ -328,7 +329,7 @@ equal_time:;
 		if (!only || strstr(only, stem))
 			bench_equal_time(scenes[i], 128, secs, 4 * secs);
 	}
-	char rm[128];
-	snprintf(rm, sizeof rm, "rm -rf %s", dir);
-	return system(rm) != 0;
+	test_remove_tree(dir);
+	free(dir);
+	return 0;
 }

@@ -20,17 +20,6 @@
 #define CORNELL SCENE("cornell/cornell.gltf")
 #define DOOR_AJAR SCENE("door-ajar/door-ajar.gltf")
 
-static char *tmpdir;
-
-static char *path_in(const char *name)
-{
-	size_t n = strlen(tmpdir) + strlen(name) + 2;
-	char *p = malloc(n);
-	assert_non_null(p);
-	snprintf(p, n, "%s/%s", tmpdir, name);
-	return p;
-}
-
 static int file_exists(const char *path)
 {
 	struct stat st;
@@ -53,7 +42,7 @@ static char *read_file(const char *path)
 }
 
 /* Starts ajar with `args` (NULL-terminated), stdout and stderr going to
- * files in tmpdir; returns the child's pid. */
+ * files in test_dir; returns the child's pid. */
 static pid_t spawn(const char *const *args)
 {
 	const char *argv[32];
@@ -64,7 +53,7 @@ static pid_t spawn(const char *const *args)
 		n++;
 	}
 	argv[n] = NULL;
-	char *out = path_in("stdout.txt"), *err = path_in("stderr.txt");
+	char *out = test_tmp("stdout.txt"), *err = test_tmp("stderr.txt");
 	pid_t pid = fork();
 	assert_true(pid >= 0);
 	if (pid == 0) {
@@ -96,7 +85,7 @@ static Result run(const char *const *args)
 {
 	Result r;
 	r.code = wait_exit(spawn(args));
-	char *o = path_in("stdout.txt"), *e = path_in("stderr.txt");
+	char *o = test_tmp("stdout.txt"), *e = test_tmp("stderr.txt");
 	r.out = read_file(o);
 	r.err = read_file(e);
 	unlink(o);
@@ -124,29 +113,17 @@ static void expect(const char *const *args, int code, const char *needle)
 	result_free(&r);
 }
 
-/* Number of entries in tmpdir (outputs that should not exist show up). */
+/* Number of entries in test_dir (outputs that should not exist show up). */
 static int count_tmp_entries(void)
 {
 	char cmd[512];
-	snprintf(cmd, sizeof cmd, "ls -A '%s' | wc -l", tmpdir);
+	snprintf(cmd, sizeof cmd, "ls -A '%s' | wc -l", test_dir);
 	FILE *p = popen(cmd, "r");
 	assert_non_null(p);
 	int n = -1;
 	assert_int_equal(fscanf(p, "%d", &n), 1);
 	pclose(p);
 	return n;
-}
-
-static int setup(void **state)
-{
-	(void)state;
-	return test_tmpdir_setup(&tmpdir);
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	return test_tmpdir_teardown(&tmpdir);
 }
 
 static void test_help_version(void **state)
@@ -175,7 +152,7 @@ static void test_help_version(void **state)
 
 static void test_usage_errors(void **state)
 {
-	char *out = path_in("never.exr");
+	char *out = test_tmp("never.exr");
 	expect((const char *[]){NULL}, 1, "usage");
 	expect((const char *[]){"frobnicate", NULL}, 1, "frobnicate");
 	expect((const char *[]){"--frobnicate", NULL}, 1, "--frobnicate");
@@ -200,8 +177,8 @@ static void test_usage_errors(void **state)
 
 static void test_bad_scenes(void **state)
 {
-	char *missing = path_in("missing.gltf"), *broken = path_in("broken.gltf"), *out = path_in("out.exr");
-	char *png = path_in("out.png");
+	char *missing = test_tmp("missing.gltf"), *broken = test_tmp("broken.gltf"), *out = test_tmp("out.exr");
+	char *png = test_tmp("out.png");
 	expect((const char *[]){"render", missing, "-o", out, "--png", png, NULL}, 2, missing);
 	expect((const char *[]){"info", missing, NULL}, 2, missing);
 
@@ -218,7 +195,7 @@ static void test_bad_scenes(void **state)
 
 	/* An output directory that does not exist is an I/O error, found
 	 * before rendering. */
-	char *nodir = path_in("no/such/dir/out.exr");
+	char *nodir = test_tmp("no/such/dir/out.exr");
 	expect((const char *[]){"render", CORNELL, "-o", nodir, NULL}, 4, nodir);
 	free(nodir);
 	free(missing);
@@ -246,7 +223,7 @@ static void test_info(void **state)
  * glTF's units. */
 static void test_info_lights(void **state)
 {
-	char *gltf = path_in("lights.gltf");
+	char *gltf = test_tmp("lights.gltf");
 	FILE *f = fopen(gltf, "w");
 	assert_non_null(f);
 	fputs("{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_lights_punctual\"],"
@@ -280,7 +257,7 @@ static void test_info_lights(void **state)
 
 static void test_tiny_render(void **state)
 {
-	char *exr = path_in("tiny.exr"), *png = path_in("tiny.png");
+	char *exr = test_tmp("tiny.exr"), *png = test_tmp("tiny.png");
 	Result r = run((const char *[]){"render", CORNELL, "-o", exr, "--png", png, "--size", "32x32", "--spp", "2",
 					"--seed", "7", NULL});
 	if (r.code != 0)
@@ -316,7 +293,7 @@ static void test_tiny_render(void **state)
  * `options`, which must not change a bit of the image. */
 static void same_image_with(const char *options, const char *scene, const char *integrator)
 {
-	char *out[2] = {path_in("plain.exr"), path_in("options.exr")};
+	char *out[2] = {test_tmp("plain.exr"), test_tmp("options.exr")};
 	float *px[2];
 	uint32_t w[2], h[2];
 	for (int i = 0; i < 2; i++) {
@@ -347,7 +324,7 @@ static void test_cl_options(void **state)
 	/* What the host adds for GPUs (kernels/base/compat.h): the same image. */
 	same_image_with("-DAJAR_CALLS", DOOR_AJAR, "portal");
 
-	char *bad = path_in("bad.exr");
+	char *bad = test_tmp("bad.exr");
 	const char *const args_bad[] = {"render", CORNELL, "-o", bad, "--size", "16x16", "--spp", "2", NULL};
 	assert_int_equal(setenv("AJAR_CL_OPTIONS", "-cl-ajar-no-such-option", 1), 0);
 	int entries = count_tmp_entries();
@@ -366,7 +343,7 @@ static double now(void)
 
 static void test_sigint(void **state)
 {
-	char *exr = path_in("long.exr"), *err = path_in("stderr.txt");
+	char *exr = test_tmp("long.exr"), *err = test_tmp("stderr.txt");
 	const uint32_t full_spp = 1000000;
 	char full[16];
 	snprintf(full, sizeof full, "%u", full_spp);
@@ -422,5 +399,5 @@ int main(void)
 		cmocka_unit_test(test_cl_options),
 		cmocka_unit_test(test_sigint),
 	};
-	return cmocka_run_group_tests(tests, setup, teardown);
+	return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);
 }

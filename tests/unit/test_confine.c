@@ -19,7 +19,7 @@
 
 #include "ajar.h"
 
-static char *tmpdir, *scene_dir;
+static char *scene_dir; /* test_dir/scene */
 
 static void write_bytes(const char *path, const void *data, size_t n)
 {
@@ -115,7 +115,7 @@ static void test_buffer_dotdot(void **state)
 static void test_buffer_absolute(void **state)
 {
 	(void)state;
-	char *abs = test_path(tmpdir, "outside.bin");
+	char *abs = test_tmp("outside.bin");
 	char *p = write_scene("absolute", abs, NULL, NULL);
 	refused_then_allowed(p, abs);
 	free(p);
@@ -169,7 +169,7 @@ static void test_environment_image(void **state)
 	char *p = write_scene("envout", "tri.bin", NULL, ",\"extras\":{\"environment\":{\"image\":\"../sky.exr\"}}");
 	refused_then_allowed(p, "../sky.exr");
 	free(p);
-	char *abs = test_path(tmpdir, "sky.exr");
+	char *abs = test_tmp("sky.exr");
 	char extras[512];
 	snprintf(extras, sizeof extras, ",\"extras\":{\"environment\":{\"image\":\"%s\"}}", abs);
 	p = write_scene("envabs", "tri.bin", NULL, extras);
@@ -183,26 +183,24 @@ static void test_environment_image(void **state)
 
 static int setup(void **state)
 {
-	(void)state;
-	tmpdir = test_tmpdir();
-	if (!tmpdir)
+	if (test_group_setup(state))
 		return -1;
-	scene_dir = test_path(tmpdir, "scene");
+	scene_dir = test_tmp("scene");
 	char *sub = test_path(scene_dir, "sub");
 	if (mkdir(scene_dir, 0755) || mkdir(sub, 0755))
 		return -1;
 	char *f;
-	write_tri(f = test_path(tmpdir, "outside.bin"));
+	write_tri(f = test_tmp("outside.bin"));
 	free(f);
 	write_tri(f = test_path(scene_dir, "tri.bin"));
 	free(f);
 	write_tri(f = test_path(sub, "inner.bin"));
 	free(f);
 	const float px[4 * 4] = {1, 1, 1, 1, 0.5f, 0.5f, 0.5f, 1, 0.25f, 0.25f, 0.25f, 1, 1, 0, 0, 1};
-	if (ajar_write_png(f = test_path(tmpdir, "outside.png"), px, 2, 2) != AJAR_OK)
+	if (ajar_write_png(f = test_tmp("outside.png"), px, 2, 2) != AJAR_OK)
 		return -1;
 	free(f);
-	if (ajar_write_exr(f = test_path(tmpdir, "sky.exr"), px, 2, 2, NULL, 0) != AJAR_OK)
+	if (ajar_write_exr(f = test_tmp("sky.exr"), px, 2, 2, NULL, 0) != AJAR_OK)
 		return -1;
 	free(f);
 	if (ajar_write_exr(f = test_path(sub, "sky.exr"), px, 2, 2, NULL, 0) != AJAR_OK)
@@ -219,11 +217,8 @@ static int setup(void **state)
 
 static int teardown(void **state)
 {
-	(void)state;
-	test_remove_tree(tmpdir);
 	free(scene_dir);
-	free(tmpdir);
-	return 0;
+	return test_group_teardown(state);
 }
 
 int main(void)

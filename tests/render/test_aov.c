@@ -21,8 +21,6 @@
 #define H 24
 #define SPP 16
 
-static char *tmpdir;
-
 static uint32_t material(ajar_scene *s, float r, float g, float b, float metallic, float transmission, float emit)
 {
 	ajar_material m;
@@ -227,7 +225,7 @@ static void test_integrators_and_exr(void **state)
 	assert_int_equal(ajar_renderer_render(r, NULL, NULL), AJAR_OK);
 	float *aov = malloc(sizeof(float) * 10 * W * H);
 	assert_int_equal(ajar_renderer_aovs(r, aov), AJAR_OK);
-	char *path = test_path(tmpdir, "aov.exr");
+	char *path = test_tmp("aov.exr");
 	assert_int_equal(ajar_renderer_write_exr(r, path), AJAR_OK);
 	ajar_renderer_destroy(&r);
 	/* Channels asked for are in the header, the others not. */
@@ -252,18 +250,6 @@ static void test_integrators_and_exr(void **state)
 	ajar_scene_destroy(&s);
 }
 
-static int setup(void **state)
-{
-	(void)state;
-	return test_tmpdir_setup(&tmpdir);
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	return test_tmpdir_teardown(&tmpdir);
-}
-
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -271,5 +257,5 @@ int main(void)
 		cmocka_unit_test(test_glass),	  cmocka_unit_test(test_variance),
 		cmocka_unit_test(test_integrators_and_exr),
 	};
-	return cmocka_run_group_tests(tests, setup, teardown);
+	return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);
 }

@@ -379,16 +379,19 @@ static unsigned scene_omit(const char *path)
 	return omit;
 }
 
-/* Feature-specialised programs (kernels/materials.md): the Cornell box has no
- * alpha, no tilted normals, no textures and no TriExtra, so its program is
- * built with all four -DAJAR_NO_* options, and renders the same bits as
+/* Feature-specialised programs (kernels/material/README.md): the Cornell box
+ * has no alpha, no tilted normals, no textures, no TriExtra and no panes, so
+ * its program is built with all five -DAJAR_NO_* options, and renders the same bits as
  * the general program (AJAR_KERNEL_FEATURES=all); scenes that have a
  * feature keep its code; a malformed AJAR_KERNEL_FEATURES is refused. */
 static void test_kernel_features(void **state)
 {
 	(void)state;
-	const unsigned all = DEVICE_OMIT_ALPHA | DEVICE_OMIT_BENT_NORMALS | DEVICE_OMIT_TEXTURES | DEVICE_OMIT_TRI_EXTRA;
+	const unsigned all = DEVICE_OMIT_ALPHA | DEVICE_OMIT_BENT_NORMALS | DEVICE_OMIT_TEXTURES | DEVICE_OMIT_TRI_EXTRA |
+			     DEVICE_OMIT_PANES;
 	assert_int_equal(scene_omit(SCENE("cornell/cornell.gltf")), all);
+	/* A glazed room has panes. */
+	assert_int_equal(scene_omit(SCENE("window-room/window-room-glazed.gltf")) & DEVICE_OMIT_PANES, 0);
 	unsigned alpha = scene_omit(SCENE("khronos/AlphaBlendModeTest/AlphaBlendModeTest.gltf"));
 	assert_int_equal(alpha & (DEVICE_OMIT_ALPHA | DEVICE_OMIT_TEXTURES), 0);
 	unsigned nmap = scene_omit(SCENE("khronos/NormalTangentTest/NormalTangentTest.gltf"));

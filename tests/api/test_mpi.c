@@ -31,10 +31,6 @@
 /* The image size: 32x32, 64x64 for the test that must render long enough. */
 static uint32_t W = 32, H = 32;
 
-static char *tmpdir;
-
-static char *tmp(const char *name) { return test_path(tmpdir, name); }
-
 static ajar_scene *load(const char *path)
 {
 	ajar_scene *s = NULL;
@@ -114,7 +110,7 @@ static void same_image(const char *exr, const float *want)
 
 /* Runs argv (NULL-terminated; "ajar" is replaced by the ajar command with
  * faults injected from its environment, test_ajar_faults_bin) with
- * stderr to tmpdir/stderr.txt. With kill_after set, waits until that file
+ * stderr to test_dir/stderr.txt. With kill_after set, waits until that file
  * exists and `pidfile` names a process, then sends SIGKILL to it. Returns
  * the exit status as the shell shows it (128 + signal when killed). */
 static int run(const char *const *args, const char *kill_after, const char *pidfile)
@@ -124,7 +120,7 @@ static int run(const char *const *args, const char *kill_after, const char *pidf
 	for (; args[n] && n < 63; n++)
 		argv[n] = strcmp(args[n], "ajar") ? args[n] : test_ajar_faults_bin();
 	argv[n] = NULL;
-	char *err = tmp("stderr.txt");
+	char *err = test_tmp("stderr.txt");
 	fflush(NULL);
 	pid_t pid = fork();
 	assert_true(pid >= 0);
@@ -172,7 +168,7 @@ static int run(const char *const *args, const char *kill_after, const char *pidf
 
 static char *stderr_text(void)
 {
-	char *p = tmp("stderr.txt");
+	char *p = test_tmp("stderr.txt");
 	FILE *f = fopen(p, "rb");
 	assert_non_null(f);
 	char *s = calloc(1, 65536);
@@ -214,7 +210,8 @@ static void test_two_ranks_equal_one(void **state)
 {
 	(void)state;
 	skip_without_mpi();
-	char *ck1 = tmp("one.ck"), *ck2 = tmp("two.ck"), *exr = tmp("two.exr"), *strat = tmp("two-strat.exr");
+	char *ck1 = test_tmp("one.ck"), *ck2 = test_tmp("two.ck"), *exr = test_tmp("two.exr");
+	char *strat = test_tmp("two-strat.exr");
 	float *want = one_process(SCENE("cornell/cornell.gltf"), AJAR_INTEGRATOR_PT, 40, 0, 0, ck1);
 	/* Small passes (the test hook), so both ranks get many ranges. */
 	const char *pt[] = {MPIRUN, "-n", "2", "env", "AJAR_TEST_PASS_SPP=2", "ajar", "render",
@@ -256,7 +253,7 @@ static void test_time_limit(void **state)
 	(void)state;
 	skip_without_mpi();
 	W = H = 16; /* a second at 16x16 is already some 1500 spp */
-	char *ck1 = tmp("one.ck"), *ck2 = tmp("two.ck"), *exr = tmp("two.exr");
+	char *ck1 = test_tmp("one.ck"), *ck2 = test_tmp("two.ck"), *exr = test_tmp("two.exr");
 	const char *args[] = {MPIRUN, "-n", "2", "env", "AJAR_TEST_PASS_SPP=2", "ajar", "render",
 			      SCENE("cornell/cornell.gltf"), "-o", exr, "--size", "16x16", "--time", "1", "--seed",
 			      "5", "--max-depth", "6", "--checkpoint", ck2, "-q", NULL};
@@ -298,7 +295,7 @@ static void test_device_fails_in_rank1(void **state)
 {
 	(void)state;
 	skip_without_mpi();
-	char *ck1 = tmp("one.ck"), *ck2 = tmp("two.ck"), *exr = tmp("two.exr");
+	char *ck1 = test_tmp("one.ck"), *ck2 = test_tmp("two.ck"), *exr = test_tmp("two.exr");
 	float *want = one_process(SCENE("cornell/cornell.gltf"), AJAR_INTEGRATOR_PT, 40, 0, 0, ck1);
 	static const char *const modes[] = {"AJAR_TEST_FAIL_DEVICE=0:4", "AJAR_TEST_FAIL_DEVICE=0:4:lost"};
 	for (int m = 0; m < 2; m++) {
@@ -333,7 +330,8 @@ static void test_rank_killed(void **state)
 	(void)state;
 	skip_without_mpi();
 	W = H = 64;
-	char *ck1 = tmp("one.ck"), *ck2 = tmp("two.ck"), *exr = tmp("two.exr"), *pid = tmp("rank1.pid");
+	char *ck1 = test_tmp("one.ck"), *ck2 = test_tmp("two.ck"), *exr = test_tmp("two.exr");
+	char *pid = test_tmp("rank1.pid");
 	char script[512], spp[16];
 	snprintf(script, sizeof script, "echo $$ > %s; exec \"$0\" \"$@\"", pid);
 	/* On a machine fast enough to finish before the kill, again with 4x the samples. */
@@ -385,7 +383,7 @@ static void test_rank_cannot_start(void **state)
 {
 	(void)state;
 	skip_without_mpi();
-	char *exr = tmp("never.exr");
+	char *exr = test_tmp("never.exr");
 	static const struct {
 		const char *scene, *device;
 		int rc;
@@ -409,18 +407,6 @@ static void test_rank_cannot_start(void **state)
 	free(exr);
 }
 
-static int setup(void **state)
-{
-	(void)state;
-	return test_tmpdir_setup(&tmpdir);
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	return test_tmpdir_teardown(&tmpdir);
-}
-
 int main(void)
 {
 	/* The in-process reference renders with one PoCL thread too (the same
@@ -433,5 +419,5 @@ int main(void)
 		cmocka_unit_test(test_rank_killed),
 		cmocka_unit_test(test_rank_cannot_start),
 	};
-	return cmocka_run_group_tests(tests, setup, teardown);
+	return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);
 }

@@ -32,13 +32,19 @@ char *test_tmpdir(void);
 char *test_path(const char *dir, const char *name);
 /* Removes dir and everything under it (links are not followed). */
 void test_remove_tree(const char *dir);
-/* A group's fixtures for a file-wide temporary directory: *dir gets a
- * fresh one (0, or -1 if none could be made); teardown removes it. */
-int test_tmpdir_setup(char **dir);
-int test_tmpdir_teardown(char **dir);
+/* The one temporary-directory set-up of the test binaries: a group's
+ * fixtures (cmocka_run_group_tests(tests, test_group_setup,
+ * test_group_teardown)) that give the whole file one fresh directory,
+ * test_dir, and remove it with everything in it afterwards. Setup fails
+ * the group (-1) if no directory can be made. */
+extern char *test_dir;
+int test_group_setup(void **state);
+int test_group_teardown(void **state);
+/* "test_dir/name", malloc'ed. */
+char *test_tmp(const char *name);
 /* The ajar program the CLI tests run: $AJAR_BIN, else build/ajar. */
 const char *test_ajar_bin(void);
-/* tests/ajar_faults.c's program, beside the running test binary: the ajar
+/* tests/support/ajar_faults.c's program, beside the running test binary: the ajar
  * command with faults injected from AJAR_TEST_FAIL_DEVICE and
  * AJAR_TEST_PASS_SPP in its environment. */
 const char *test_ajar_faults_bin(void);
