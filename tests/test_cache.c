@@ -1,4 +1,4 @@
-/* test_cache.c — the kernel binary cache of src/device/device.c: a first build
+/* test_cache.c — the kernel binary cache of src/device/device_build.c: a first build
  * compiles and writes exactly one cache file, the next build of the same
  * source and options loads it and the program runs; other options get
  * their own file; a corrupted file is detected, rebuilt and replaced by a
@@ -19,7 +19,8 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "device/device.h"
+#include "device/device_build.h"
+#include "device/device_plan.h"
 #include "device/kernel_source.h"
 #include "testutil.h"
 
@@ -32,7 +33,7 @@ static char *root; /* temporary root: every cache directory lives here */
 static unsigned next_dir;
 
 /* A fresh, not yet existing cache directory that AJAR_CACHE_DIR names
- * (device.c creates it on the first write). */
+ * (device_build.c creates it on the first write). */
 static char *fresh_cache_dir(void)
 {
 	char name[32];

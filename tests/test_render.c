@@ -19,7 +19,7 @@
 #include <string.h>
 
 #include "ajar.h"
-#include "device/device.h"
+#include "device/device_plan.h"
 #include "image/exr.h"
 #include "prepare/prepare.h"
 #include "render/render_overrides.h"

@@ -10,7 +10,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "device/device.h"
+#include "device/device_plan.h"
 #include "core/error.h"
 #include "prepare/policy.h"
 #include "prepare/portal_flux.h"

@@ -17,7 +17,7 @@ typedef struct {
 	int sky_res;             /* cells a side of the planes' sky tables: the program's PORTAL_SKY_RES (kernels/light/portal_sky.h) */
 	double bvh_seconds;
 	V3 bmin, bmax;
-	unsigned kernel_omit; /* DEVICE_OMIT_* (device.h): features no triangle or material uses */
+	unsigned kernel_omit; /* DEVICE_OMIT_* (device/device_plan.h): features no triangle or material uses */
 } SceneData;
 
 /* Prepares s for a width x height image rendered with the options o

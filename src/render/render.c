@@ -35,7 +35,8 @@
 
 #include "render/checkpoint_file.h"
 #include "render/cluster.h"
-#include "device/device.h"
+#include "device/device_build.h"
+#include "device/device_plan.h"
 #include "core/env_vars.h"
 #include "core/error.h"
 #include "image/exr.h"

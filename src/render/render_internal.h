@@ -14,7 +14,7 @@
 
 #include "ajar.h"
 #include "render/checkpoint_file.h"
-#include "device/device.h"
+#include "device/device_plan.h"
 #include "prepare/prepare.h"
 #include "device/upload.h"
 
