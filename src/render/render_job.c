@@ -4,17 +4,21 @@
  * rank of a failure anywhere). Rank 0 adds one device per device of the
  * other ranks to its scheduler, each driven by a proxy thread
  * (job_proxy_thread) that takes ranges with scheduler_take_range like a
- * device thread, sends them to that rank and counts them done when the answer comes: the dealing by measured
- * speed, the time limit, cancels, checkpoints and device failures are rank
- * 0's, exactly as for its own devices. The other ranks serve (job_serve):
- * they render the ranges they are sent, and on a gather (at a checkpoint
- * and at the end) sum their films into rank 0's `remote` films with an MPI
- * reduction. Every sum is of integers, so the image is the same bits as
- * one process that rendered the same sample indices. A device that fails
- * on another rank is dropped like a local one (that rank keeps its film
- * when it can, as the salvage does here). A rank that stops answering
- * (killed; mpirun then stops the whole job) cannot be summed: the render
- * ends with an error and nothing but the last checkpoint is kept. */
+ * device thread, sends them to that rank and counts them done when the
+ * answer comes: the dealing by measured speed, the time limit, cancels,
+ * checkpoints and device failures are rank 0's, exactly as for its own
+ * devices. The other ranks serve (job_serve): they render the ranges they
+ * are sent, and on a gather (at a checkpoint and at the end) sum their
+ * films into rank 0's `remote` films with an MPI reduction. Every sum is
+ * of integers, so the image is the same bits as one process that rendered
+ * the same sample indices. A device that fails on another rank is dropped
+ * like a local one (that rank keeps its film when it can, as the salvage
+ * does here). A rank that stops answering (killed; mpirun then stops the
+ * whole job) cannot be summed: the render ends with an error and nothing
+ * but the last checkpoint is kept. A resumed job reads its checkpoint in
+ * render_checkpoint.c. */
+#include "render/render_job.h"
+
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -22,10 +26,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/checkpoint_file.h"
-#include "render/cluster.h"
 #include "core/error.h"
-#include "render/render_internal.h"
+#include "render/cluster.h"
+#include "render/render_device.h"
+#include "render/render_film.h"
+#include "render/render_scheduler.h"
 
 enum { JOB_PASS = 1, JOB_GATHER, JOB_END };
 /* TAG_PASS, TAG_DONE and TAG_WHY + the device's index on its rank */
@@ -130,49 +135,6 @@ ajar_status job_join(ajar_renderer *r, ajar_status st)
 	return st;
 }
 
-/* Rank 0: the options of a resumed job come from the checkpoint, read
- * here only; the other ranks receive them (they need no copy of the file). */
-ajar_status job_resume(const ajar_scene *scene, const char *path, const ajar_options *o,
-		       ajar_renderer **out)
-{
-	struct {
-		int32_t status;
-		char error[1024];
-		ajar_options want;
-	} msg;
-	memset(&msg, 0, sizeof msg);
-	Checkpoint c;
-	int have = 0;
-	ajar_status st = AJAR_OK;
-	if (cluster_rank() == 0) {
-		st = checkpoint_read(path, &c, 0);
-		have = st == AJAR_OK;
-		if (have) {
-			options_from_checkpoint(&c, &msg.want);
-			st = resume_options(&msg.want, o, path);
-		}
-		msg.status = (int32_t)st;
-		if (st != AJAR_OK)
-			snprintf(msg.error, sizeof msg.error, "%s", ajar_last_error());
-		msg.want.device = NULL;
-	}
-	if (cluster_bcast(&msg, sizeof msg, NULL) != 1) {
-		if (have)
-			checkpoint_free(&c);
-		return AJAR_ERROR_DEVICE;
-	}
-	msg.want.device = o ? o->device : NULL;
-	if (msg.status != AJAR_OK) {
-		if (have)
-			checkpoint_free(&c);
-		return cluster_rank() == 0 ? st : err_set((ajar_status)msg.status, "rank 0: %s", msg.error);
-	}
-	st = renderer_new(scene, &msg.want, NULL, have ? &c : NULL, have ? path : NULL, out);
-	if (have)
-		checkpoint_free(&c);
-	return st;
-}
-
 /* Rank 0: the thread of a device of another rank. It keeps two ranges
  * there (PIPELINE): the device starts the next as soon as it ends one, so
  * the messages' latency is hidden. The speed is measured from one end of
@@ -220,12 +182,7 @@ void *job_proxy_thread(void *arg)
 		r->in_flight--;
 		r->events++;
 		if (rc == 1 && d.ok) {
-			if (!range_list_push(&rd->done, g))
-				r->out_of_memory = 1;
-			rd->spp_kept += g.count;
-			rd->busy_seconds += t - start;
-			rd->per_spp = (t - start) / g.count;
-			r->spp_done += g.count;
+			scheduler_range_done(r, rd, g, t - start);
 			if (d.idle >= 0) {
 				rd->job_ranges++;
 				rd->job_idle += d.idle;
@@ -248,7 +205,7 @@ void *job_proxy_thread(void *arg)
 			if (!r->job_lost)
 				r->job_lost = rd->rank;
 		}
-		render_drop_device(r, rd, g, NULL, NULL, rc == 1 && d.kept);
+		scheduler_drop_device(r, rd, g, NULL, NULL, rc == 1 && d.kept);
 		for (int k = 0; k < nq; k++) { /* queued there, never rendered */
 			if (!range_list_push(&r->holes, q[k]))
 				r->out_of_memory = 1;
@@ -274,7 +231,7 @@ void *job_proxy_thread(void *arg)
 /* Rank 0: the other ranks' films summed into r->remote. */
 ajar_status job_gather(ajar_renderer *r)
 {
-	size_t n = 3 * (size_t)r->width * r->height, ns = render_splat_count(r);
+	size_t n = 3 * (size_t)r->width * r->height, ns = film_splat_count(r);
 	if (!r->remote) {
 		r->remote = calloc(n ? n : 1, sizeof *r->remote);
 		r->remote_splat = calloc(ns ? ns : 1, sizeof *r->remote_splat);
@@ -370,19 +327,19 @@ static void *job_device_thread(void *arg)
 		int film_ok = 0;
 		double t0 = render_seconds();
 		d.idle = ended < 0 ? -1.0 : t0 - ended;
-		d.ok = rd->alive && render_run_pass(rd, g, &film_ok);
+		d.ok = rd->alive && render_device_pass(rd, g, &film_ok);
 		ended = render_seconds();
 		long *accum = NULL, *splat = NULL;
 		if (!d.ok && rd->alive) {
 			if (film_ok)
-				render_read_films(rd, &accum, &splat);
+				film_read(rd, &accum, &splat);
 			snprintf(why.text, sizeof why.text, "%s", rd->error);
 		} else if (!d.ok) {
 			snprintf(why.text, sizeof why.text, "device %d of rank %d was dropped before", index, cluster_rank());
 		}
 		if (!d.ok && rd->alive) {
 			pthread_mutex_lock(&r->lock);
-			d.kept = accum && render_salvage_add(r, accum, splat);
+			d.kept = accum && film_salvage_add(r, accum, splat);
 			rd->alive = 0; /* its film is in the salvage, or lost: rank 0 renders those ranges again */
 			pthread_mutex_unlock(&r->lock);
 		}
@@ -419,10 +376,10 @@ ajar_status job_serve(ajar_renderer *r)
 		}
 		if (c.op == JOB_GATHER) {
 			/* Rank 0 gathers only while no pass is in flight anywhere. */
-			size_t n = 3 * (size_t)r->width * r->height, ns = render_splat_count(r);
+			size_t n = 3 * (size_t)r->width * r->height, ns = film_splat_count(r);
 			JobDone d = {1, 0, -1.0};
 			JobWhy why = {""};
-			if (render_reduce(r) != AJAR_OK) {
+			if (film_reduce(r) != AJAR_OK) {
 				d.ok = 0;
 				snprintf(why.text, sizeof why.text, "%s", ajar_last_error());
 				memset(r->film, 0, n * sizeof *r->film);
