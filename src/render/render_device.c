@@ -16,6 +16,33 @@
 #include "render/render_film.h"
 #include "render/render_overrides.h"
 
+/* An explicit work-group size, measured on PoCL 3.1's CPU device (2
+ * cores, 128x128 path tracing, first pass = PoCL's cold work-group
+ * compile + 1 spp; Msamples/s over 16 spp; two runs each):
+ *   local    cornell: first pass, speed    bathroom: first pass, speed
+ *   1        0.63/0.61 s, 1.69/1.77        0.71/0.74 s, 0.35/0.25
+ *   8        0.61/0.68 s, 1.74/1.57        0.73/0.70 s, 0.34/0.38
+ *   64       0.63/0.68 s, 1.69/1.56        0.81/0.69 s, 0.33/0.38
+ *   NULL     crashes (SIGSEGV in PoCL's work-group function) at 128x128
+ *            and 256x256: PoCL picks 4096 work-items per group.
+ * On the CPU the choice is within noise; 64 is a multiple of every GPU's
+ * SIMD width, capped by what the compiled kernel allows. */
+static ajar_status work_group_size(RenderDevice *rd)
+{
+	Device *d = &rd->dev;
+	size_t max_local = 0;
+	CL_TRY(d, clGetKernelWorkGroupInfo(rd->k_render, d->id, CL_KERNEL_WORK_GROUP_SIZE, sizeof max_local,
+					   &max_local, NULL));
+	for (rd->local = 64; rd->local > 1 && rd->local > max_local; rd->local /= 2)
+		;
+	if (rd->plan.soa && rd->plan.capacity % rd->local)
+		rd->plan.capacity -= rd->plan.capacity % rd->local; /* whole groups; the stride is the built one */
+	if (rd->plan.soa && rd->plan.capacity == 0)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "device %s: subpath capacity below the work-group size %zu",
+			       d->name, rd->local);
+	return AJAR_OK;
+}
+
 /* Context, program, scene and films on one device. */
 static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_id plat, cl_device_id id)
 {
@@ -64,27 +91,8 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 	CL_TRY(d, clSetKernelArg(rd->k_render, rd->arg_first + 4, sizeof aov_at, &aov_at));
 	CL_TRY(d, clSetKernelArg(rd->k_render, rd->arg_first + 5, sizeof(cl_mem), &rd->scratch));
 	CL_TRY(d, clFinish(d->queue));
-	/* An explicit work-group size, measured on PoCL 3.1's CPU device (2
-	 * cores, 128x128 path tracing, first pass = PoCL's cold work-group
-	 * compile + 1 spp; Msamples/s over 16 spp; two runs each):
-	 *   local    cornell: first pass, speed    bathroom: first pass, speed
-	 *   1        0.63/0.61 s, 1.69/1.77        0.71/0.74 s, 0.35/0.25
-	 *   8        0.61/0.68 s, 1.74/1.57        0.73/0.70 s, 0.34/0.38
-	 *   64       0.63/0.68 s, 1.69/1.56        0.81/0.69 s, 0.33/0.38
-	 *   NULL     crashes (SIGSEGV in PoCL's work-group function) at 128x128
-	 *            and 256x256: PoCL picks 4096 work-items per group.
-	 * On the CPU the choice is within noise; 64 is a multiple of every GPU's
-	 * SIMD width, capped by what the compiled kernel allows. */
-	size_t max_local = 0;
-	CL_TRY(d, clGetKernelWorkGroupInfo(rd->k_render, d->id, CL_KERNEL_WORK_GROUP_SIZE, sizeof max_local,
-					   &max_local, NULL));
-	for (rd->local = 64; rd->local > 1 && rd->local > max_local; rd->local /= 2)
-		;
-	if (rd->plan.soa && rd->plan.capacity % rd->local)
-		rd->plan.capacity -= rd->plan.capacity % rd->local; /* whole groups; the stride is the built one */
-	if (rd->plan.soa && rd->plan.capacity == 0)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "device %s: subpath capacity below the work-group size %zu",
-			       d->name, rd->local);
+	if ((st = work_group_size(rd)) != AJAR_OK)
+		return st;
 	if (rd->plan.soa || rd->plan.lanes > 1)
 		log_msg(AJAR_LOG_INFO, "device %s: subpaths %s, %u work-items a pixel, at most %zu a launch", d->name,
 			rd->plan.soa ? "in global memory" : "private", rd->plan.lanes,

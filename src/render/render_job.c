@@ -63,6 +63,40 @@ typedef struct {
 	char selector[MAX_RENDER_DEVICES][16];
 } JobHello;
 
+/* Rank 0 deals to every device of every rank: the other ranks' devices
+ * join r->devs, each driven by a proxy thread, and every name says its rank. */
+static ajar_status add_remote_devices(ajar_renderer *r, const JobHello *all, int size)
+{
+	uint32_t total = r->ndev;
+	for (int k = 1; k < size; k++)
+		total += all[k].ndev;
+	RenderDevice *devs = realloc(r->devs, sizeof *devs * total);
+	if (!devs)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory");
+	r->devs = devs;
+	memset(devs + r->ndev, 0, sizeof *devs * (total - r->ndev));
+	size_t len = 0;
+	for (uint32_t i = 0; i < r->ndev; i++) {
+		snprintf(devs[i].dev.selector, sizeof devs[i].dev.selector, "rank 0, %s", all[0].selector[i]);
+		len += (size_t)snprintf(r->device_names + len, sizeof r->device_names - len, "%s%s (%s)",
+					i ? " + " : "", devs[i].dev.name, devs[i].dev.selector);
+	}
+	for (int k = 1; k < size; k++)
+		for (uint32_t j = 0; j < all[k].ndev; j++) {
+			RenderDevice *rd = &devs[r->ndev++];
+			rd->r = r;
+			rd->alive = 1;
+			rd->rank = k;
+			rd->remote = j;
+			snprintf(rd->dev.name, sizeof rd->dev.name, "%s", all[k].name[j]);
+			snprintf(rd->dev.selector, sizeof rd->dev.selector, "rank %d, %s", k % 100000, all[k].selector[j]);
+			if (len < sizeof r->device_names)
+				len += (size_t)snprintf(r->device_names + len, sizeof r->device_names - len, " + %s (%s)",
+							rd->dev.name, rd->dev.selector);
+		}
+	return AJAR_OK;
+}
+
 ajar_status job_join(ajar_renderer *r, ajar_status st)
 {
 	int size = cluster_size(), me = cluster_rank();
@@ -101,38 +135,48 @@ ajar_status job_join(ajar_renderer *r, ajar_status st)
 				     "rank %d (%s) prepared another scene or other options than rank 0 (%s): every rank "
 				     "must read the same scene files with the same options",
 				     k, all[k].host, all[0].host);
-	uint32_t total = r->ndev;
-	for (int k = 1; k < size; k++)
-		total += all[k].ndev;
-	RenderDevice *devs = st == AJAR_OK && me == 0 ? realloc(r->devs, sizeof *devs * total) : NULL;
-	if (st == AJAR_OK && me == 0 && !devs)
-		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory");
-	if (st == AJAR_OK && me == 0) {
-		/* Rank 0 deals to every device of every rank. */
-		r->devs = devs;
-		memset(devs + r->ndev, 0, sizeof *devs * (total - r->ndev));
-		size_t len = 0;
-		for (uint32_t i = 0; i < r->ndev; i++) {
-			snprintf(devs[i].dev.selector, sizeof devs[i].dev.selector, "rank 0, %s", all[0].selector[i]);
-			len += (size_t)snprintf(r->device_names + len, sizeof r->device_names - len, "%s%s (%s)",
-						i ? " + " : "", devs[i].dev.name, devs[i].dev.selector);
-		}
-		for (int k = 1; k < size; k++)
-			for (uint32_t j = 0; j < all[k].ndev; j++) {
-				RenderDevice *rd = &devs[r->ndev++];
-				rd->r = r;
-				rd->alive = 1;
-				rd->rank = k;
-				rd->remote = j;
-				snprintf(rd->dev.name, sizeof rd->dev.name, "%s", all[k].name[j]);
-				snprintf(rd->dev.selector, sizeof rd->dev.selector, "rank %d, %s", k % 100000, all[k].selector[j]);
-				if (len < sizeof r->device_names)
-					len += (size_t)snprintf(r->device_names + len, sizeof r->device_names - len, " + %s (%s)",
-								rd->dev.name, rd->dev.selector);
-			}
-	}
+	if (st == AJAR_OK && me == 0)
+		st = add_remote_devices(r, all, size);
 	free(all);
 	return st;
+}
+
+/* Rank 0, under the lock (left while it receives): range g of rd came back
+ * failed (rc 1, with the device's answer d) or not at all (rc from
+ * cluster_recv: the rank stopped answering). rd is dropped, and the nq
+ * ranges queued behind g there come back unrendered. */
+static void proxy_drop(ajar_renderer *r, RenderDevice *rd, Range g, const Range *q, int nq, int rc, JobDone *d)
+{
+	int tag_done = TAG_DONE + (int)rd->remote, tag_why = TAG_WHY + (int)rd->remote;
+	if (rc == 1) {
+		JobWhy why = {"?"};
+		pthread_mutex_unlock(&r->lock);
+		rc = cluster_recv(rd->rank, tag_why, &why, sizeof why, NULL, NULL, &r->cancel);
+		pthread_mutex_lock(&r->lock);
+		why.text[sizeof why.text - 1] = '\0';
+		snprintf(rd->error, sizeof rd->error, "%s", why.text);
+	}
+	if (rc != 1) {
+		snprintf(rd->error, sizeof rd->error, "rank %d stopped answering%s%s", rd->rank,
+			 rc < 0 ? ": " : " (killed, or its machine failed)", rc < 0 ? ajar_last_error() : "");
+		if (!r->job_lost)
+			r->job_lost = rd->rank;
+	}
+	scheduler_drop_device(r, rd, g, NULL, NULL, rc == 1 && d->kept);
+	for (int k = 0; k < nq; k++) { /* queued there, never rendered */
+		if (!range_list_push(&r->holes, q[k]))
+			r->out_of_memory = 1;
+		r->in_flight--;
+	}
+	if (rc == 1 && nq) { /* their answers, so no message is left behind */
+		pthread_mutex_unlock(&r->lock);
+		JobWhy why;
+		for (int k = 0; k < nq; k++)
+			if (cluster_recv(rd->rank, tag_done, d, sizeof *d, NULL, NULL, &r->cancel) == 1 && !d->ok)
+				cluster_recv(rd->rank, tag_why, &why, sizeof why, NULL, NULL, &r->cancel);
+		pthread_mutex_lock(&r->lock);
+	}
+	pthread_cond_broadcast(&r->cond);
 }
 
 /* Rank 0: the thread of a device of another rank. It keeps two ranges
@@ -149,8 +193,7 @@ void *job_proxy_thread(void *arg)
 	ajar_renderer *r = rd->r;
 	Range q[PIPELINE];
 	double sent[PIPELINE], last = 0;
-	int nq = 0, tag_pass = TAG_PASS + (int)rd->remote, tag_done = TAG_DONE + (int)rd->remote,
-	    tag_why = TAG_WHY + (int)rd->remote;
+	int nq = 0, tag_pass = TAG_PASS + (int)rd->remote, tag_done = TAG_DONE + (int)rd->remote;
 	pthread_mutex_lock(&r->lock);
 	for (;;) {
 		int lost = 0;
@@ -191,35 +234,7 @@ void *job_proxy_thread(void *arg)
 			pthread_cond_broadcast(&r->cond);
 			continue;
 		}
-		if (rc == 1) {
-			JobWhy why = {"?"};
-			pthread_mutex_unlock(&r->lock);
-			rc = cluster_recv(rd->rank, tag_why, &why, sizeof why, NULL, NULL, &r->cancel);
-			pthread_mutex_lock(&r->lock);
-			why.text[sizeof why.text - 1] = '\0';
-			snprintf(rd->error, sizeof rd->error, "%s", why.text);
-		}
-		if (rc != 1) {
-			snprintf(rd->error, sizeof rd->error, "rank %d stopped answering%s%s", rd->rank,
-				 rc < 0 ? ": " : " (killed, or its machine failed)", rc < 0 ? ajar_last_error() : "");
-			if (!r->job_lost)
-				r->job_lost = rd->rank;
-		}
-		scheduler_drop_device(r, rd, g, NULL, NULL, rc == 1 && d.kept);
-		for (int k = 0; k < nq; k++) { /* queued there, never rendered */
-			if (!range_list_push(&r->holes, q[k]))
-				r->out_of_memory = 1;
-			r->in_flight--;
-		}
-		if (rc == 1 && nq) { /* their answers, so no message is left behind */
-			pthread_mutex_unlock(&r->lock);
-			JobWhy why;
-			for (int k = 0; k < nq; k++)
-				if (cluster_recv(rd->rank, tag_done, &d, sizeof d, NULL, NULL, &r->cancel) == 1 && !d.ok)
-					cluster_recv(rd->rank, tag_why, &why, sizeof why, NULL, NULL, &r->cancel);
-			pthread_mutex_lock(&r->lock);
-		}
-		pthread_cond_broadcast(&r->cond);
+		proxy_drop(r, rd, g, q, nq, rc, &d);
 		break;
 	}
 	r->running--;

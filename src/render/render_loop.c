@@ -114,27 +114,11 @@ static int report_drops(ajar_renderer *r)
 	return drops;
 }
 
-ajar_status render_loop(ajar_renderer *r, ajar_progress_fn fn, void *user)
+/* The calling thread, under the lock, until every device thread ended:
+ * after each pass event the progress callback, warnings of dropped
+ * devices, and a checkpoint when one is due. */
+static void wait_passes(ajar_renderer *r, ajar_progress_fn fn, void *user)
 {
-	pthread_mutex_lock(&r->lock);
-	r->t0 = render_seconds() - r->elapsed;
-	r->ckpt_last = render_seconds();
-	r->running = 0;
-	for (uint32_t i = 0; i < r->ndev; i++) {
-		RenderDevice *rd = &r->devs[i];
-		/* A device of another rank is driven by a proxy thread (render_job.c). */
-		rd->started = rd->alive && pthread_create(&rd->thread, NULL, rd->rank ? job_proxy_thread : device_thread,
-							  rd) == 0;
-		r->running += (uint32_t)rd->started;
-	}
-	if (r->running == 0 && r->last_dropped != NULL) {
-		pthread_mutex_unlock(&r->lock);
-		return err_set(AJAR_ERROR_DEVICE, "no OpenCL device left (the last failed: %s)", r->last_dropped->error);
-	}
-	if (r->running == 0 && scheduler_work_left(r) > 0 && !atomic_load(&r->cancel)) {
-		pthread_mutex_unlock(&r->lock);
-		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "cannot start a render thread");
-	}
 	uint64_t seen = r->events;
 	int callbacks = fn != NULL;
 	while (r->running > 0) {
@@ -156,20 +140,11 @@ ajar_status render_loop(ajar_renderer *r, ajar_progress_fn fn, void *user)
 			render_checkpoint_during(r);
 		pthread_cond_broadcast(&r->cond); /* wakes idle devices after a cancel */
 	}
-	pthread_mutex_unlock(&r->lock);
-	for (uint32_t i = 0; i < r->ndev; i++)
-		if (r->devs[i].started) {
-			pthread_join(r->devs[i].thread, NULL);
-			r->devs[i].started = 0;
-		}
-	r->elapsed = render_seconds() - r->t0;
-	report_drops(r);
-	if (r->ndev > 1) {
-		char shares[2048];
-		render_info_shares(r, shares, sizeof shares);
-		log_msg(AJAR_LOG_INFO, "devices: %s", shares);
-	}
+}
 
+/* After the device threads ended: why the render stopped short, if it did. */
+static ajar_status outcome(ajar_renderer *r)
+{
 	uint32_t alive = 0;
 	for (uint32_t i = 0; i < r->ndev; i++)
 		alive += (uint32_t)r->devs[i].alive;
@@ -186,4 +161,42 @@ ajar_status render_loop(ajar_renderer *r, ajar_progress_fn fn, void *user)
 	if (left > 0 && scheduler_time_left(r) > 0 && atomic_load(&r->cancel))
 		return err_set(AJAR_ERROR_CANCELLED, "render cancelled after %u samples per pixel", r->spp_done);
 	return AJAR_OK;
+}
+
+ajar_status render_loop(ajar_renderer *r, ajar_progress_fn fn, void *user)
+{
+	pthread_mutex_lock(&r->lock);
+	r->t0 = render_seconds() - r->elapsed;
+	r->ckpt_last = render_seconds();
+	r->running = 0;
+	for (uint32_t i = 0; i < r->ndev; i++) {
+		RenderDevice *rd = &r->devs[i];
+		/* A device of another rank is driven by a proxy thread (render_job.c). */
+		rd->started = rd->alive && pthread_create(&rd->thread, NULL, rd->rank ? job_proxy_thread : device_thread,
+							  rd) == 0;
+		r->running += (uint32_t)rd->started;
+	}
+	if (r->running == 0 && r->last_dropped != NULL) {
+		pthread_mutex_unlock(&r->lock);
+		return err_set(AJAR_ERROR_DEVICE, "no OpenCL device left (the last failed: %s)", r->last_dropped->error);
+	}
+	if (r->running == 0 && scheduler_work_left(r) > 0 && !atomic_load(&r->cancel)) {
+		pthread_mutex_unlock(&r->lock);
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "cannot start a render thread");
+	}
+	wait_passes(r, fn, user);
+	pthread_mutex_unlock(&r->lock);
+	for (uint32_t i = 0; i < r->ndev; i++)
+		if (r->devs[i].started) {
+			pthread_join(r->devs[i].thread, NULL);
+			r->devs[i].started = 0;
+		}
+	r->elapsed = render_seconds() - r->t0;
+	report_drops(r);
+	if (r->ndev > 1) {
+		char shares[2048];
+		render_info_shares(r, shares, sizeof shares);
+		log_msg(AJAR_LOG_INFO, "devices: %s", shares);
+	}
+	return outcome(r);
 }
