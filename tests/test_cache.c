@@ -22,6 +22,7 @@
 #include "device/device_build.h"
 #include "device/device_plan.h"
 #include "device/kernel_source.h"
+#include "prepare/prepare.h"
 #include "testutil.h"
 
 #define BASE_OPTIONS KERNEL_OPTIONS "0"
@@ -314,10 +315,10 @@ static void test_render_options(void **state)
 	DevicePlan p = {0};
 	device_render_options(&cpu, 0, &p, NULL, buf, sizeof buf);
 	assert_string_equal(buf, KERNEL_OPTIONS "0 ");
-	p.omit = DEVICE_OMIT_ALPHA | DEVICE_OMIT_TEXTURES;
+	p.omit = KERNEL_OMIT_ALPHA | KERNEL_OMIT_TEXTURES;
 	device_render_options(&cpu, 0, &p, "-cl-opt-disable", buf, sizeof buf);
 	assert_string_equal(buf, KERNEL_OPTIONS "0 -DAJAR_NO_ALPHA -DAJAR_NO_TEXTURES -cl-opt-disable");
-	p.omit = DEVICE_OMIT_ALPHA | DEVICE_OMIT_BENT_NORMALS | DEVICE_OMIT_TEXTURES | DEVICE_OMIT_TRI_EXTRA;
+	p.omit = KERNEL_OMIT_ALPHA | KERNEL_OMIT_BENT_NORMALS | KERNEL_OMIT_TEXTURES | KERNEL_OMIT_TRI_EXTRA;
 	p.soa = 1;
 	p.capacity = 128;
 	device_render_options(&gpu, 1, &p, NULL, buf, sizeof buf);

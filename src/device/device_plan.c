@@ -13,6 +13,7 @@
 #include "core/error.h"
 #include "device/device_build.h"
 #include "light/portal_sky.h"
+#include "prepare/prepare.h"
 #include "base/types.h"
 
 /* A positive integer from the environment: *out, 1 if set, -1 if malformed. */
@@ -100,11 +101,11 @@ void device_render_options(const Device *d, int integrator, const DevicePlan *p,
 	static const struct {
 		unsigned bit;
 		const char *option;
-	} omit[] = {{DEVICE_OMIT_ALPHA, "-DAJAR_NO_ALPHA "},
-		    {DEVICE_OMIT_BENT_NORMALS, "-DAJAR_NO_BENT_NORMALS "},
-		    {DEVICE_OMIT_TEXTURES, "-DAJAR_NO_TEXTURES "},
-		    {DEVICE_OMIT_TRI_EXTRA, "-DAJAR_NO_TRI_EXTRA "},
-		    {DEVICE_OMIT_PANES, "-DAJAR_NO_PANES "}};
+	} omit[] = {{KERNEL_OMIT_ALPHA, "-DAJAR_NO_ALPHA "},
+		    {KERNEL_OMIT_BENT_NORMALS, "-DAJAR_NO_BENT_NORMALS "},
+		    {KERNEL_OMIT_TEXTURES, "-DAJAR_NO_TEXTURES "},
+		    {KERNEL_OMIT_TRI_EXTRA, "-DAJAR_NO_TRI_EXTRA "},
+		    {KERNEL_OMIT_PANES, "-DAJAR_NO_PANES "}};
 	device_build_options(d, integrator, NULL, buf, cap);
 	size_t n = strlen(buf);
 	if (p->soa)

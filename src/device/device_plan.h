@@ -18,18 +18,10 @@ typedef struct {
 	size_t capacity;   /* work-items the scratch holds (its stride), the most one launch covers */
 	unsigned lanes;    /* work-items per pixel: a pass's samples of a pixel are split between them */
 	size_t scratch_bytes; /* 0 without scratch */
-	unsigned omit;        /* DEVICE_OMIT_*: scene features the program leaves out (the caller sets it) */
+	unsigned omit;        /* KERNEL_OMIT_* (prepare.h): scene features the program leaves out (the caller sets it) */
 	int general;          /* AJAR_KERNEL_FEATURES=all: omit nothing, whatever `omit` says */
 	int sky_res;          /* cells a side of the planes' sky tables (-DPORTAL_SKY_RES unless 128; the caller sets it) */
 } DevicePlan;
-/* Scene features render_pass can be built without (kernel specialisation,
- * kernels/materials.md "Feature-specialised programs"): prepare_scene says
- * which a scene lacks; each becomes a -D option, and the cache keys on it. */
-#define DEVICE_OMIT_ALPHA 1u        /* -DAJAR_NO_ALPHA: no TRI_ALPHA triangle */
-#define DEVICE_OMIT_BENT_NORMALS 2u /* -DAJAR_NO_BENT_NORMALS: no shading normal tilted from ng, no normal map */
-#define DEVICE_OMIT_TEXTURES 4u     /* -DAJAR_NO_TEXTURES: no material reads a texture */
-#define DEVICE_OMIT_TRI_EXTRA 8u    /* -DAJAR_NO_TRI_EXTRA: no TRI_EXTRA triangle (TEXCOORD_1, COLOR_0, tangents) */
-#define DEVICE_OMIT_PANES 16u       /* -DAJAR_NO_PANES: no TRI_PANE triangle (thin glass that rays cross) */
 /* The plan of integrator `integrator` for an image of npix pixels on d:
  * private arrays on CPUs and for pt, the scratch on other devices; one lane
  * per pixel on CPUs, on other devices enough for compute units x
