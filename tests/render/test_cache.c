@@ -1,4 +1,4 @@
-/* test_cache.c — the kernel binary cache of src/device/device.c: a first build
+/* test_cache.c — the kernel binary cache of src/device/device_build.c: a first build
  * compiles and writes exactly one cache file, the next build of the same
  * source and options loads it and the program runs; other options get
  * their own file; a corrupted file is detected, rebuilt and replaced by a
@@ -20,8 +20,10 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "device/device.h"
+#include "device/device_build.h"
+#include "device/device_plan.h"
 #include "device/kernel_source.h"
+#include "prepare/prepare.h"
 #include "testutil.h"
 
 #define BASE_OPTIONS KERNEL_OPTIONS "0"
@@ -32,7 +34,7 @@ extern const unsigned ajar_layout_count;
 static unsigned next_dir;
 
 /* A fresh, not yet existing cache directory that AJAR_CACHE_DIR names
- * (device.c creates it on the first write). */
+ * (device_build.c creates it on the first write). */
 static char *fresh_cache_dir(void)
 {
 	char name[32];
@@ -313,10 +315,10 @@ static void test_render_options(void **state)
 	DevicePlan p = {0};
 	device_render_options(&cpu, 0, &p, NULL, buf, sizeof buf);
 	assert_string_equal(buf, KERNEL_OPTIONS "0 ");
-	p.omit = DEVICE_OMIT_ALPHA | DEVICE_OMIT_TEXTURES;
+	p.omit = KERNEL_OMIT_ALPHA | KERNEL_OMIT_TEXTURES;
 	device_render_options(&cpu, 0, &p, "-cl-opt-disable", buf, sizeof buf);
 	assert_string_equal(buf, KERNEL_OPTIONS "0 -DAJAR_NO_ALPHA -DAJAR_NO_TEXTURES -cl-opt-disable");
-	p.omit = DEVICE_OMIT_ALPHA | DEVICE_OMIT_BENT_NORMALS | DEVICE_OMIT_TEXTURES | DEVICE_OMIT_TRI_EXTRA;
+	p.omit = KERNEL_OMIT_ALPHA | KERNEL_OMIT_BENT_NORMALS | KERNEL_OMIT_TEXTURES | KERNEL_OMIT_TRI_EXTRA;
 	p.soa = 1;
 	p.capacity = 128;
 	device_render_options(&gpu, 1, &p, NULL, buf, sizeof buf);

@@ -3,7 +3,7 @@
  * of kernels/base/layout.h, compared with the host's (src/device/layout_check.c). */
 #include <stdlib.h>
 
-#include "device/device.h"
+#include "device/device_build.h"
 #include "device/kernel_source.h"
 #include "testutil.h"
 

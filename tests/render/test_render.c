@@ -19,7 +19,6 @@
 #include <string.h>
 
 #include "ajar.h"
-#include "device/device.h"
 #include "image/exr.h"
 #include "prepare/prepare.h"
 #include "render/render_overrides.h"
@@ -360,7 +359,7 @@ static void test_same_seed_same_bits(void **state)
 	ajar_scene_destroy(&s);
 }
 
-/* The features prepare_scene finds a scene without (DEVICE_OMIT_*). */
+/* The features prepare_scene finds a scene without (KERNEL_OMIT_*). */
 static unsigned scene_omit(const char *path)
 {
 	ajar_scene *s;
@@ -387,17 +386,17 @@ static unsigned scene_omit(const char *path)
 static void test_kernel_features(void **state)
 {
 	(void)state;
-	const unsigned all = DEVICE_OMIT_ALPHA | DEVICE_OMIT_BENT_NORMALS | DEVICE_OMIT_TEXTURES | DEVICE_OMIT_TRI_EXTRA |
-			     DEVICE_OMIT_PANES;
+	const unsigned all = KERNEL_OMIT_ALPHA | KERNEL_OMIT_BENT_NORMALS | KERNEL_OMIT_TEXTURES | KERNEL_OMIT_TRI_EXTRA |
+			     KERNEL_OMIT_PANES;
 	assert_int_equal(scene_omit(SCENE("cornell/cornell.gltf")), all);
 	/* A glazed room has panes. */
-	assert_int_equal(scene_omit(SCENE("window-room/window-room-glazed.gltf")) & DEVICE_OMIT_PANES, 0);
+	assert_int_equal(scene_omit(SCENE("window-room/window-room-glazed.gltf")) & KERNEL_OMIT_PANES, 0);
 	unsigned alpha = scene_omit(SCENE("khronos/AlphaBlendModeTest/AlphaBlendModeTest.gltf"));
-	assert_int_equal(alpha & (DEVICE_OMIT_ALPHA | DEVICE_OMIT_TEXTURES), 0);
+	assert_int_equal(alpha & (KERNEL_OMIT_ALPHA | KERNEL_OMIT_TEXTURES), 0);
 	unsigned nmap = scene_omit(SCENE("khronos/NormalTangentTest/NormalTangentTest.gltf"));
-	assert_int_equal(nmap & (DEVICE_OMIT_BENT_NORMALS | DEVICE_OMIT_TEXTURES | DEVICE_OMIT_TRI_EXTRA), 0);
+	assert_int_equal(nmap & (KERNEL_OMIT_BENT_NORMALS | KERNEL_OMIT_TEXTURES | KERNEL_OMIT_TRI_EXTRA), 0);
 	unsigned colour = scene_omit(SCENE("khronos/VertexColorTest/VertexColorTest.gltf"));
-	assert_int_equal(colour & DEVICE_OMIT_TRI_EXTRA, 0);
+	assert_int_equal(colour & KERNEL_OMIT_TRI_EXTRA, 0);
 
 	ajar_scene *s;
 	assert_int_equal(ajar_scene_load(SCENE("cornell/cornell.gltf"), &s), AJAR_OK);

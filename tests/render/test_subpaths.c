@@ -1,5 +1,5 @@
 /* test_subpaths.c — where bdpt's and portal's subpaths live (kernels/integrator/vertex.h,
- * src/device/device.c device_plan; kernels/gpu.md, "On GPUs: subpaths in global
+ * src/device/device_plan.c; kernels/gpu.md, "On GPUs: subpaths in global
  * memory"): private arrays or the global scratch laid out by work-item, and
  * a pass spread over several work-items a pixel, must render the same image
  * bit for bit on the same device. On PoCL the GPU's layout is forced with
@@ -11,11 +11,11 @@
 #include <string.h>
 
 #include "ajar.h"
-#include "device/device.h"
+#include "device/device_plan.h"
 #include "testutil.h"
 #include "integrator/vertex.h"
 
-/* The host's room for a vertex (device.h) holds the kernels' PathVertex. */
+/* The host's room for a vertex (device/device_plan.h) holds the kernels' PathVertex. */
 _Static_assert(sizeof(PathVertex) <= 4 * DEVICE_VERTEX_WORDS, "PathVertex outgrew DEVICE_VERTEX_WORDS");
 _Static_assert(SUBPATH_MAX == DEVICE_SUBPATH_MAX, "SUBPATH_MAX and DEVICE_SUBPATH_MAX differ");
 

@@ -10,7 +10,7 @@
 #include <stdlib.h>
 
 #include "ajar.h"
-#include "device/device.h"
+#include "device/device_build.h"
 #include "device/kernel_source.h"
 #include "prepare/prepare.h"
 #include "scene/scene.h"
