@@ -26,6 +26,7 @@
 #include <unistd.h>
 
 #include "core/error.h"
+#include "core/input_file.h"
 
 /* The last message the OpenEXR library gave on this thread; it is more
  * specific than its error code (e.g. which attribute is malformed). */
@@ -285,14 +286,9 @@ static ajar_status exr_open(const char *path, ExrReader *r)
 {
 	r->ctxt = NULL;
 	r->stream.io_errno = 0;
-	r->stream.fd = open(path, O_RDONLY | O_CLOEXEC);
-	if (r->stream.fd < 0)
-		return err_set(AJAR_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
-	struct stat sb;
-	if (fstat(r->stream.fd, &sb) == 0 && S_ISDIR(sb.st_mode)) {
-		close(r->stream.fd);
-		return err_set(AJAR_ERROR_IO, "%s: cannot read: is a directory", path);
-	}
+	ajar_status ost = input_open(path, &r->stream.fd, NULL);
+	if (ost != AJAR_OK)
+		return ost;
 	exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
 	init.error_handler_fn = exr_on_error;
 	init.user_data = &r->stream;

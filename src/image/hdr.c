@@ -6,22 +6,26 @@
 #include "image/hdr.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include <stb_image.h>
 
 #include "core/error.h"
+#include "core/input_file.h"
 
 int hdr_file(const char *path)
 {
-	FILE *f = fopen(path, "rb");
-	if (!f)
+	/* Not a regular file, or not readable: the caller's other reader reports it. */
+	int fd = input_is_regular(path) ? open(path, O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY) : -1;
+	if (fd < 0)
 		return 0;
 	char head[10] = {0};
-	size_t n = fread(head, 1, sizeof head, f);
-	fclose(f);
+	ssize_t n = pread(fd, head, sizeof head, 0);
+	close(fd);
 	return (n >= 10 && !memcmp(head, "#?RADIANCE", 10)) || (n >= 6 && !memcmp(head, "#?RGBE", 6));
 }
 
@@ -58,9 +62,15 @@ static int hdr_cb_eof(void *user)
 ajar_status hdr_read(const char *path, float **rgb, uint32_t *width, uint32_t *height)
 {
 	*rgb = NULL;
-	HdrStream hs = {fopen(path, "rb"), 0};
-	if (!hs.f)
-		return err_set(AJAR_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
+	int fd;
+	ajar_status st = input_open(path, &fd, NULL);
+	if (st != AJAR_OK)
+		return st;
+	HdrStream hs = {fdopen(fd, "rb"), 0};
+	if (!hs.f) {
+		close(fd);
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+	}
 	const stbi_io_callbacks cb = {hdr_cb_read, hdr_cb_skip, hdr_cb_eof};
 	int w = 0, h = 0, n = 0;
 	float *px = stbi_loadf_from_callbacks(&cb, &hs, &w, &h, &n, 3);

@@ -19,6 +19,7 @@
 #include <zlib.h>
 
 #include "core/error.h"
+#include "core/input_file.h"
 #include "image/exr.h"
 
 #define CKPT_MAGIC "AJARCKPT"
@@ -240,11 +241,16 @@ static ajar_status read_body(const char *path, Reader *r, Checkpoint *c, uint64_
 ajar_status checkpoint_read(const char *path, Checkpoint *c, int header_only)
 {
 	memset(c, 0, sizeof *c);
-	Reader r = {fopen(path, "rb"), crc32(0L, Z_NULL, 0), 0};
-	if (!r.f)
-		return err_set(AJAR_ERROR_IO, "%s: cannot open checkpoint: %s", path, strerror(errno));
-	struct stat sb;
-	uint64_t have = fstat(fileno(r.f), &sb) == 0 ? (uint64_t)sb.st_size : 0;
+	int fd;
+	uint64_t have = 0;
+	ajar_status ost = input_open(path, &fd, &have);
+	if (ost != AJAR_OK)
+		return ost;
+	Reader r = {fdopen(fd, "rb"), crc32(0L, Z_NULL, 0), 0};
+	if (!r.f) {
+		close(fd);
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+	}
 	ajar_status st = AJAR_OK;
 	char magic[8];
 	uint32_t format = 0, opts[CKPT_OPTIONS], sections;

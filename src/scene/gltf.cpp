@@ -26,9 +26,11 @@
 #include <vector>
 
 #include <stdlib.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "core/error.h"
+#include "core/input_file.h"
 #include "scene/gltf.h"
 #include "scene/tangents.h"
 
@@ -54,7 +56,7 @@ struct Loader {
 	std::vector<int> image_textures;    /* glTF image -> scene texture or -1 */
 	bool allow_outside = false; /* files outside the scene's folder may be read */
 	std::string root;           /* the scene's folder, symbolic links resolved */
-	std::string refused;        /* the first message about a file outside root */
+	std::string refused;        /* the first refusal of a file the scene names */
 };
 
 ajar_status fail(const Loader &L, ajar_status st, const char *fmt, ...) AJAR_PRINTF(3, 4);
@@ -119,21 +121,41 @@ std::string fs_expand(const std::string &joined, void *user)
 	return !uri.empty() && uri[0] == '/' ? uri : joined;
 }
 
+/* Nothing is opened here (tinygltf's own FileExists opens the file, which
+ * blocks on a FIFO): the name exists and is inside the folder. */
 bool fs_exists(const std::string &path, void *user)
 {
 	Loader &L = *(Loader *)user;
-	return tg::FileExists(path, nullptr) && confined(L, path, uri_of(L, path));
+	struct stat sb;
+	return stat(path.c_str(), &sb) == 0 && confined(L, path, uri_of(L, path));
 }
 
+ajar_status read_fd(const char *path, int fd, uint64_t size, std::vector<unsigned char> &data);
+
+/* Confined first, then opened as a regular file only (input_open); the
+ * first refusal becomes the load's error, naming the URI. */
 bool fs_read(std::vector<unsigned char> *out, std::string *err, const std::string &path, void *user)
 {
 	Loader &L = *(Loader *)user;
-	if (!confined(L, path, uri_of(L, path))) {
+	std::string uri = uri_of(L, path);
+	if (!confined(L, path, uri)) {
 		if (err)
 			*err += "outside the scene's folder\n";
 		return false;
 	}
-	return tg::ReadWholeFile(out, err, path, nullptr);
+	int fd;
+	uint64_t size = 0;
+	ajar_status st = input_open(path.c_str(), &fd, &size);
+	if (st == AJAR_OK)
+		st = read_fd(path.c_str(), fd, size, *out);
+	if (st != AJAR_OK) {
+		if (L.refused.empty())
+			L.refused = "'" + uri + "': " + ajar_last_error();
+		if (err)
+			*err += std::string(ajar_last_error()) + "\n";
+		return false;
+	}
+	return true;
 }
 
 /* ---- Accessors ---------------------------------------------------------- */
@@ -1297,20 +1319,37 @@ ajar_status walk_nodes(Loader &L, const std::vector<int> &roots, const char *roo
 	return AJAR_OK;
 }
 
+/* The whole of an opened regular file (closed here); at most 4 GiB, the
+ * most a .glb can hold, so a buffer's size is never what a huge file says. */
+ajar_status read_fd(const char *path, int fd, uint64_t size, std::vector<unsigned char> &data)
+{
+	if (size > 0xffffffffu) {
+		close(fd);
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: file larger than 4 GiB", path);
+	}
+	data.resize((size_t)size);
+	size_t got = 0;
+	while (got < data.size()) {
+		ssize_t k = read(fd, data.data() + got, data.size() - got);
+		if (k < 0 && errno == EINTR)
+			continue;
+		if (k <= 0) {
+			int e = errno;
+			close(fd);
+			return err_set(AJAR_ERROR_IO, "%s: cannot read: %s", path, k < 0 ? strerror(e) : "the file shrank");
+		}
+		got += (size_t)k;
+	}
+	close(fd);
+	return AJAR_OK;
+}
+
 ajar_status read_file(const char *path, std::vector<unsigned char> &data)
 {
-	FILE *f = fopen(path, "rb");
-	if (!f)
-		return err_set(AJAR_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
-	unsigned char buf[65536];
-	size_t got;
-	while ((got = fread(buf, 1, sizeof buf, f)) > 0)
-		data.insert(data.end(), buf, buf + got);
-	int bad = ferror(f), e = errno;
-	fclose(f);
-	if (bad)
-		return err_set(AJAR_ERROR_IO, "%s: cannot read: %s", path, strerror(e));
-	return AJAR_OK;
+	int fd;
+	uint64_t size = 0;
+	ajar_status st = input_open(path, &fd, &size);
+	return st ? st : read_fd(path, fd, size, data);
 }
 
 ajar_status load(Loader &L)

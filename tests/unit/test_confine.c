@@ -3,16 +3,21 @@
  * symbolic link) outside the scene file's folder is refused with a message
  * naming the URI, and read when ajar_load_options.allow_outside_files is
  * set; names that stay inside (a subfolder, "sub/../x", a link that points
- * inside) load either way.
+ * inside) load either way. Only regular files are read, and nothing is
+ * opened before it is known to be one inside the folder: a FIFO (whose
+ * open would wait for a writer forever) or a directory ("." as a URI) is
+ * bad input naming it.
  *
  * Layout in a fresh temporary directory T:
  *   T/outside.bin, T/outside.png, T/sky.exr     files outside the scene folder
  *   T/scene/tri.bin, T/scene/sub/inner.bin      inside
- *   T/scene/link-out.bin -> ../outside.bin, T/scene/link-in.bin -> tri.bin */
+ *   T/scene/link-out.bin -> ../outside.bin, T/scene/link-in.bin -> tri.bin
+ *   T/fifo, T/scene/fifo                        FIFOs nobody writes to */
 #include "testutil.h"
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <signal.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -181,6 +186,55 @@ static void test_environment_image(void **state)
 	free(p);
 }
 
+/* Loads that must fail with BAD_INPUT and a message holding `needle`; a
+ * load that blocks (a FIFO opened for reading waits for a writer) ends the
+ * binary by SIGALRM instead of hanging the suite. */
+static void refused_with(const char *path, int allow, const char *needle)
+{
+	alarm(30);
+	ajar_status st = load(path, allow);
+	alarm(0);
+	const char *msg = ajar_last_error();
+	if (st != AJAR_ERROR_BAD_INPUT || !strstr(msg, path) || !strstr(msg, needle))
+		fail_msg("%s: got %s \"%s\", wanted \"%s\"", path, ajar_status_name(st), msg, needle);
+}
+
+static void test_special_files(void **state)
+{
+	(void)state;
+	/* A FIFO outside the folder: refused as outside, never opened. */
+	char *p = write_scene("fifoout", "../fifo", NULL, NULL);
+	refused_with(p, 0, "outside the scene's folder");
+	refused_with(p, 1, "not a regular file (a FIFO)");
+	free(p);
+	/* Inside: as a buffer, an image, the environment image. */
+	p = write_scene("fifobuf", "fifo", NULL, NULL);
+	refused_with(p, 0, "not a regular file (a FIFO)");
+	free(p);
+	p = write_scene("fifoimg", "tri.bin", ",\"images\":[{\"uri\":\"fifo\"}]", NULL);
+	refused_with(p, 0, "'fifo'");
+	free(p);
+	p = write_scene("fifoenv", "tri.bin", NULL, ",\"extras\":{\"environment\":{\"image\":\"fifo\"}}");
+	refused_with(p, 0, "not a regular file (a FIFO)");
+	free(p);
+	/* "." is the folder: bad input, not an allocation of its "size". */
+	p = write_scene("dotbuf", ".", NULL, NULL);
+	refused_with(p, 0, "is a directory");
+	free(p);
+	p = write_scene("dotimg", "tri.bin", ",\"images\":[{\"uri\":\".\"}]", NULL);
+	refused_with(p, 0, "is a directory");
+	free(p);
+	/* The scene file itself. */
+	char *fifo = test_path(scene_dir, "fifo");
+	alarm(30);
+	ajar_scene *s = NULL;
+	ajar_status st = ajar_scene_load(fifo, &s);
+	alarm(0);
+	assert_int_equal(st, AJAR_ERROR_BAD_INPUT);
+	assert_non_null(strstr(ajar_last_error(), "not a regular file (a FIFO)"));
+	free(fifo);
+}
+
 static int setup(void **state)
 {
 	if (test_group_setup(state))
@@ -209,6 +263,10 @@ static int setup(void **state)
 	char *l = test_path(scene_dir, "link-out.bin");
 	char *l2 = test_path(scene_dir, "link-in.bin");
 	int bad = symlink("../outside.bin", l) || symlink("tri.bin", l2);
+	char *fo = test_tmp("fifo"), *fi = test_path(scene_dir, "fifo");
+	bad = bad || mkfifo(fo, 0644) || mkfifo(fi, 0644);
+	free(fo);
+	free(fi);
 	free(l);
 	free(l2);
 	free(sub);
@@ -230,6 +288,7 @@ int main(void)
 		cmocka_unit_test(test_inside),
 		cmocka_unit_test(test_image),
 		cmocka_unit_test(test_environment_image),
+		cmocka_unit_test(test_special_files),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
 }
