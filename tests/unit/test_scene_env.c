@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static void test_environment_image(void **state)
 {
@@ -201,6 +202,59 @@ static void test_environment_hdr(void **state)
 	load_fails("hdrcut.gltf", AJAR_ERROR_BAD_INPUT, "cut.hdr: not a readable Radiance HDR image");
 }
 
+/* Cut-short and oversized .hdr files, which stb_image alone either reads
+ * forever (its run-length reader takes the zeros past the end as empty
+ * runs: both files below hung `ajar info`) or allocates for from the header
+ * alone: refused as bad input, naming the file, before any pixel buffer. A
+ * hang ends the binary by SIGALRM instead of the suite. RLE scanlines read
+ * back; the resolution line may space its parts as stb allows. */
+static void test_environment_hdr_hostile(void **state)
+{
+	static const char head[] = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 8\n";
+	unsigned char data[sizeof head - 1 + 4 + 8];
+	memcpy(data, head, sizeof head - 1);
+	const unsigned char scan[4] = {2, 2, 0, 8};
+	memcpy(data + sizeof head - 1, scan, 4);
+	memset(data + sizeof head - 1 + 4, 0, 8);
+	/* The 49 bytes: a scanline header and the end of the file. */
+	write_bytes("eof.hdr", data, sizeof head - 1 + 4);
+	/* Long enough for its size, but only zero counts: runs of nothing. */
+	write_bytes("zeros.hdr", data, sizeof data);
+	const char *cases[][2] = {{"eof.hdr", "cut short"},
+				  {"zeros.hdr", "cut short"},
+				  {"huge.hdr", "at most 65536 a side"},
+				  {"many.hdr", "134217728 in all"},
+				  {"tall.hdr", "cut short (12 bytes cannot hold 8x60000"}};
+	write_text("huge.hdr", "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 70000\n\x02\x02\x01\x11");
+	write_text("many.hdr", "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 16384 +X 16384\n\x02\x02\x40\x00");
+	write_text("tall.hdr", "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 60000 +X 8\n012345678901");
+	for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+		char extras[256];
+		snprintf(extras, sizeof extras, ",\"extras\":{\"environment\":{\"image\":\"%s\"}}", cases[k][0]);
+		write_tri_gltf("hostile.gltf", "0", "{\"mesh\":0}", extras);
+		alarm(30);
+		load_fails("hostile.gltf", AJAR_ERROR_BAD_INPUT, cases[k][0]);
+		alarm(0);
+		if (!strstr(ajar_last_error(), cases[k][1]))
+			fail_msg("%s: \"%s\"", cases[k][0], ajar_last_error());
+	}
+	/* A whole RLE scanline of 8 texels (each channel one run), with the
+	 * resolution line spaced as stb accepts it. */
+	static const char head2[] = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1   +X 8\n";
+	unsigned char ok[sizeof head2 - 1 + 4 + 8];
+	memcpy(ok, head2, sizeof head2 - 1);
+	const unsigned char rle[12] = {2, 2, 0, 8, 0x88, 128, 0x88, 64, 0x88, 0, 0x88, 129};
+	memcpy(ok + sizeof head2 - 1, rle, sizeof rle);
+	write_bytes("rle.hdr", ok, sizeof ok);
+	write_tri_gltf("rle.gltf", "0", "{\"mesh\":0}", ",\"extras\":{\"environment\":{\"image\":\"rle.hdr\"}}");
+	Scene *s = load_ok("rle.gltf");
+	assert_int_equal(s->env_width, 8);
+	assert_int_equal(s->env_height, 1);
+	for (int i = 0; i < 8; i++)
+		assert_true(s->env_rgb[3 * i] == 1.0f && s->env_rgb[3 * i + 1] == 0.5f && s->env_rgb[3 * i + 2] == 0.0f);
+	ajar_scene_destroy(&s);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -208,6 +262,7 @@ int main(void)
 		cmocka_unit_test(test_environment_pixels),
 		cmocka_unit_test(test_environment_rotation),
 		cmocka_unit_test(test_environment_hdr),
+		cmocka_unit_test(test_environment_hdr_hostile),
 	};
 	return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);
 }
