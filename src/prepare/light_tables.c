@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "light/lights.h"
+#include "scene/emit_mask.h"
 
 static float tri_area(V3 p0, V3 p1, V3 p2)
 {
@@ -93,6 +94,11 @@ static ajar_status build_emitters(const Scene *s, Tri *tris, const TriShade *sha
 	signed char *level = calloc(ntris ? ntris : 1, 1);
 	if (!level)
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "lights: out of memory for %u triangles", ntris);
+	EmitMask mask;
+	if (emit_mask_build(&mask, s->textures, s->ntextures, s->texels, mats, s->nmaterials) != AJAR_OK) {
+		free(level);
+		return AJAR_ERROR_OUT_OF_MEMORY;
+	}
 	/* Which triangles emit, and each one's finest level. */
 	for (uint32_t i = 0; i < ntris; i++) {
 		Tri *t = &tris[i];
@@ -101,13 +107,14 @@ static ajar_status build_emitters(const Scene *s, Tri *tris, const TriShade *sha
 		level[i] = -1;
 		if (!(v3_lum(m->emission) > 0.0f) || !(tri_area(t->p0, t->p1, t->p2) > 0.0f))
 			continue;
-		if (m->emissive_tex && !scene_tri_can_emit(&v, i, m->emissive_tex - 1))
+		if (m->emissive_tex && !emit_mask_can_emit(&mask, &v, i, m->emissive_tex - 1))
 			continue;
 		/* Cells as fine as the texture that varies the emission: the
 		 * emissive one, else, where alpha cuts holes, the base colour's. */
 		int tex = m->emissive_tex ? m->emissive_tex - 1 : (t->flags & TRI_ALPHA) ? m->base_tex : -1;
 		level[i] = (signed char)(tex >= 0 ? cell_level(&v, i, tex, MAX_LEVEL) : 0);
 	}
+	emit_mask_free(&mask);
 	uint64_t n;
 	for (int cap = MAX_LEVEL;; cap--) {
 		n = 0;

@@ -16,6 +16,7 @@
 #include "image/hdr.h"
 #include "material/bsdf.h"
 #include "material/texture.h"
+#include "scene/emit_mask.h"
 
 /* Device code indexes with int, so no array may pass INT32_MAX entries. */
 #define SCENE_MAX_ITEMS ((size_t)INT32_MAX)
@@ -592,8 +593,6 @@ void scene_bounds(const Scene *s, V3 *bmin, V3 *bmax)
 	*bmax = hi;
 }
 
-#define SCAN_LIMIT (1u << 22) /* texels a "can it emit" test reads at most */
-
 /* Triangle i's texture coordinates under tex's transform, in texels. */
 void scene_tri_texel_coords(const SceneView *v, uint32_t i, int tex, double x[3], double y[3])
 {
@@ -609,52 +608,6 @@ void scene_tri_texel_coords(const SceneView *v, uint32_t i, int tex, double x[3]
 		x[k] = ((double)t->xf[0] * u[k] + (double)t->xf[1] * w[k] + t->xf[2]) * t->width;
 		y[k] = ((double)t->xf[3] * u[k] + (double)t->xf[4] * w[k] + t->xf[5]) * t->height;
 	}
-}
-
-/* Texel indices lo..hi (of n) as a small range [*a, *b] that the wrap
- * mode maps onto the same texels: clamped, or shifted by whole periods
- * (two images wide, for mirrored repeat), or all of one period. */
-static void scan_range(double lo, double hi, int n, int mode, long *a, long *b)
-{
-	if (mode == TEX_WRAP_CLAMP) {
-		*a = (long)fmin(fmax(lo, 0.0), n - 1.0);
-		*b = (long)fmin(fmax(hi, 0.0), n - 1.0);
-	} else if (hi - lo >= 2.0 * n) {
-		*a = 0;
-		*b = 2L * n - 1;
-	} else {
-		double shift = 2.0 * n * floor(lo / (2.0 * n));
-		*a = (long)(lo - shift);
-		*b = (long)(hi - shift);
-	}
-}
-
-/* Whether triangle i can emit anywhere: some texel that a lookup inside
- * its coordinates' bounding box reads (bilinear: the texels around
- * x - 0.5, which include nearest's) is not black. Too large a box to read
- * counts as emitting. */
-int scene_tri_can_emit(const SceneView *v, uint32_t i, int tex)
-{
-	const Texture *t = &v->textures[tex];
-	double x[3], y[3];
-	scene_tri_texel_coords(v, i, tex, x, y);
-	const double eps = 1e-3; /* float rounding in the kernel's lookup */
-	double x0 = floor(fmin(x[0], fmin(x[1], x[2])) - 0.5 - eps), x1 = floor(fmax(x[0], fmax(x[1], x[2])) - 0.5 + eps) + 1;
-	double y0 = floor(fmin(y[0], fmin(y[1], y[2])) - 0.5 - eps), y1 = floor(fmax(y[0], fmax(y[1], y[2])) - 0.5 + eps) + 1;
-	if ((x1 - x0 + 1) * (y1 - y0 + 1) > SCAN_LIMIT)
-		return 1;
-	long ax, bx, ay, by;
-	scan_range(x0, x1, t->width, TEX_WRAP_S(t->flags), &ax, &bx);
-	scan_range(y0, y1, t->height, TEX_WRAP_T(t->flags), &ay, &by);
-	for (long yy = ay; yy <= by; yy++) {
-		int ty = texture_wrap((int)yy, t->height, TEX_WRAP_T(t->flags));
-		for (long xx = ax; xx <= bx; xx++) {
-			int tx = texture_wrap((int)xx, t->width, TEX_WRAP_S(t->flags));
-			if (v->texels[t->offset + (size_t)ty * t->width + tx] & 0xffffffu)
-				return 1;
-		}
-	}
-	return 0;
 }
 
 SceneView scene_surface_view(const Scene *s)
@@ -674,12 +627,16 @@ uint32_t scene_count_emissive(const Scene *s)
 {
 	uint32_t n = 0;
 	SceneView v = scene_surface_view(s);
+	EmitMask mask;
+	if (emit_mask_build(&mask, s->textures, s->ntextures, s->texels, s->materials, s->nmaterials) != AJAR_OK)
+		err_clear(); /* without the tables, the texels are read */
 	for (uint32_t i = 0; i < s->ntris; i++) {
 		int m = s->tris[i].material;
 		if (m >= 0 && (uint32_t)m < s->nmaterials && !v3_is_zero(s->materials[m].emission) &&
-		    (!s->materials[m].emissive_tex || scene_tri_can_emit(&v, i, s->materials[m].emissive_tex - 1)))
+		    (!s->materials[m].emissive_tex || emit_mask_can_emit(&mask, &v, i, s->materials[m].emissive_tex - 1)))
 			n++;
 	}
+	emit_mask_free(&mask);
 	return n;
 }
 

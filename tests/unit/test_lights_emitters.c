@@ -1,7 +1,8 @@
 /* test_lights_emitters.c — the emitters' and portals' tables
  * (src/prepare/light_tables.c) and their sampling (kernels/light/lights.h):
  * emissive triangles chosen by power and uniform points on them, emissive
- * textures and alpha masks (only where they emit), the metallic-roughness
+ * textures and alpha masks (only where they emit; which triangles can
+ * emit at all, src/scene/emit_mask.c), the metallic-roughness
  * texture; portal triangles chosen by area; chi-square against the
  * expected counts. */
 #include "lit.h"
@@ -10,6 +11,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
+
+#include "scene/emit_mask.h"
 
 /* Emissive triangles of different areas and emissions, one black, one
  * with zero area: selection by power, uniform points, front normals. */
@@ -232,6 +236,103 @@ static void test_emissive_texture(void **state)
 	lit_free(&l);
 }
 
+/* Whether triangles can emit (src/scene/emit_mask.c): the summed-area
+ * tables answer as reading every texel under the box does, for random
+ * textures (sparse lit texels), every wrap mode on each axis, UVs inside,
+ * across and far outside [0, 1], transforms and both UV sets. */
+static void test_emit_mask_matches_scan(void **state)
+{
+	(void)state;
+	rng_state = 5;
+	Scene *s;
+	assert_int_equal(scene_new("<test>", &s), AJAR_OK);
+	enum { NT = 9, TRIS = 4000 };
+	const int modes[3] = {TEX_WRAP_CLAMP, TEX_WRAP_MIRROR, 0};
+	for (int t = 0; t < NT; t++) {
+		uint32_t w = 1 + (uint32_t)(rnd() * 40), h = 1 + (uint32_t)(rnd() * 40);
+		uint8_t *rgba = calloc((size_t)w * h, 4);
+		for (size_t i = 0; i < (size_t)w * h; i++)
+			if (rnd() < 0.01f)
+				rgba[4 * i + (size_t)(rnd() * 3)] = 200;
+		uint32_t img, tex;
+		assert_int_equal(scene_add_texture(s, w, h, rgba, &img), AJAR_OK);
+		free(rgba);
+		const float xf[6] = {1 + rnd(), rnd() - 0.5f, rnd() * 3, rnd() - 0.5f, 1 + rnd(), -rnd() * 3};
+		int flags = (t % 2 ? TEX_NEAREST : 0) | (t == 4 ? TEX_UV1 : 0) | modes[t % 3] |
+			    (modes[t / 3] << 2);
+		assert_int_equal(scene_add_texture_use(s, img, flags, xf, &tex), AJAR_OK);
+		uint32_t m = add_material(s, v3(1, 1, 1));
+		s->materials[m].emissive_tex = (int)tex + 1;
+	}
+	for (int k = 0; k < TRIS; k++) {
+		float pos[9], uv[6], uv1[6], span = k % 4 == 0 ? 6.0f : k % 4 == 1 ? 0.05f : 1.0f;
+		for (int c = 0; c < 9; c++)
+			pos[c] = rnd();
+		float cu = (rnd() - 0.5f) * (k % 7 == 0 ? 40.0f : 3.0f), cv = (rnd() - 0.5f) * 3.0f;
+		for (int c = 0; c < 3; c++) {
+			uv[2 * c] = uv1[2 * c] = cu + span * rnd();
+			uv[2 * c + 1] = uv1[2 * c + 1] = cv + span * rnd();
+		}
+		assert_int_equal(scene_add_triangles_ex(s, "t", pos, NULL, uv, uv1, NULL, NULL, 3, NULL, 1,
+							(uint32_t)(k % NT)),
+				 AJAR_OK);
+	}
+	SceneView v = scene_surface_view(s);
+	EmitMask mask;
+	assert_int_equal(emit_mask_build(&mask, s->textures, s->ntextures, s->texels, s->materials, s->nmaterials),
+			 AJAR_OK);
+	int yes = 0;
+	for (uint32_t i = 0; i < s->ntris; i++) {
+		int tex = s->materials[s->tris[i].material].emissive_tex - 1;
+		int a = emit_mask_can_emit(&mask, &v, i, tex), b = emit_mask_can_emit(NULL, &v, i, tex);
+		if (a != b)
+			fail_msg("triangle %u, texture %d: table %d, scan %d", i, tex, a, b);
+		yes += a;
+	}
+	printf("  %d of %u triangles can emit\n", yes, s->ntris);
+	assert_true(yes > TRIS / 10 && yes < TRIS * 9 / 10); /* both answers are exercised */
+	emit_mask_free(&mask);
+	scene_free(s);
+}
+
+/* The issue's scene, built directly: one black 2000 x 2000 emissive
+ * texture on a quad, 2,000 times. No triangle emits; answering took 24 s
+ * per 1,000 quads before the tables (every texel under every triangle was
+ * read), so the alarm ends the binary if that comes back. A black texture
+ * larger than the old 2^22-texel reading limit was counted as emitting
+ * (not read at all); it is exact now. */
+static void test_emit_mask_black(void **state)
+{
+	(void)state;
+	enum { W = 2000, COPIES = 2000 };
+	const int sides[2] = {W, 3000};
+	for (int k = 0; k < 2; k++) {
+		Scene *s;
+		assert_int_equal(scene_new("<test>", &s), AJAR_OK);
+		uint32_t n = (uint32_t)sides[k];
+		uint8_t *rgba = calloc((size_t)n * n, 4);
+		assert_non_null(rgba);
+		uint32_t img, tex;
+		assert_int_equal(scene_add_texture(s, n, n, rgba, &img), AJAR_OK);
+		free(rgba);
+		const float xf[6] = {1, 0, 0, 0, 1, 0};
+		assert_int_equal(scene_add_texture_use(s, img, 0, xf, &tex), AJAR_OK);
+		uint32_t m = add_material(s, v3(1, 1, 1));
+		s->materials[m].emissive_tex = (int)tex + 1;
+		float uv[] = {0, 0, 1, 0, 1, 1, 0, 1};
+		uint32_t idx[] = {0, 1, 2, 0, 2, 3};
+		for (int c = 0; c < (k ? 1 : COPIES); c++) {
+			float x = (float)c;
+			float pos[] = {x, 0, 0, x + 1, 0, 0, x + 1, 1, 0, x, 1, 0};
+			assert_int_equal(scene_add_triangles(s, "quad", pos, NULL, uv, 4, idx, 2, m), AJAR_OK);
+		}
+		alarm(60);
+		assert_int_equal(scene_count_emissive(s), 0);
+		alarm(0);
+		scene_free(s);
+	}
+}
+
 static void test_portal_sampling(void **state)
 {
 	rng_state = 13;
@@ -282,6 +383,8 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_emissive_texture),
+		cmocka_unit_test(test_emit_mask_matches_scan),
+		cmocka_unit_test(test_emit_mask_black),
 		cmocka_unit_test(test_emitter_sampling),
 		cmocka_unit_test(test_portal_sampling),
 	};
