@@ -54,7 +54,7 @@ TESTS := $(UNIT_TESTS) $(notdir $(basename $(wildcard tests/render/test_*.c test
 obj = $(addprefix $(BUILD)/src/,$(addsuffix .o,$(1)))
 DEPS_test_bsdf := $(call obj,core/error)
 DEPS_test_sampling := $(call obj,core/error)
-DEPS_test_bvh := $(call obj,core/error core/input_file scene/scene scene/emit_mask prepare/bvh_build scene/gltf scene/tangents image/exr image/exr_read image/hdr)
+DEPS_test_bvh := $(call obj,core/error core/input_file scene/scene scene/emit_mask prepare/bvh_build scene/gltf scene/tangents image/texture_file image/exr image/exr_read image/hdr)
 # The light tests share tests/support/lit.c (the kernels' light code inside).
 LIGHT_DEPS := $(BUILD)/tests/lit.o $(call obj,core/error core/input_file scene/scene scene/emit_mask prepare/light_tables image/exr image/exr_read image/hdr)
 DEPS_test_lights_env := $(LIGHT_DEPS) $(call obj,prepare/portal_flux)
@@ -63,7 +63,7 @@ DEPS_test_lights_sample := $(LIGHT_DEPS)
 DEPS_test_lights_sky_planes := $(LIGHT_DEPS) $(call obj,prepare/sky_tables)
 DEPS_test_lights_sky_planes_fine := $(patsubst %/lit.o,%/lit_fine.o,$(DEPS_test_lights_sky_planes))
 # The scene module: the loader, the API's scene calls, the images a scene reads.
-SCENE_DEPS := $(call obj,core/error core/input_file scene/scene scene/emit_mask scene/scene_api scene/gltf scene/tangents image/exr image/exr_read image/hdr)
+SCENE_DEPS := $(call obj,core/error core/input_file scene/scene scene/emit_mask scene/scene_api scene/gltf scene/tangents image/texture_file image/exr image/exr_read image/hdr)
 DEPS_test_scene_shipped := $(BUILD)/tests/scene_files.o $(SCENE_DEPS)
 DEPS_test_scene_api := $(BUILD)/tests/scene_files.o $(SCENE_DEPS)
 DEPS_test_scene_gltf := $(BUILD)/tests/scene_files.o $(SCENE_DEPS)
@@ -73,7 +73,7 @@ DEPS_test_exr := $(call obj,core/error core/input_file image/exr image/exr_read 
 DEPS_test_confine := $(SCENE_DEPS) $(call obj,image/png)
 # The kernels' integrators run on the host (tests/support/kernel_host.c) on
 # scenes as prepare_scene makes them; the MIS tests add the oracle.
-HOST_DEPS := $(BUILD)/tests/kernel_host.o $(call obj,core/error core/input_file scene/scene scene/emit_mask scene/scene_api scene/gltf scene/tangents image/exr image/exr_read image/hdr prepare/bvh_build prepare/light_tables prepare/prepare prepare/policy prepare/portal_flux prepare/sky_tables render/render_options)
+HOST_DEPS := $(BUILD)/tests/kernel_host.o $(call obj,core/error core/input_file scene/scene scene/emit_mask scene/scene_api scene/gltf scene/tangents image/texture_file image/exr image/exr_read image/hdr prepare/bvh_build prepare/light_tables prepare/prepare prepare/policy prepare/portal_flux prepare/sky_tables render/render_options)
 DEPS_test_bdpt := $(BUILD)/tests/mis_oracle.o $(HOST_DEPS)
 DEPS_test_punctual := $(HOST_DEPS)
 PORTAL_DEPS := $(BUILD)/tests/portal_scenes.o $(HOST_DEPS)

@@ -31,6 +31,7 @@
 
 #include "core/error.h"
 #include "core/input_file.h"
+#include "image/texture_file.h"
 #include "scene/gltf.h"
 #include "scene/tangents.h"
 
@@ -155,6 +156,50 @@ bool fs_read(std::vector<unsigned char> *out, std::string *err, const std::strin
 			*err += std::string(ajar_last_error()) + "\n";
 		return false;
 	}
+	return true;
+}
+
+/* ---- Images ----------------------------------------------------------------
+ * tinygltf's own loader decodes every image from the size its header
+ * claims; ours decodes through image/texture_file.c, which checks that size
+ * first and refuses a file cut short, and names the image by its URI. */
+
+/* How a message names images[i]: its URI, its buffer view or "data URI". */
+std::string image_name(const tg::Image *im, int i)
+{
+	std::string s = "images[" + std::to_string(i) + "] (";
+	if (!im->uri.empty())
+		s += "'" + im->uri + "'";
+	else if (im->bufferView >= 0)
+		s += "bufferViews[" + std::to_string(im->bufferView) + "]";
+	else
+		s += "a data URI";
+	return s + ")";
+}
+
+bool load_image(tg::Image *im, const int i, std::string *err, std::string *, int, int, const unsigned char *bytes,
+		int size, void *)
+{
+	unsigned char *px = nullptr;
+	int w = 0, h = 0, bits = 8;
+	char why[256];
+	if (!texture_decode(bytes, size > 0 ? (size_t)size : 0, &px, &w, &h, &bits, why, sizeof why)) {
+		if (err)
+			*err += image_name(im, i) + ": " + why + "\n";
+		return false;
+	}
+	im->width = w;
+	im->height = h;
+	im->component = 4;
+	im->bits = bits;
+	im->pixel_type = bits == 16 ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT : TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+	try {
+		im->image.assign(px, px + (size_t)w * (size_t)h * 4 * (size_t)(bits / 8));
+	} catch (...) {
+		texture_free(px);
+		throw;
+	}
+	texture_free(px);
 	return true;
 }
 
@@ -1366,6 +1411,7 @@ ajar_status load(Loader &L)
 	bool ok;
 	tg::FsCallbacks fs = {fs_exists, fs_expand, fs_read, tg::WriteWholeFile, &L};
 	loader.SetFsCallbacks(fs);
+	loader.SetImageLoader(load_image, &L);
 	if (data.size() >= 4 && memcmp(data.data(), "glTF", 4) == 0)
 		ok = loader.LoadBinaryFromMemory(&L.model, &err, &warn, data.data(), (unsigned)data.size(), L.dir);
 	else

@@ -12,6 +12,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <stb_image_write.h>
+
 static void test_hierarchy_trs(void **state)
 {
 	/* Parent: translate (1,2,3), scale 2; child 1: 90 degrees about +Y with
@@ -357,6 +359,86 @@ static void write_lights_gltf(const char *name, const char *scene_nodes, const c
 
 #define LIGHT_NODE(i) "{\"extensions\":{\"KHR_lights_punctual\":{\"light\":" #i "}}"
 
+/* ---- Images that lie about their size -----------------------------------
+ * tinygltf decoded every image from the size its header declares: a
+ * 688-byte JPEG declaring 20000 x 20000 texels loaded (4.7 GB, and a
+ * garbage texture, as stb reads past the end as zeros). Refused now before
+ * decoding (more than 16384 a side) or when the decoder reads past the
+ * end, each message naming the image by its URI. */
+static void spill_image(void *ctx, void *data, int n)
+{
+	FILE *f = ctx;
+	assert_int_equal(fwrite(data, 1, (size_t)n, f), (size_t)n);
+}
+
+/* test_dir/name: an 8 x 8 JPEG (or PNG) whose header declares w x h, cut
+ * to `keep` bytes (0: whole). */
+static void write_lying_image(const char *name, int jpeg, int w, int h, size_t keep)
+{
+	unsigned char rgb[8 * 8 * 3];
+	for (int i = 0; i < 8 * 8 * 3; i++)
+		rgb[i] = (unsigned char)(i * 37);
+	char *p = test_tmp(name);
+	FILE *f = fopen(p, "wb");
+	assert_non_null(f);
+	assert_true(jpeg ? stbi_write_jpg_to_func(spill_image, f, 8, 8, 3, rgb, 90)
+			 : stbi_write_png_to_func(spill_image, f, 8, 8, 3, rgb, 24));
+	assert_int_equal(fclose(f), 0);
+	f = fopen(p, "rb");
+	unsigned char buf[4096];
+	size_t n = fread(buf, 1, sizeof buf, f);
+	fclose(f);
+	for (size_t i = 0; jpeg && i + 9 < n; i++)
+		if (buf[i] == 0xff && buf[i + 1] == 0xc0) { /* SOF0: length, precision, height, width */
+			buf[i + 5] = (unsigned char)(h >> 8), buf[i + 6] = (unsigned char)h;
+			buf[i + 7] = (unsigned char)(w >> 8), buf[i + 8] = (unsigned char)w;
+			break;
+		}
+	if (!jpeg) { /* IHDR's width and height, big-endian at 16 */
+		for (int k = 0; k < 4; k++) {
+			buf[16 + k] = (unsigned char)(w >> (24 - 8 * k));
+			buf[20 + k] = (unsigned char)(h >> (24 - 8 * k));
+		}
+	}
+	write_bytes(name, buf, keep ? keep : n);
+	free(p);
+}
+
+static void test_lying_images(void **state)
+{
+	write_tri_bin();
+	static const struct {
+		const char *name;
+		int jpeg, w, h;
+		size_t keep;
+		const char *why;
+	} cases[] = {
+		{"huge.jpg", 1, 20000, 20000, 0, "'huge.jpg'): 20000x20000 texels: at most 16384 a side"},
+		{"wide.png", 0, 16385, 1, 0, "'wide.png'): 16385x1 texels: at most 16384 a side"},
+		{"cut.jpg", 1, 1000, 1000, 0, "'cut.jpg'): the image data is cut short"},
+		{"cut8.jpg", 1, 8, 8, 300, "'cut8.jpg'): the image data is cut short"},
+		{"junk.png", 0, 8, 8, 20, "'junk.png'): "},
+	};
+	for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+		write_lying_image(cases[k].name, cases[k].jpeg, cases[k].w, cases[k].h, cases[k].keep);
+		char json[2048];
+		snprintf(json, sizeof json,
+			 "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}]," TRI_BUFFERS(
+				 "tri.bin") "," TRI_ACCESSORS(3) ",\"images\":[{\"uri\":\"%s\"}]}",
+			 cases[k].name);
+		write_text("lying.gltf", json);
+		load_fails("lying.gltf", AJAR_ERROR_BAD_INPUT, cases[k].why);
+		assert_non_null(strstr(ajar_last_error(), "images[0] ("));
+	}
+	/* The same files whole and honest load. */
+	write_lying_image("ok.jpg", 1, 8, 8, 0);
+	write_lying_image("ok.png", 0, 8, 8, 0);
+	write_text("honest.gltf", "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}]," TRI_BUFFERS(
+					  "tri.bin") "," TRI_ACCESSORS(3) ",\"images\":[{\"uri\":\"ok.jpg\"},{\"uri\":\"ok.png\"}]}");
+	Scene *s = load_ok("honest.gltf");
+	scene_free(s);
+}
+
 static void test_lights_punctual(void **state)
 {
 	/* nodes[1]: the directional light turned -90 degrees about X (-Z to
@@ -435,6 +517,7 @@ int main(void)
 		cmocka_unit_test(test_portals_and_environment),
 		cmocka_unit_test(test_broken_files),
 		cmocka_unit_test(test_lights_punctual),
+		cmocka_unit_test(test_lying_images),
 	};
 	return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);
 }

@@ -1,0 +1,147 @@
+/* texture_file.c — texture images through stb_image, with the checks it
+ * lacks (texture_file.h). stb decodes from the size a header declares and
+ * reads past the end of the data as zeros: a 688-byte JPEG declaring
+ * 20000 x 20000 texels made it allocate 4.7 GB and gave a garbage texture.
+ * Here the declared size is checked first, and the decode goes through a
+ * reader that notices a read past the end. Otherwise it decodes exactly as
+ * tinygltf's own loader did (RGBA, 16 bits where the file has them), so
+ * textures are the same bits. */
+#include "image/texture_file.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <stb_image.h>
+
+typedef struct {
+	const unsigned char *p;
+	size_t n, pos;
+	int short_reads;
+} Bytes;
+
+static int cb_read(void *user, char *data, int size)
+{
+	Bytes *b = user;
+	size_t k = b->n - b->pos < (size_t)size ? b->n - b->pos : (size_t)size;
+	if (k == 0 && size > 0)
+		b->short_reads++;
+	memcpy(data, b->p + b->pos, k);
+	b->pos += k;
+	return (int)k;
+}
+
+static void cb_skip(void *user, int n)
+{
+	Bytes *b = user;
+	if (n < 0)
+		b->pos = (size_t)-(long)n > b->pos ? 0 : b->pos - (size_t)-(long)n;
+	else if ((size_t)n > b->n - b->pos)
+		b->pos = b->n, b->short_reads++;
+	else
+		b->pos += (size_t)n;
+}
+
+static int cb_eof(void *user)
+{
+	const Bytes *b = user;
+	return b->pos >= b->n;
+}
+
+static const stbi_io_callbacks callbacks = {cb_read, cb_skip, cb_eof};
+
+/* The fewest bytes a JPEG of its declared size can have: every scan codes
+ * each 8 x 8 block of a component with at least one bit (its DC
+ * coefficient, or an end-of-band run that covers it), so the first
+ * component's blocks at its sampling need that many bits. 0 if the file
+ * has no frame header (stb then says what is wrong). */
+static size_t jpeg_min_bytes(const unsigned char *p, size_t n)
+{
+	if (n < 4 || p[0] != 0xff || p[1] != 0xd8)
+		return 0;
+	for (size_t i = 2; i + 4 <= n;) {
+		if (p[i] != 0xff) {
+			i++;
+			continue;
+		}
+		unsigned m = p[i + 1];
+		if (m == 0xff || m == 0x01 || (m >= 0xd0 && m <= 0xd9)) { /* fill, TEM, RSTn, SOI, EOI: no length */
+			i += m == 0xff ? 1 : 2;
+			continue;
+		}
+		size_t len = (size_t)p[i + 2] << 8 | p[i + 3];
+		int sof = m >= 0xc0 && m <= 0xcf && m != 0xc4 && m != 0xc8 && m != 0xcc;
+		if (sof && i + 10 + 3 <= n && len >= 8) {
+			const unsigned char *f = p + i + 4; /* precision, height, width, components */
+			size_t h = (size_t)f[1] << 8 | f[2], w = (size_t)f[3] << 8 | f[4];
+			unsigned nc = f[5], hmax = 1, vmax = 1;
+			for (unsigned c = 0; c < nc && i + 10 + 3 * c + 3 <= n; c++) {
+				unsigned hv = f[7 + 3 * c];
+				hmax = (hv >> 4) > hmax ? hv >> 4 : hmax;
+				vmax = (hv & 15) > vmax ? hv & 15 : vmax;
+			}
+			unsigned h1 = f[7] >> 4, v1 = f[7] & 15;
+			if (nc == 0 || h1 == 0 || v1 == 0)
+				return 0;
+			size_t cw = (w * h1 + hmax - 1) / hmax, ch = (h * v1 + vmax - 1) / vmax;
+			return ((cw + 7) / 8) * ((ch + 7) / 8) / 8;
+		}
+		if (m == 0xda) /* the scan began before a frame header */
+			return 0;
+		i += 2 + len;
+	}
+	return 0;
+}
+
+int texture_decode(const unsigned char *bytes, size_t n, unsigned char **pixels, int *width, int *height, int *bits,
+		   char *why, size_t cap)
+{
+	*pixels = NULL;
+	Bytes b = {bytes, n, 0, 0};
+	int w = 0, h = 0, comp = 0;
+	if (n > 0x7fffffff) {
+		snprintf(why, cap, "larger than 2 GiB");
+		return 0;
+	}
+	if (!stbi_info_from_callbacks(&callbacks, &b, &w, &h, &comp)) {
+		const char *r = stbi_failure_reason();
+		snprintf(why, cap, "not an image stb_image reads (PNG, JPEG, ...): %s", r ? r : "unknown format");
+		return 0;
+	}
+	if (w < 1 || h < 1 || w > TEXTURE_MAX_SIDE || h > TEXTURE_MAX_SIDE) {
+		snprintf(why, cap, "%dx%d texels: at most %d a side", w, h, TEXTURE_MAX_SIDE);
+		return 0;
+	}
+	size_t need = jpeg_min_bytes(bytes, n);
+	if (need > n) {
+		snprintf(why, cap, "the image data is cut short (%zu bytes cannot code %dx%d texels)", n, w, h);
+		return 0;
+	}
+	unsigned char *data = NULL;
+	int depth = 8;
+	b = (Bytes){bytes, n, 0, 0};
+	int is16 = stbi_is_16_bit_from_callbacks(&callbacks, &b);
+	b = (Bytes){bytes, n, 0, 0};
+	if (is16 && (data = (unsigned char *)stbi_load_16_from_callbacks(&callbacks, &b, &w, &h, &comp, 4)))
+		depth = 16;
+	if (!data) {
+		b = (Bytes){bytes, n, 0, 0};
+		data = stbi_load_from_callbacks(&callbacks, &b, &w, &h, &comp, 4);
+	}
+	if (!data || b.short_reads) {
+		const char *r = stbi_failure_reason();
+		if (b.short_reads)
+			snprintf(why, cap, "the image data is cut short");
+		else
+			snprintf(why, cap, "cannot decode: %s", r ? r : "unknown error");
+		stbi_image_free(data);
+		return 0;
+	}
+	*pixels = data;
+	*width = w;
+	*height = h;
+	*bits = depth;
+	return 1;
+}
+
+void texture_free(unsigned char *pixels) { stbi_image_free(pixels); }
