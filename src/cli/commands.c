@@ -10,6 +10,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <libgen.h>
+#include <limits.h>
 #include <math.h>
 #include <signal.h>
 #include <stdatomic.h>
@@ -160,8 +161,17 @@ static int load_scene(const char *path, int allow_outside_files, ajar_scene **sc
 static int check_output(const char *opt, const char *path)
 {
 	struct stat sb;
-	if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode)) {
-		fprintf(stderr, "ajar: error: %s %s: is a directory\n", opt, path);
+	/* The library renames a new file onto the name: only a regular file
+	 * may be replaced, never a device (as root, -o /dev/full replaced
+	 * the device node), a FIFO or a symbolic link. */
+	if (lstat(path, &sb) == 0 && !S_ISREG(sb.st_mode)) {
+		const char *what = S_ISDIR(sb.st_mode)			? "is a directory"
+				   : S_ISLNK(sb.st_mode)		? "is a symbolic link (name its target)"
+				   : S_ISFIFO(sb.st_mode)		? "is a FIFO"
+				   : S_ISCHR(sb.st_mode) || S_ISBLK(sb.st_mode) ? "is a device"
+									: "is not a regular file";
+		fprintf(stderr, "ajar: error: %s %s: %s; outputs are written to a new file and renamed onto their name\n",
+			opt, path, what);
 		return EXIT_IO;
 	}
 	char *copy = strdup(path);
@@ -181,6 +191,51 @@ static int check_output(const char *opt, const char *path)
 	}
 	free(copy);
 	return rc;
+}
+
+/* Whether two names are one file: the same inode where both exist, else
+ * the same name once their folders are resolved. */
+static int same_file(const char *a, const char *b)
+{
+	struct stat sa, sb;
+	int ea = stat(a, &sa) == 0, eb = stat(b, &sb) == 0;
+	if (ea && eb)
+		return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+	if (ea != eb)
+		return 0;
+	char *ca = strdup(a), *cb = strdup(b), *da = strdup(a), *db = strdup(b);
+	char ra[PATH_MAX], rb[PATH_MAX];
+	int same = ca && cb && da && db && realpath(dirname(da), ra) && realpath(dirname(db), rb) && !strcmp(ra, rb) &&
+		   !strcmp(basename(ca), basename(cb));
+	free(ca);
+	free(cb);
+	free(da);
+	free(db);
+	return same;
+}
+
+/* No output may be the scene, the checkpoint resumed (unless it is the one
+ * kept up to date) or another output: -o naming the scene overwrote it. */
+static int check_outputs_distinct(const RenderArgs *a)
+{
+	const struct {
+		const char *opt, *path;
+	} out[] = {{"-o", a->exr}, {"--png", a->png}, {"--strategies", a->strategies}, {"--checkpoint", a->checkpoint}};
+	enum { N = sizeof out / sizeof out[0] };
+	for (int i = 0; i < N; i++) {
+		if (!out[i].path)
+			continue;
+		const char *clash = same_file(out[i].path, a->scene) ? "the scene"
+				    : i < 3 && a->resume && same_file(out[i].path, a->resume) ? "--resume"
+												 : NULL;
+		for (int j = 0; !clash && j < i; j++)
+			if (out[j].path && same_file(out[i].path, out[j].path))
+				clash = out[j].opt;
+		if (clash)
+			return args_usage_error("%s %s: is also %s; every output needs a file of its own", out[i].opt,
+						out[i].path, clash);
+	}
+	return EXIT_OK;
 }
 
 /* ---- Signals --------------------------------------------------------------- */
@@ -427,6 +482,8 @@ static int cmd_render(int argc, char **argv)
 			rc = check_output("--strategies", a.strategies);
 		if (rc == EXIT_OK && ckpt)
 			rc = check_output(a.checkpoint ? "--checkpoint" : "--resume", ckpt);
+		if (rc == EXIT_OK)
+			rc = check_outputs_distinct(&a);
 		if (rc == EXIT_OK && a.resume)
 			rc = resume_options(&a);
 	}

@@ -46,9 +46,31 @@ static const char *exr_why(exr_result_t rv)
 
 /* ---- Atomic output files ------------------------------------------------ */
 
+/* What an existing `path` is, if the rename would replace something that
+ * is not a plain file: a device node (as root, -o /dev/full replaced the
+ * device), a FIFO, a socket, a symbolic link (the link, not its target,
+ * would become the file) or a directory. NULL for a regular file or none. */
+static const char *not_replaceable(const char *path)
+{
+	struct stat sb;
+	if (lstat(path, &sb) != 0 || S_ISREG(sb.st_mode))
+		return NULL;
+	return S_ISDIR(sb.st_mode)			   ? "a directory"
+	       : S_ISLNK(sb.st_mode)			   ? "a symbolic link"
+	       : S_ISFIFO(sb.st_mode)			   ? "a FIFO"
+	       : S_ISCHR(sb.st_mode) || S_ISBLK(sb.st_mode) ? "a device"
+							   : "not a regular file";
+}
+
 ajar_status image_tmp_open(const char *path, char **tmp_path, int *fd)
 {
 	static atomic_uint counter;
+	const char *what = not_replaceable(path);
+	if (what)
+		return err_set(AJAR_ERROR_IO,
+			       "%s: is %s; outputs are written to a new file renamed onto their name, which would "
+			       "replace it (name a regular file)",
+			       path, what);
 	size_t n = strlen(path) + 48;
 	char *tmp = malloc(n);
 	if (!tmp)

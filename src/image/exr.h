@@ -36,7 +36,9 @@ ajar_status exr_decode_rgba(const char *path, int fd, const char *const channel[
  * a new file next to `path` (*tmp_path is malloc'd); image_tmp_finish
  * closes it and, if `status` is AJAR_OK, renames it to `path`, else removes
  * it, frees tmp_path and returns the final status. So a failed write never
- * leaves a partial file, nor replaces an existing one. */
+ * leaves a partial file, nor replaces an existing one. A `path` that is
+ * anything but a regular file (a device, FIFO, symbolic link, directory)
+ * is refused (I/O error): the rename would replace it. */
 ajar_status image_tmp_open(const char *path, char **tmp_path, int *fd);
 ajar_status image_tmp_finish(const char *path, char *tmp_path, int fd, ajar_status status);
 /* write() all of `data`, retrying short writes; errors name `path`. */

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -387,6 +388,83 @@ static void test_sigint(void **state)
 	free(err);
 }
 
+/* ---- Outputs that are not new regular files --------------------------------
+ * Outputs are written to a new file renamed onto their name, which
+ * replaced whatever had the name: a device node (as root, -o /dev/full
+ * replaced the device), a FIFO, a symbolic link (the link, not its
+ * target); -o naming the scene overwrote the scene with exit 0. Each is
+ * refused before rendering, and the name is left as it was. */
+static mode_t kind_of(const char *path)
+{
+	struct stat sb;
+	return lstat(path, &sb) == 0 ? sb.st_mode & S_IFMT : 0;
+}
+
+static void test_special_outputs(void **state)
+{
+	char *fifo = test_tmp("out-fifo.exr"), *link = test_tmp("out-link.exr"), *dev = test_tmp("out-null.exr");
+	char *target = test_tmp("target.exr");
+	assert_int_equal(mkfifo(fifo, 0644), 0);
+	assert_int_equal(symlink("target.exr", link), 0);
+	/* A character device like /dev/null, where the system lets us make
+	 * one (root in most containers); the test never names /dev itself. */
+	int have_dev = mknod(dev, S_IFCHR | 0666, makedev(1, 3)) == 0;
+	const char *names[3] = {fifo, link, dev};
+	const char *why[3] = {"is a FIFO", "is a symbolic link", "is a device"};
+	for (int k = 0; k < 2 + have_dev; k++) {
+		mode_t before = kind_of(names[k]);
+		expect((const char *[]){"render", CORNELL, "-o", names[k], "--size", "8x8", "--spp", "1", NULL}, 4, why[k]);
+		expect((const char *[]){"render", CORNELL, "-o", target, "--png", names[k], "--size", "8x8", "--spp", "1", NULL},
+		       4, why[k]);
+		assert_int_equal(kind_of(names[k]), before);
+		/* The library refuses too (ajar_write_exr, the PNG, checkpoints). */
+		float px[4] = {1, 1, 1, 1};
+		assert_int_equal(ajar_write_exr(names[k], px, 1, 1, NULL, 0), AJAR_ERROR_IO);
+		assert_non_null(strstr(ajar_last_error(), why[k]));
+		assert_int_equal(kind_of(names[k]), before);
+	}
+	assert_false(file_exists(target));
+	if (!have_dev)
+		printf("  (no device node: mknod not permitted here)\n");
+
+	/* An output that is the scene, or another output. */
+	char *scene = test_tmp("scene.gltf");
+	char *text = read_file(CORNELL);
+	FILE *f = fopen(scene, "wb");
+	assert_non_null(f);
+	fputs(text, f);
+	fclose(f);
+	char *bin = test_tmp("cornell.bin"), cmd[1024];
+	snprintf(cmd, sizeof cmd, "cp scenes/cornell/*.bin '%s/' 2>/dev/null; true", test_dir);
+	assert_int_equal(system(cmd), 0);
+	expect((const char *[]){"render", scene, "-o", scene, "--size", "8x8", "--spp", "1", NULL}, 1,
+	       "is also the scene");
+	char *again = read_file(scene);
+	assert_string_equal(again, text);
+	char *out = test_tmp("same.exr"), *dotted = test_tmp("./same.exr");
+	expect((const char *[]){"render", scene, "-o", out, "--png", dotted, "--size", "8x8", "--spp", "1", NULL}, 1,
+	       "is also -o");
+	expect((const char *[]){"render", scene, "-o", out, "--checkpoint", dotted, "--size", "8x8", "--spp", "1", NULL}, 1,
+	       "is also");
+	assert_false(file_exists(out));
+	free(again);
+	free(text);
+	free(bin);
+	free(out);
+	free(dotted);
+	snprintf(cmd, sizeof cmd, "rm -f '%s'/*.bin", test_dir);
+	assert_int_equal(system(cmd), 0);
+	unlink(scene);
+	free(scene);
+	unlink(fifo);
+	unlink(link);
+	unlink(dev);
+	free(fifo);
+	free(link);
+	free(dev);
+	free(target);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -398,6 +476,7 @@ int main(void)
 		cmocka_unit_test(test_tiny_render),
 		cmocka_unit_test(test_cl_options),
 		cmocka_unit_test(test_sigint),
+		cmocka_unit_test(test_special_outputs),
 	};
 	return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);
 }
