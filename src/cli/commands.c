@@ -242,21 +242,48 @@ static int check_outputs_distinct(const RenderArgs *a)
 
 static ajar_renderer *_Atomic g_renderer;
 static volatile sig_atomic_t g_interrupted;
+/* While a file is written, a second signal waits for it to be complete
+ * (g_deferred): ending at once left OUT.exr.tmpPID.N behind. */
+static volatile sig_atomic_t g_writing, g_deferred;
 
-static void on_signal(int sig)
+/* The signal's default action: the program ends as if never handled. */
+static void end_by(int sig)
 {
-	g_interrupted = 1;
-	/* The next SIGINT/SIGTERM takes the default action (ends the process). */
 	struct sigaction dfl;
 	memset(&dfl, 0, sizeof dfl);
 	dfl.sa_handler = SIG_DFL;
 	sigemptyset(&dfl.sa_mask);
 	sigaction(SIGINT, &dfl, NULL);
 	sigaction(SIGTERM, &dfl, NULL);
+	raise(sig);
+}
+
+static void on_signal(int sig)
+{
+	if (g_interrupted) { /* the second one ends the program */
+		if (g_writing)
+			g_deferred = sig;
+		else
+			end_by(sig);
+		return;
+	}
+	g_interrupted = 1;
 	/* The library documents ajar_renderer_cancel as signal-safe. */
 	ajar_renderer *r = atomic_load(&g_renderer);
 	if (r)
 		ajar_renderer_cancel(r);
+}
+
+/* Around every output the program writes (and the render, whose periodic
+ * checkpoint may be in flight): a second signal that came meanwhile ends
+ * the program once the file is complete. */
+static void writing_begin(void) { g_writing = 1; }
+
+static void writing_end(void)
+{
+	g_writing = 0;
+	if (g_deferred)
+		end_by(g_deferred);
 }
 
 static void install_signals(void)
@@ -326,20 +353,26 @@ static ajar_status write_png(ajar_renderer *r, const char *path, double exposure
 
 static int write_outputs(ajar_renderer *r, const RenderArgs *a)
 {
+	writing_begin();
 	ajar_status st = ajar_renderer_write_exr(r, a->exr);
+	writing_end();
 	if (st != AJAR_OK) {
 		report(st, a->exr);
 		return exit_code(st) == EXIT_BAD_INPUT ? EXIT_IO : exit_code(st);
 	}
 	if (a->strategies) {
+		writing_begin();
 		st = ajar_renderer_write_strategies(r, a->strategies);
+		writing_end();
 		if (st != AJAR_OK) {
 			report(st, a->strategies);
 			return exit_code(st) == EXIT_BAD_INPUT ? EXIT_IO : exit_code(st);
 		}
 	}
 	if (a->png) {
+		writing_begin();
 		st = write_png(r, a->png, a->exposure);
+		writing_end();
 		if (st != AJAR_OK) {
 			report(st, a->png);
 			return exit_code(st) == EXIT_BAD_INPUT ? EXIT_IO : exit_code(st);
@@ -411,7 +444,9 @@ static int resume_options(RenderArgs *a)
 /* The last checkpoint of a render that has samples; 0 or EXIT_IO. */
 static int final_checkpoint(ajar_renderer *r, const RenderArgs *a, const char *path)
 {
+	writing_begin();
 	ajar_status st = ajar_renderer_write_checkpoint(r, path);
+	writing_end();
 	if (st != AJAR_OK) {
 		report(st, path);
 		return EXIT_IO;
@@ -547,7 +582,11 @@ static int cmd_render(int argc, char **argv)
 			args_integrator_name(a.opt.integrator), budget, from, ranks, device ? device : "?");
 	}
 
+	if (ckpt) /* the render writes checkpoints as it goes */
+		writing_begin();
 	st = ajar_renderer_render(r, on_progress, &progress);
+	if (ckpt)
+		writing_end();
 	progress_break_line(&progress);
 	uint32_t spp = ajar_renderer_spp(r);
 	if (st != AJAR_OK && st != AJAR_ERROR_CANCELLED) {
@@ -558,8 +597,14 @@ static int cmd_render(int argc, char **argv)
 			 * then the checkpoint written during the render stays. */
 			if (size == 1)
 				final_checkpoint(r, &a, ckpt);
-			else if (ajar_renderer_write_checkpoint(r, ckpt) == AJAR_OK && !a.quiet)
-				fprintf(stderr, "ajar: checkpoint %s holds %u spp\n", ckpt, spp);
+			else {
+				writing_begin();
+				st = ajar_renderer_write_checkpoint(r, ckpt);
+				writing_end();
+				if (st == AJAR_OK && !a.quiet)
+					fprintf(stderr, "ajar: checkpoint %s holds %u spp\n", ckpt, spp);
+				st = AJAR_ERROR_DEVICE;
+			}
 			if (msg)
 				fprintf(stderr, "ajar: error: %s\n", msg);
 			free(msg);

@@ -27,6 +27,7 @@
 
 #include "core/error.h"
 #include "core/input_file.h"
+#include "image/image_overrides.h"
 
 /* The last message the OpenEXR library gave on this thread; it is more
  * specific than its error code (e.g. which attribute is malformed). */
@@ -95,10 +96,14 @@ ajar_status image_tmp_open(const char *path, char **tmp_path, int *fd)
 	return err_set(AJAR_ERROR_IO, "%s: cannot create a temporary file next to it", path);
 }
 
+void (*image_tmp_hook)(const char *tmp_path);
+
 ajar_status image_tmp_finish(const char *path, char *tmp_path, int fd, ajar_status status)
 {
 	if (close(fd) != 0 && status == AJAR_OK)
 		status = err_set(AJAR_ERROR_IO, "%s: cannot write file: %s", path, strerror(errno));
+	if (image_tmp_hook)
+		image_tmp_hook(tmp_path);
 	if (status == AJAR_OK && rename(tmp_path, path) != 0)
 		status = err_set(AJAR_ERROR_IO, "%s: cannot rename %s to it: %s", path, tmp_path,
 				 strerror(errno));

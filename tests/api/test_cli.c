@@ -465,6 +465,43 @@ static void test_special_outputs(void **state)
 	free(target);
 }
 
+/* A second SIGINT while the image is being written waited for nothing:
+ * the program ended with OUT.exr.tmpPID.N left behind, against "a failed
+ * run leaves no partial file". The command with faults
+ * (tests/support/ajar_faults.c) raises two SIGINTs when the EXR's
+ * temporary file is complete but not yet renamed: the program ends by the
+ * second (as a second Ctrl-C does) once that file is whole, writes no
+ * other output, and leaves no temporary file. */
+static void test_second_sigint_in_write(void **state)
+{
+	char *exr = test_tmp("sig.exr"), *png = test_tmp("sig.png");
+	assert_int_equal(setenv("AJAR_TEST_SIGNALS_IN_WRITE", "2", 1), 0);
+	pid_t pid = fork();
+	assert_true(pid >= 0);
+	if (pid == 0) {
+		int null = open("/dev/null", O_WRONLY);
+		if (null >= 0)
+			dup2(null, 2);
+		execl(test_ajar_faults_bin(), "ajar", "render", CORNELL, "-o", exr, "--png", png, "--size", "8x8", "--spp",
+		      "1", "-q", (char *)NULL);
+		_exit(127);
+	}
+	assert_int_equal(unsetenv("AJAR_TEST_SIGNALS_IN_WRITE"), 0);
+	int status;
+	assert_int_equal(waitpid(pid, &status, 0), pid);
+	assert_true(WIFSIGNALED(status) && WTERMSIG(status) == SIGINT);
+	assert_int_equal(count_tmp_entries(), 1); /* the EXR, whole; no PNG, no temporary */
+	float *px;
+	uint32_t w, h;
+	assert_int_equal(ajar_read_exr(exr, &px, &w, &h), AJAR_OK);
+	assert_int_equal(w, 8);
+	free(px);
+	assert_false(file_exists(png));
+	unlink(exr);
+	free(exr);
+	free(png);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -477,6 +514,7 @@ int main(void)
 		cmocka_unit_test(test_cl_options),
 		cmocka_unit_test(test_sigint),
 		cmocka_unit_test(test_special_outputs),
+		cmocka_unit_test(test_second_sigint_in_write),
 	};
 	return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);
 }

@@ -5,17 +5,35 @@
  *   AJAR_TEST_FAIL_DEVICE=<device>:<pass>[:lost]  pass <pass> (from 1) of
  *       device <device> (from 0, in selection order) fails at launch, or
  *       with ":lost" after its kernel ran;
- *   AJAR_TEST_PASS_SPP=N  every pass renders at most N samples per pixel.
+ *   AJAR_TEST_PASS_SPP=N  every pass renders at most N samples per pixel;
+ *   AJAR_TEST_SIGNALS_IN_WRITE=N  N SIGINTs are raised while the first
+ *       output file is written (its temporary name complete, not renamed).
  * Without them it is the `ajar` command. */
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "cli/commands.h"
+#include "image/image_overrides.h"
 #include "render/render_overrides.h"
+
+static int signals_in_write;
+
+static void raise_in_write(const char *tmp_path)
+{
+	(void)tmp_path;
+	for (; signals_in_write > 0; signals_in_write--)
+		raise(SIGINT);
+}
 
 int main(int argc, char **argv)
 {
+	const char *sig = getenv("AJAR_TEST_SIGNALS_IN_WRITE");
+	if (sig) {
+		signals_in_write = atoi(sig);
+		image_tmp_hook = raise_in_write;
+	}
 	const char *fail = getenv("AJAR_TEST_FAIL_DEVICE"), *spp = getenv("AJAR_TEST_PASS_SPP");
 	unsigned device, pass;
 	char mode[8] = "";
