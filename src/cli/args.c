@@ -12,9 +12,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Largest image side we accept; far beyond any sensible render, small
- * enough that width * height * 16 bytes cannot overflow anywhere. */
-#define MAX_SIDE 65536u
+/* Largest image side: the library's (AJAR_MAX_SIDE), said here so the
+ * message states the real limit. */
+#define MAX_SIDE AJAR_MAX_SIDE
 
 int args_usage_error(const char *fmt, ...)
 {

@@ -38,6 +38,39 @@ ajar_status cl_fail(const Device *d, const char *what, cl_int err)
 		       cl_error_name(err), (int)err);
 }
 
+ajar_status device_reserve(const Device *d, const size_t *sizes, int n, const char *what)
+{
+	cl_ulong max_alloc = 0, global = 0;
+	clGetDeviceInfo(d->id, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof max_alloc, &max_alloc, NULL);
+	clGetDeviceInfo(d->id, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof global, &global, NULL);
+	double total = 0, largest = 0;
+	for (int i = 0; i < n; i++) {
+		total += (double)sizes[i];
+		largest = sizes[i] > largest ? (double)sizes[i] : largest;
+	}
+	const double mib = 1024.0 * 1024.0;
+	if (max_alloc && largest > (double)max_alloc)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY,
+			       "OpenCL device %s: %s need a buffer of %.0f MiB; the device allows %.0f MiB in one", d->name,
+			       what, largest / mib, (double)max_alloc / mib);
+	if (global && total > (double)global)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "OpenCL device %s: %s need %.0f MiB; the device has %.0f MiB",
+			       d->name, what, total / mib, (double)global / mib);
+	if (!d->is_cpu)
+		return AJAR_OK;
+	void **p = calloc((size_t)n + 1, sizeof *p);
+	int ok = p != NULL;
+	for (int i = 0; ok && i < n; i++)
+		ok = (p[i] = malloc(sizes[i] ? sizes[i] : 1)) != NULL;
+	for (int i = 0; p && i < n; i++)
+		free(p[i]);
+	free(p);
+	if (!ok)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "OpenCL device %s: out of memory for %s (%.0f MiB)", d->name, what,
+			       total / mib);
+	return AJAR_OK;
+}
+
 ajar_status device_open(Device *d, cl_platform_id platform, cl_device_id id)
 {
 	cl_int err;

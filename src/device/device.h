@@ -27,6 +27,12 @@ ajar_status device_open(Device *d, cl_platform_id platform, cl_device_id id);
 void device_close(Device *d);
 ajar_status device_kernel(Device *d, const char *name, cl_kernel *out);
 ajar_status device_buffer(Device *d, cl_mem_flags flags, size_t bytes, const void *host, cl_mem *out);
+/* Whether buffers of the n sizes can all be had on d, asked before any is
+ * made: OpenCL's limits for one buffer and for all, and on a CPU device,
+ * whose buffers are host memory that PoCL allocates only when a buffer is
+ * first used (aborting the process when that fails), by allocating them
+ * here at once and freeing them. AJAR_ERROR_OUT_OF_MEMORY naming `what`. */
+ajar_status device_reserve(const Device *d, const size_t *sizes, int n, const char *what);
 
 /* Names the failing call and the OpenCL error on the device. */
 ajar_status cl_fail(const Device *d, const char *what, cl_int err);

@@ -92,14 +92,15 @@ static ajar_status renderer_new(const ajar_scene *scene, const ajar_options *opt
 		goto fail;
 	if (ck && (st = render_checkpoint_check(r, ck, ck_path)) != AJAR_OK)
 		goto fail;
-	if ((st = render_devices_open(r, opt->device)) != AJAR_OK)
-		goto fail;
+	/* The host's films first: they fail cleanly, before any device works. */
 	r->film = calloc(3 * (size_t)r->width * r->height, sizeof *r->film);
 	r->film_splat = calloc(film_splat_count(r), sizeof *r->film_splat);
 	if (!r->film || !r->film_splat) {
 		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory for a %ux%u image", r->width, r->height);
 		goto fail;
 	}
+	if ((st = render_devices_open(r, opt->device)) != AJAR_OK)
+		goto fail;
 	if (ck && (st = render_checkpoint_apply(r, ck, ck_path)) != AJAR_OK)
 		goto fail;
 	if ((st = job_join(r, AJAR_OK)) != AJAR_OK)

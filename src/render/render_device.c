@@ -74,6 +74,19 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 		free(why);
 		return st;
 	}
+	/* The scene's arrays, the films and the scratch, all known before one is made. */
+	size_t sizes[AJAR_MAX_BUFFERS + 3];
+	int nsizes = 0;
+#define AJAR_SIZE(type, name) sizes[nsizes++] = sizeof(type) * r->data.n_##name;
+	AJAR_SCENE_BUFFERS(AJAR_SIZE)
+#undef AJAR_SIZE
+	sizes[nsizes++] = bytes;
+	sizes[nsizes++] = sbytes;
+	sizes[nsizes++] = rd->plan.soa ? rd->plan.scratch_bytes : 4;
+	char what[96];
+	snprintf(what, sizeof what, "the scene and the films of a %ux%u image", r->width, r->height);
+	if ((st = device_reserve(d, sizes, nsizes, what)) != AJAR_OK)
+		return st;
 	if ((st = device_kernel(d, "render_pass", &rd->k_render)) != AJAR_OK ||
 	    (st = upload_scene(d, &r->data, &rd->bufs)) != AJAR_OK ||
 	    (st = upload_bind(d, rd->k_render, &rd->bufs, &rd->arg_first)) != AJAR_OK ||

@@ -28,14 +28,19 @@ size_t film_splat_count(const ajar_renderer *r)
 
 size_t film_splat_bytes(const ajar_renderer *r) { return sizeof(cl_long) * film_splat_count(r); }
 
-int film_read(RenderDevice *rd, long **accum, long **splat)
+/* A device's films into host arrays of film_bytes and film_splat_bytes. */
+static int film_read_into(RenderDevice *rd, long *accum, long *splat)
 {
 	size_t bytes = film_bytes(rd->r), sbytes = film_splat_bytes(rd->r);
-	*accum = malloc(bytes);
-	*splat = malloc(sbytes);
-	if (*accum && *splat &&
-	    clEnqueueReadBuffer(rd->dev.queue, rd->accum, CL_TRUE, 0, bytes, *accum, 0, NULL, NULL) == CL_SUCCESS &&
-	    clEnqueueReadBuffer(rd->dev.queue, rd->splat, CL_TRUE, 0, sbytes, *splat, 0, NULL, NULL) == CL_SUCCESS)
+	return clEnqueueReadBuffer(rd->dev.queue, rd->accum, CL_TRUE, 0, bytes, accum, 0, NULL, NULL) == CL_SUCCESS &&
+	       clEnqueueReadBuffer(rd->dev.queue, rd->splat, CL_TRUE, 0, sbytes, splat, 0, NULL, NULL) == CL_SUCCESS;
+}
+
+int film_read(RenderDevice *rd, long **accum, long **splat)
+{
+	*accum = malloc(film_bytes(rd->r));
+	*splat = malloc(film_splat_bytes(rd->r));
+	if (*accum && *splat && film_read_into(rd, *accum, *splat))
 		return 1;
 	free(*accum);
 	free(*splat);
@@ -84,21 +89,28 @@ ajar_status film_reduce(ajar_renderer *r)
 			sum_splat[i] += r->remote_splat[i];
 	}
 	/* Integer sums first, scaled once: the same bits whatever the device count. */
+	long *a = NULL, *s = NULL;
 	for (uint32_t k = 0; k < r->ndev; k++) {
 		RenderDevice *rd = &r->devs[k];
-		long *a, *s;
 		if (!rd->alive || rd->rank) /* another rank's films are in r->remote */
 			continue;
-		if (!film_read(rd, &a, &s))
-			return err_set(AJAR_ERROR_DEVICE, "OpenCL device %s: reading the film back failed",
-				       rd->dev.name);
+		if (!a && (!(a = malloc(film_bytes(r))) || !(s = malloc(film_splat_bytes(r))))) {
+			free(a);
+			return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory reading back the films of a %ux%u image",
+				       r->width, r->height);
+		}
+		if (!film_read_into(rd, a, s)) {
+			free(a);
+			free(s);
+			return err_set(AJAR_ERROR_DEVICE, "OpenCL device %s: reading the film back failed", rd->dev.name);
+		}
 		for (size_t i = 0; i < n; i++)
 			sum[i] += a[i];
 		for (size_t i = 0; i < ns; i++)
 			sum_splat[i] += s[i];
-		free(a);
-		free(s);
 	}
+	free(a);
+	free(s);
 	return AJAR_OK;
 }
 

@@ -22,9 +22,9 @@ ajar_status options_resolve(const ajar_options *in, ajar_options *out)
 	ajar_options *o = out;
 	if (o->max_depth == 0)
 		o->max_depth = o->integrator == AJAR_INTEGRATOR_PT ? 64 : AJAR_BIDIR_MAX_DEPTH;
-	if (o->width > 16384 || o->height > 16384 || (o->width == 0) != (o->height == 0))
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "image size %ux%u: both must be in 1..16384",
-			       o->width, o->height);
+	if (o->width > AJAR_MAX_SIDE || o->height > AJAR_MAX_SIDE || (o->width == 0) != (o->height == 0))
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "image size %ux%u: both must be in 1..%u", o->width,
+			       o->height, AJAR_MAX_SIDE);
 	if (o->integrator != AJAR_INTEGRATOR_PT && o->integrator != AJAR_INTEGRATOR_BDPT &&
 	    o->integrator != AJAR_INTEGRATOR_PORTAL)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "unknown integrator %d", (int)o->integrator);

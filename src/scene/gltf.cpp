@@ -571,9 +571,10 @@ ajar_status read_resolution(Loader &L, const tg::Value &extras, const char *wher
 	if (!r || L.s->width)
 		return AJAR_OK;
 	if (!r->IsArray() || r->ArrayLen() != 2 || !r->Get(0).IsNumber() || !r->Get(1).IsNumber() ||
-	    !(r->Get(0).GetNumberAsDouble() >= 1 && r->Get(0).GetNumberAsDouble() <= 65536) ||
-	    !(r->Get(1).GetNumberAsDouble() >= 1 && r->Get(1).GetNumberAsDouble() <= 65536))
-		return fail(L, AJAR_ERROR_BAD_INPUT, "%s.extras.resolution must be [width, height] in 1..65536", where);
+	    !(r->Get(0).GetNumberAsDouble() >= 1 && r->Get(0).GetNumberAsDouble() <= AJAR_MAX_SIDE) ||
+	    !(r->Get(1).GetNumberAsDouble() >= 1 && r->Get(1).GetNumberAsDouble() <= AJAR_MAX_SIDE))
+		return fail(L, AJAR_ERROR_BAD_INPUT, "%s.extras.resolution must be [width, height] in 1..%u", where,
+			    AJAR_MAX_SIDE);
 	L.s->width = (uint32_t)r->Get(0).GetNumberAsDouble();
 	L.s->height = (uint32_t)r->Get(1).GetNumberAsDouble();
 	return AJAR_OK;
