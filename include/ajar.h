@@ -182,12 +182,16 @@ typedef enum { AJAR_MIS_POWER = 0, AJAR_MIS_BALANCE = 1, AJAR_MIS_AUTO = 2 } aja
 #define AJAR_AOV_DEPTH 4u    /* distance from the camera to the first hit */
 #define AJAR_AOV_VARIANCE 8u /* variance of the pixel mean of the pixel's own samples */
 #define AJAR_AOV_ALL 15u
-/* Image and AOVs: at most AJAR_MAX_SIDE pixels a side. */
+/* Most samples per pixel a render takes (ajar_options.spp, and where a
+ * time limit alone stops it): 2^21, where the 64-bit fixed-point films of
+ * a pixel's own samples and of the AOVs cannot overflow. Image and AOVs:
+ * at most AJAR_MAX_SIDE pixels a side. */
+#define AJAR_MAX_SPP 2097152u
 #define AJAR_MAX_SIDE 16384u
 
 typedef struct {
 	uint32_t width, height;  /* 0: scene's suggestion, else 512 x 512/aspect; at most AJAR_MAX_SIDE */
-	uint32_t spp;            /* samples per pixel; 0 = until time_limit */
+	uint32_t spp;            /* samples per pixel, at most AJAR_MAX_SPP; 0 = until time_limit */
 	double time_limit;       /* seconds; 0 = none */
 	ajar_integrator integrator;
 	uint32_t max_depth;      /* maximum path segments (camera segment included) */

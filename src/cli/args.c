@@ -198,7 +198,7 @@ int args_parse_render(int argc, char **argv, RenderArgs *a)
 		else if (!strcmp(name, "--checkpoint-every"))
 			rc = parse_seconds(name, val, &a->checkpoint_every);
 		else if (!strcmp(name, "--spp")) {
-			rc = parse_u32(name, val, 1, UINT32_MAX, &a->opt.spp);
+			rc = parse_u32(name, val, 1, AJAR_MAX_SPP, &a->opt.spp);
 			spp_given = 1;
 		} else if (!strcmp(name, "--time")) {
 			rc = parse_seconds(name, val, &a->opt.time_limit);

@@ -16,6 +16,8 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "film/aov_layout.h"
+#include "film/film.h"
 #include "render/cluster.h"
 #include "render/render_film.h"
 #include "render/render_job.h"
@@ -206,6 +208,34 @@ ajar_status render_checkpoint_check(ajar_renderer *r, const Checkpoint *c, const
 	return AJAR_OK;
 }
 
+/* A checkpoint's films hold what `done` samples a pixel can add, as any
+ * input is checked: the own pixels' sums in [0, done FILM_SAMPLE_MAX],
+ * splats and strategy layers >= 0, each AOV within done times its
+ * per-sample bound. A value near 2^63 in a crafted file made the next sum
+ * overflow (UBSan: signed overflow); now it is refused naming the file. */
+static ajar_status checkpoint_films_check(const ajar_renderer *r, const Checkpoint *c, uint64_t done,
+					  const char *path)
+{
+	const long own = (long)done * FILM_SAMPLE_MAX;
+	const long sq = (long)done * ((long)AOV_SQ_MAX * (long)AOV_SQ_SCALE + 1);
+	static const char *const what[CKPT_SECTIONS] = {"the pixels' own sums", "the splat or strategy films",
+							"the AOV film"};
+	for (int sec = 0; sec < CKPT_SECTIONS; sec++)
+		for (size_t i = 0; i < c->nfilm[sec]; i++) {
+			long v = c->film[sec][i];
+			int ok = sec == CKPT_ACCUM   ? v >= 0 && v <= own
+				 : sec == CKPT_SPLAT ? v >= 0
+				 : i % AOV_CHANNELS < 7 ? v >= -own && v <= own
+							: v >= 0 && v <= sq;
+			if (!ok)
+				return err_set(AJAR_ERROR_BAD_INPUT,
+					       "%s: checkpoint is corrupted (%s: value %zu, %ld, is more than %llu samples per "
+					       "pixel can add)",
+					       path, what[sec], i, v, (unsigned long long)done);
+		}
+	return AJAR_OK;
+}
+
 ajar_status render_checkpoint_apply(ajar_renderer *r, Checkpoint *c, const char *path)
 {
 	size_t n = 3 * (size_t)r->width * r->height, ns = film_aov_offset(r);
@@ -227,6 +257,13 @@ ajar_status render_checkpoint_apply(ajar_renderer *r, Checkpoint *c, const char 
 		end = g.first + g.count;
 		done += g.count;
 	}
+	if (end > AJAR_MAX_SPP)
+		return err_set(AJAR_ERROR_BAD_INPUT,
+			       "%s: checkpoint is corrupted (sample indices up to %u, beyond the %u a render takes)", path,
+			       end, AJAR_MAX_SPP);
+	ajar_status st = checkpoint_films_check(r, c, done, path);
+	if (st != AJAR_OK)
+		return st;
 	if (r->spp_target && r->spp_target < end)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT,
 			       "%s: the checkpoint holds %llu samples per pixel (indices up to %u); a sample count of %u "

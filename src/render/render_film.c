@@ -48,6 +48,43 @@ int film_read(RenderDevice *rd, long **accum, long **splat)
 	return 0;
 }
 
+/* dst += src over n values, all or none: the index of the first sum that
+ * would pass the 64-bit range, or n when none does (the films' values are
+ * sums of bounded samples, but light paths' splats have no count bound, and
+ * a checkpoint can say anything). */
+static size_t add_all_or_none(long *dst, const long *src, size_t n)
+{
+	long t;
+	for (size_t i = 0; i < n; i++)
+		if (__builtin_add_overflow(dst[i], src[i], &t))
+			return i;
+	for (size_t i = 0; i < n; i++)
+		dst[i] += src[i];
+	return n;
+}
+
+/* The error for a film value (index i of an RGB film, layers after the
+ * first) whose sum passes 2^63. */
+static ajar_status film_overflow(const ajar_renderer *r, size_t i)
+{
+	size_t pix = (i / 3) % ((size_t)r->width * r->height);
+	return err_set(AJAR_ERROR_BAD_INPUT,
+		       "pixel (%zu, %zu): the sum of its samples passes the 64-bit film (2^63 at 2^20 a unit: 8.8e12 "
+		       "per pixel and channel, light paths' splats included): the scene is too bright for %u samples "
+		       "per pixel",
+		       pix % r->width, pix / r->width, r->spp_done);
+}
+
+/* The own pixels', splat and strategy films hold sums of values >= 0: a
+ * negative one wrapped past 2^63 on a device. */
+static ajar_status film_check(const ajar_renderer *r, const long *v, size_t n)
+{
+	for (size_t i = 0; i < n; i++)
+		if (v[i] < 0)
+			return film_overflow(r, i);
+	return AJAR_OK;
+}
+
 int film_salvage_add(ajar_renderer *r, const long *accum, const long *splat)
 {
 	size_t n = 3 * (size_t)r->width * r->height, ns = film_splat_count(r);
@@ -61,10 +98,17 @@ int film_salvage_add(ajar_renderer *r, const long *accum, const long *splat)
 			return 0;
 		}
 	}
+	/* A film that would overflow the salvage is not kept: its ranges are
+	 * rendered again, and the sums are checked once more at the end. */
+	long t;
 	for (size_t i = 0; i < n; i++)
-		r->salvage[i] += accum[i];
+		if (__builtin_add_overflow(r->salvage[i], accum[i], &t))
+			return 0;
 	for (size_t i = 0; i < ns; i++)
-		r->salvage_splat[i] += splat[i];
+		if (__builtin_add_overflow(r->salvage_splat[i], splat[i], &t))
+			return 0;
+	add_all_or_none(r->salvage, accum, n);
+	add_all_or_none(r->salvage_splat, splat, ns);
 	return 1;
 }
 
@@ -82,11 +126,12 @@ ajar_status film_reduce(ajar_renderer *r)
 		memset(sum, 0, n * sizeof *sum);
 		memset(sum_splat, 0, ns * sizeof *sum_splat);
 	}
+	size_t at;
 	if (r->remote) { /* rank 0: what the other ranks rendered */
-		for (size_t i = 0; i < n; i++)
-			sum[i] += r->remote[i];
-		for (size_t i = 0; i < ns; i++)
-			sum_splat[i] += r->remote_splat[i];
+		if ((at = add_all_or_none(sum, r->remote, n)) < n)
+			return film_overflow(r, at);
+		if ((at = add_all_or_none(sum_splat, r->remote_splat, ns)) < ns)
+			return film_overflow(r, at);
 	}
 	/* Integer sums first, scaled once: the same bits whatever the device count. */
 	long *a = NULL, *s = NULL;
@@ -104,14 +149,16 @@ ajar_status film_reduce(ajar_renderer *r)
 			free(s);
 			return err_set(AJAR_ERROR_DEVICE, "OpenCL device %s: reading the film back failed", rd->dev.name);
 		}
-		for (size_t i = 0; i < n; i++)
-			sum[i] += a[i];
-		for (size_t i = 0; i < ns; i++)
-			sum_splat[i] += s[i];
+		if ((at = add_all_or_none(sum, a, n)) < n || (at = add_all_or_none(sum_splat, s, ns)) < ns) {
+			free(a);
+			free(s);
+			return film_overflow(r, at);
+		}
 	}
 	free(a);
 	free(s);
-	return AJAR_OK;
+	ajar_status st = film_check(r, sum, n);
+	return st != AJAR_OK ? st : film_check(r, sum_splat, film_aov_offset(r));
 }
 
 ajar_status film_image(ajar_renderer *r, float *rgba)
@@ -123,8 +170,12 @@ ajar_status film_image(ajar_renderer *r, float *rgba)
 	long *sum = r->film, *sum_splat = r->film_splat;
 	double scale = r->spp_done ? 1.0 / ((double)FILM_SCALE * r->spp_done) : 0.0;
 	for (size_t i = 0; i < n / 3; i++) {
-		for (int c = 0; c < 3; c++)
-			rgba[4 * i + c] = (float)((double)(sum[3 * i + c] + sum_splat[3 * i + c]) * scale);
+		for (int c = 0; c < 3; c++) {
+			long v;
+			if (__builtin_add_overflow(sum[3 * i + c], sum_splat[3 * i + c], &v))
+				return film_overflow(r, 3 * i + c);
+			rgba[4 * i + c] = (float)((double)v * scale);
+		}
 		rgba[4 * i + 3] = 1.0f;
 	}
 	return AJAR_OK;

@@ -25,6 +25,10 @@ ajar_status options_resolve(const ajar_options *in, ajar_options *out)
 	if (o->width > AJAR_MAX_SIDE || o->height > AJAR_MAX_SIDE || (o->width == 0) != (o->height == 0))
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "image size %ux%u: both must be in 1..%u", o->width,
 			       o->height, AJAR_MAX_SIDE);
+	if (o->spp > AJAR_MAX_SPP)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT,
+			       "%u samples per pixel: at most %u (AJAR_MAX_SPP), where the 64-bit films cannot overflow",
+			       o->spp, AJAR_MAX_SPP);
 	if (o->integrator != AJAR_INTEGRATOR_PT && o->integrator != AJAR_INTEGRATOR_BDPT &&
 	    o->integrator != AJAR_INTEGRATOR_PORTAL)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "unknown integrator %d", (int)o->integrator);

@@ -27,8 +27,10 @@ double scheduler_time_left(const ajar_renderer *r)
 
 uint64_t scheduler_work_left(const ajar_renderer *r)
 {
-	uint64_t n = r->spp_target ? r->spp_target - r->next_first : UINT64_MAX;
-	for (size_t i = 0; i < r->holes.n && n != UINT64_MAX; i++)
+	/* A time limit alone stops at AJAR_MAX_SPP too (the films' bound). */
+	uint32_t target = r->spp_target ? r->spp_target : AJAR_MAX_SPP;
+	uint64_t n = target > r->next_first ? target - r->next_first : 0;
+	for (size_t i = 0; i < r->holes.n; i++)
 		n += r->holes.r[i].count;
 	return n;
 }
@@ -46,7 +48,7 @@ int scheduler_take_range(ajar_renderer *r, RenderDevice *rd, Range *g)
 	uint32_t count = 1;
 	if (rd->per_spp > 0) {
 		count = (uint32_t)fmax(1.0, fmin(fmin(PASS_SECONDS, scheduler_time_left(r)) / rd->per_spp, 1e6));
-		if (left != UINT64_MAX) {
+		if (r->spp_target) {
 			/* Near the end, split the rest by speed; a device not
 			 * measured yet counts as fast as this one. */
 			double rates = 0;

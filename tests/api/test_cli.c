@@ -164,8 +164,9 @@ static void test_usage_errors(void **state)
 	expect((const char *[]){"render", CORNELL, "-o", out, "--size", "0x5", NULL}, 1, "--size");
 	expect((const char *[]){"render", CORNELL, "-o", out, "--size", "abc", NULL}, 1, "--size");
 	expect((const char *[]){"render", CORNELL, "-o", out, "--size=64x", NULL}, 1, "--size");
-	/* The real limit, stated: 16384 a side (not 65536). */
+	/* The real limits, stated: 16384 a side (not 65536), 2^21 spp (not 2^32 - 1). */
 	expect((const char *[]){"render", CORNELL, "-o", out, "--size", "16385x8", NULL}, 1, "(1 to 16384)");
+	expect((const char *[]){"render", CORNELL, "-o", out, "--spp", "2097153", NULL}, 1, "(1 to 2097152)");
 	expect((const char *[]){"render", CORNELL, "-o", out, "--time", "-1", NULL}, 1, "--time");
 	expect((const char *[]){"render", CORNELL, "-o", out, "--integrator", "magic", NULL}, 1, "--integrator");
 	expect((const char *[]){"render", CORNELL, "-o", out, "--mis", "heavy", NULL}, 1, "not auto, power or balance");

@@ -1,6 +1,14 @@
 /* test_limits.c — the limits a render keeps, stated in include/ajar.h and
  * enforced before anything overflows or is allocated:
  *
+ * - samples per pixel: at most AJAR_MAX_SPP (2^21), where the 64-bit
+ *   fixed-point films of a pixel's own samples and of the AOVs cannot
+ *   overflow; a render with a time limit alone stops there. A 1x1 render
+ *   of a sky of radiance 1e7 (clamped to 1e6 a sample) gave -954,687 at
+ *   9M spp with exit 0;
+ * - films whose sums pass 2^63 anyway (light paths' splats have no count
+ *   bound; a checkpoint can say anything) are refused, never wrapped, and
+ *   a checkpoint's films must hold what its samples can add;
  * - image size: at most AJAR_MAX_SIDE a side, and memory for the films
  *   found missing before the device touches them: under an address-space
  *   limit PoCL aborted the process (exit 134) when a film it allocates on
@@ -13,11 +21,20 @@
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include "ajar.h"
 #include "testutil.h"
 
 #define CORNELL SCENE("cornell/cornell.gltf")
+
+static ajar_scene *load(const char *path)
+{
+	ajar_scene *s = NULL;
+	if (ajar_scene_load(path, &s) != AJAR_OK)
+		fail_msg("%s: %s", path, ajar_last_error());
+	return s;
+}
 
 /* A triangle far behind the camera and a sky of radiance `sky`: every
  * camera ray sees the sky. */
@@ -47,6 +64,104 @@ static ajar_options tiny(uint32_t spp)
 	o.width = o.height = 1;
 	o.spp = spp;
 	return o;
+}
+
+/* The cap: more is refused, and a time limit alone stops at it with the
+ * clamped value, 1e6 (before: the render ran on to the time limit, past
+ * 8.8M spp, where the film wrapped). */
+static void test_spp_cap(void **state)
+{
+	ajar_scene *s = sky_scene(1e7f);
+	ajar_renderer *r = NULL;
+	ajar_options o = tiny(AJAR_MAX_SPP + 1);
+	assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_ERROR_INVALID_ARGUMENT);
+	assert_non_null(strstr(ajar_last_error(), "2097152"));
+	o = tiny(0);
+	o.time_limit = 40; /* far more than the ~3 s the cap takes; the render stops at the cap */
+	assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_OK);
+	assert_int_equal(ajar_renderer_render(r, NULL, NULL), AJAR_OK);
+	assert_int_equal(ajar_renderer_spp(r), AJAR_MAX_SPP);
+	float px[4];
+	uint32_t w, h;
+	assert_int_equal(ajar_renderer_image(r, px, &w, &h), AJAR_OK);
+	assert_float_equal(px[0], 1e6f, 1.0f);
+	ajar_renderer_destroy(&r);
+	ajar_scene_destroy(&s);
+}
+
+/* The checkpoint of a 1x1 render of `scene` with `integrator` at `spp`,
+ * its bytes in *buf (malloc'ed). */
+static size_t checkpoint_bytes(ajar_scene *s, ajar_integrator integrator, uint32_t spp, const char *path,
+			       unsigned char **buf)
+{
+	ajar_options o = tiny(spp);
+	o.integrator = integrator;
+	ajar_renderer *r = NULL;
+	assert_int_equal(ajar_renderer_create(s, &o, &r), AJAR_OK);
+	assert_int_equal(ajar_renderer_render(r, NULL, NULL), AJAR_OK);
+	assert_int_equal(ajar_renderer_write_checkpoint(r, path), AJAR_OK);
+	ajar_renderer_destroy(&r);
+	FILE *f = fopen(path, "rb");
+	assert_non_null(f);
+	*buf = malloc(1 << 16);
+	size_t n = fread(*buf, 1, 1 << 16, f);
+	fclose(f);
+	return n;
+}
+
+/* Sets film value k of a 1x1 checkpoint without AOVs (3 own, then 3
+ * splat values, then the CRC-32) and writes it back with a valid CRC. */
+static void patch_film(const char *path, unsigned char *buf, size_t n, int k, long v)
+{
+	memcpy(buf + n - 4 - 48 + 8 * (size_t)k, &v, 8);
+	uint32_t crc = (uint32_t)crc32(crc32(0L, Z_NULL, 0), buf, (uInt)(n - 4));
+	memcpy(buf + n - 4, &crc, 4);
+	FILE *f = fopen(path, "wb");
+	assert_non_null(f);
+	assert_int_equal(fwrite(buf, 1, n, f), n);
+	fclose(f);
+}
+
+/* A checkpoint's own-pixel sum near 2^63 (the issue's crafted file made
+ * the next sum overflow, UBSan: signed overflow) is refused naming the
+ * file; a splat sum that a resumed render's splats push past 2^63 is an
+ * error, not a wrapped image. */
+static void test_checkpoint_films(void **state)
+{
+	char *ck = test_tmp("limits.ckpt");
+	ajar_scene *s = sky_scene(1.0f);
+	unsigned char *buf;
+	size_t n = checkpoint_bytes(s, AJAR_INTEGRATOR_PT, 4, ck, &buf);
+	patch_film(ck, buf, n, 0, 0x7ffffffffffff000L);
+	ajar_renderer *r = NULL;
+	assert_int_equal(ajar_renderer_resume(s, ck, NULL, &r), AJAR_ERROR_BAD_INPUT);
+	assert_non_null(strstr(ajar_last_error(), ck));
+	assert_non_null(strstr(ajar_last_error(), "the pixels' own sums"));
+	patch_film(ck, buf, n, 1, -5);
+	assert_int_equal(ajar_renderer_resume(s, ck, NULL, &r), AJAR_ERROR_BAD_INPUT);
+	free(buf);
+	ajar_scene_destroy(&s);
+
+	/* bdpt's light paths splat into the one pixel of the Cornell box. */
+	s = load(CORNELL);
+	n = checkpoint_bytes(s, AJAR_INTEGRATOR_BDPT, 4, ck, &buf);
+	for (int c = 0; c < 3; c++)
+		patch_film(ck, buf, n, 3 + c, 0x7fffffffffffffffL - 1000);
+	ajar_options o;
+	assert_int_equal(ajar_checkpoint_options(ck, &o, NULL), AJAR_OK);
+	o.spp = 64;
+	assert_int_equal(ajar_renderer_resume(s, ck, &o, &r), AJAR_OK);
+	assert_int_equal(ajar_renderer_render(r, NULL, NULL), AJAR_OK);
+	float px[4];
+	uint32_t w, h;
+	assert_int_equal(ajar_renderer_image(r, px, &w, &h), AJAR_ERROR_BAD_INPUT);
+	assert_non_null(strstr(ajar_last_error(), "passes the 64-bit film"));
+	assert_int_equal(ajar_renderer_write_exr(r, test_tmp("never.exr")), AJAR_ERROR_BAD_INPUT);
+	ajar_renderer_destroy(&r);
+	ajar_scene_destroy(&s);
+	free(buf);
+	unlink(ck);
+	free(ck);
 }
 
 /* Current virtual memory of this process, in bytes. */
@@ -151,6 +266,8 @@ int main(int argc, char **argv)
 		return 1;
 	self[n] = '\0';
 	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_spp_cap),
+		cmocka_unit_test(test_checkpoint_films),
 		cmocka_unit_test(test_memory_before_device),
 		cmocka_unit_test(test_size_limit),
 	};
