@@ -20,6 +20,7 @@
 #include "film/film.h"
 #include "render/cluster.h"
 #include "render/render_film.h"
+#include "render/render_options.h"
 #include "render/render_job.h"
 
 static int range_before(const void *a, const void *b)
@@ -173,6 +174,26 @@ static void options_from_checkpoint(const Checkpoint *c, ajar_options *o)
 	o->aov = c->aov;
 }
 
+/* The checkpoint's options, checked as a renderer checks any options: a
+ * file whose options no render can have is corrupted, named as such (a
+ * crafted one gave exit 1 with messages that did not name it). */
+static ajar_status checkpoint_options_valid(const Checkpoint *c, const char *path, ajar_options *o)
+{
+	options_from_checkpoint(c, o);
+	ajar_options resolved;
+	if (o->integrator != (ajar_integrator)c->integrator || o->mis != (ajar_mis)c->mis ||
+	    c->strategy_unweighted > 1 || !(c->elapsed >= 0 && c->elapsed < 1e12))
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: checkpoint is corrupted (its options are out of range)", path);
+	if (options_resolve(o, &resolved) != AJAR_OK) {
+		char why[512];
+		snprintf(why, sizeof why, "%s", ajar_last_error());
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: checkpoint is corrupted (its options: %s)", path, why);
+	}
+	if (resolved.max_depth != o->max_depth)
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: checkpoint is corrupted (its options: max depth 0)", path);
+	return AJAR_OK;
+}
+
 ajar_status ajar_checkpoint_options(const char *path, ajar_options *o, uint32_t *spp_done)
 {
 	if (!path || !o)
@@ -181,7 +202,10 @@ ajar_status ajar_checkpoint_options(const char *path, ajar_options *o, uint32_t 
 	ajar_status st = checkpoint_read(path, &c, spp_done == NULL);
 	if (st != AJAR_OK)
 		return st;
-	options_from_checkpoint(&c, o);
+	if ((st = checkpoint_options_valid(&c, path, o)) != AJAR_OK) {
+		checkpoint_free(&c);
+		return st;
+	}
 	if (spp_done) {
 		uint64_t n = 0;
 		for (uint32_t i = 0; i < c.nranges; i++)
@@ -316,7 +340,8 @@ ajar_status render_checkpoint_read(const char *path, const ajar_options *o, ajar
 		if ((st = checkpoint_read(path, c, 0)) != AJAR_OK)
 			return st;
 		*have = 1;
-		options_from_checkpoint(c, want);
+		if ((st = checkpoint_options_valid(c, path, want)) != AJAR_OK)
+			return st;
 		return resume_options(want, o, path);
 	}
 	/* A job: rank 0 reads the file, the other ranks receive its options
@@ -330,10 +355,8 @@ ajar_status render_checkpoint_read(const char *path, const ajar_options *o, ajar
 	if (cluster_rank() == 0) {
 		st = checkpoint_read(path, c, 0);
 		*have = st == AJAR_OK;
-		if (*have) {
-			options_from_checkpoint(c, &msg.want);
+		if (*have && (st = checkpoint_options_valid(c, path, &msg.want)) == AJAR_OK)
 			st = resume_options(&msg.want, o, path);
-		}
 		msg.status = (int32_t)st;
 		if (st != AJAR_OK)
 			snprintf(msg.error, sizeof msg.error, "%s", ajar_last_error());

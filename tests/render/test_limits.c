@@ -8,13 +8,15 @@
  *   9M spp with exit 0;
  * - films whose sums pass 2^63 anyway (light paths' splats have no count
  *   bound; a checkpoint can say anything) are refused, never wrapped, and
- *   a checkpoint's films must hold what its samples can add;
+ *   a checkpoint's films must hold what its samples can add, and its
+ *   options be ones a render can have (bad input naming the file);
  * - image size: at most AJAR_MAX_SIDE a side, and memory for the films
  *   found missing before the device touches them: under an address-space
  *   limit PoCL aborted the process (exit 134) when a film it allocates on
  *   first use did not fit.
  *
  * About 8 s on the 2-core machine, most of it the capped render. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -164,6 +166,52 @@ static void test_checkpoint_films(void **state)
 	free(ck);
 }
 
+/* A checkpoint whose options no render can have (each field of the
+ * header in turn, the CRC made valid): bad input naming the file, from
+ * ajar_checkpoint_options and ajar_renderer_resume (a crafted file gave
+ * exit 1, and 22 of 41 such messages did not name it). The header: magic,
+ * format, version[16], two hashes, scene[256] (300 bytes), then 11 u32
+ * options from width to aov, time_limit and elapsed. */
+static void test_checkpoint_options(void **state)
+{
+	char *ck = test_tmp("options.ckpt");
+	ajar_scene *s = sky_scene(1.0f);
+	unsigned char *buf;
+	size_t n = checkpoint_bytes(s, AJAR_INTEGRATOR_PT, 2, ck, &buf);
+	static const struct {
+		size_t at;
+		uint32_t v;
+	} u32s[] = {{308, 7},  {312, 5000},	  {316, 100}, {324, 9},	   {328, 9},
+		    {332, 2},  {336, 3000000}, {340, 0x40}, {312, 0}};
+	static const struct {
+		size_t at;
+		double v;
+	} f64s[] = {{344, -1.0}, {344, NAN}, {352, NAN}, {352, -5.0}};
+	size_t cases = sizeof u32s / sizeof u32s[0] + sizeof f64s / sizeof f64s[0];
+	unsigned char *bad = malloc(n);
+	for (size_t k = 0; k < cases; k++) {
+		memcpy(bad, buf, n);
+		if (k < sizeof u32s / sizeof u32s[0])
+			memcpy(bad + u32s[k].at, &u32s[k].v, 4);
+		else
+			memcpy(bad + f64s[k - sizeof u32s / sizeof u32s[0]].at, &f64s[k - sizeof u32s / sizeof u32s[0]].v, 8);
+		patch_film(ck, bad, n, 0, 0);
+		ajar_options o;
+		ajar_status st = ajar_checkpoint_options(ck, &o, NULL);
+		if (st != AJAR_ERROR_BAD_INPUT || !strstr(ajar_last_error(), ck))
+			fail_msg("case %zu: %s \"%s\"", k, ajar_status_name(st), ajar_last_error());
+		ajar_renderer *r = NULL;
+		st = ajar_renderer_resume(s, ck, NULL, &r);
+		if (st != AJAR_ERROR_BAD_INPUT || !strstr(ajar_last_error(), ck))
+			fail_msg("case %zu, resume: %s \"%s\"", k, ajar_status_name(st), ajar_last_error());
+	}
+	free(bad);
+	free(buf);
+	ajar_scene_destroy(&s);
+	unlink(ck);
+	free(ck);
+}
+
 /* Current virtual memory of this process, in bytes. */
 static size_t vm_bytes(void)
 {
@@ -268,6 +316,7 @@ int main(int argc, char **argv)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_spp_cap),
 		cmocka_unit_test(test_checkpoint_films),
+		cmocka_unit_test(test_checkpoint_options),
 		cmocka_unit_test(test_memory_before_device),
 		cmocka_unit_test(test_size_limit),
 	};
