@@ -50,28 +50,55 @@ static int cb_eof(void *user)
 
 static const stbi_io_callbacks callbacks = {cb_read, cb_skip, cb_eof};
 
-/* The fewest bytes a JPEG of its declared size can have: every scan codes
- * each 8 x 8 block of a component with at least one bit (its DC
- * coefficient, or an end-of-band run that covers it), so the first
- * component's blocks at its sampling need that many bits. 0 if the file
- * has no frame header (stb then says what is wrong). */
-static size_t jpeg_min_bytes(const unsigned char *p, size_t n)
+/* A JPEG's markers, checked before stb_image reads them, and the fewest
+ * bytes its declared size can take. stb (Debian's 2022 build) trusts a
+ * Huffman table's code counts: counts summing past 256 write past its
+ * tables (fuzz_texture found it: UBSan, index 257 of size[257]), so every
+ * table (DHT, also between the scans of a progressive file) must hold at
+ * most 256 codes and fit its segment. Every scan codes each 8 x 8 block of
+ * a component with at least one bit (its DC coefficient, or an end-of-band
+ * run covering it), so the first component's blocks at its sampling need
+ * that many bits: *min_bytes. Returns a reason to refuse, or NULL (also for
+ * what is not a JPEG: stb then says what is wrong). */
+static const char *jpeg_check(const unsigned char *p, size_t n, size_t *min_bytes)
 {
+	*min_bytes = 0;
 	if (n < 4 || p[0] != 0xff || p[1] != 0xd8)
-		return 0;
-	for (size_t i = 2; i + 4 <= n;) {
-		if (p[i] != 0xff) {
+		return NULL;
+	size_t i = 2;
+	while (i + 4 <= n) {
+		if (p[i] != 0xff) { /* entropy-coded data up to the next marker */
 			i++;
 			continue;
 		}
 		unsigned m = p[i + 1];
-		if (m == 0xff || m == 0x01 || (m >= 0xd0 && m <= 0xd9)) { /* fill, TEM, RSTn, SOI, EOI: no length */
-			i += m == 0xff ? 1 : 2;
+		if (m == 0xff) { /* fill byte */
+			i++;
 			continue;
 		}
-		size_t len = (size_t)p[i + 2] << 8 | p[i + 3];
+		if (m == 0x00 || m == 0x01 || (m >= 0xd0 && m <= 0xd7)) { /* stuffed 0xff, TEM, RSTn */
+			i += 2;
+			continue;
+		}
+		if (m == 0xd9) /* EOI */
+			break;
+		size_t len = (size_t)p[i + 2] << 8 | p[i + 3], end = i + 2 + len;
+		if (len < 2)
+			return "a marker segment shorter than its length field";
+		if (m == 0xc4) { /* DHT: tables of class/id, 16 counts, their values */
+			for (size_t t = i + 4; t < end && t < n;) {
+				size_t codes = 0;
+				for (size_t k = 0; k < 16 && t + 1 + k < n; k++)
+					codes += p[t + 1 + k];
+				if (codes > 256)
+					return "a Huffman table of more than 256 codes";
+				t += 17 + codes;
+				if (t > end)
+					return "a Huffman table longer than its segment";
+			}
+		}
 		int sof = m >= 0xc0 && m <= 0xcf && m != 0xc4 && m != 0xc8 && m != 0xcc;
-		if (sof && i + 10 + 3 <= n && len >= 8) {
+		if (sof && !*min_bytes && i + 4 + 6 + 3 <= n && len >= 8) {
 			const unsigned char *f = p + i + 4; /* precision, height, width, components */
 			size_t h = (size_t)f[1] << 8 | f[2], w = (size_t)f[3] << 8 | f[4];
 			unsigned nc = f[5], hmax = 1, vmax = 1;
@@ -81,16 +108,14 @@ static size_t jpeg_min_bytes(const unsigned char *p, size_t n)
 				vmax = (hv & 15) > vmax ? hv & 15 : vmax;
 			}
 			unsigned h1 = f[7] >> 4, v1 = f[7] & 15;
-			if (nc == 0 || h1 == 0 || v1 == 0)
-				return 0;
-			size_t cw = (w * h1 + hmax - 1) / hmax, ch = (h * v1 + vmax - 1) / vmax;
-			return ((cw + 7) / 8) * ((ch + 7) / 8) / 8;
+			if (nc > 0 && h1 > 0 && v1 > 0) {
+				size_t cw = (w * h1 + hmax - 1) / hmax, ch = (h * v1 + vmax - 1) / vmax;
+				*min_bytes = ((cw + 7) / 8) * ((ch + 7) / 8) / 8;
+			}
 		}
-		if (m == 0xda) /* the scan began before a frame header */
-			return 0;
-		i += 2 + len;
+		i = end;
 	}
-	return 0;
+	return NULL;
 }
 
 int texture_decode(const unsigned char *bytes, size_t n, unsigned char **pixels, int *width, int *height, int *bits,
@@ -112,7 +137,12 @@ int texture_decode(const unsigned char *bytes, size_t n, unsigned char **pixels,
 		snprintf(why, cap, "%dx%d texels: at most %d a side", w, h, TEXTURE_MAX_SIDE);
 		return 0;
 	}
-	size_t need = jpeg_min_bytes(bytes, n);
+	size_t need = 0;
+	const char *bad = jpeg_check(bytes, n, &need);
+	if (bad) {
+		snprintf(why, cap, "corrupt JPEG: %s", bad);
+		return 0;
+	}
 	if (need > n) {
 		snprintf(why, cap, "the image data is cut short (%zu bytes cannot code %dx%d texels)", n, w, h);
 		return 0;

@@ -363,8 +363,9 @@ static void write_lights_gltf(const char *name, const char *scene_nodes, const c
  * tinygltf decoded every image from the size its header declares: a
  * 688-byte JPEG declaring 20000 x 20000 texels loaded (4.7 GB, and a
  * garbage texture, as stb reads past the end as zeros). Refused now before
- * decoding (more than 16384 a side) or when the decoder reads past the
- * end, each message naming the image by its URI. */
+ * decoding (more than 16384 a side, a Huffman table stb would overflow)
+ * or when the decoder reads past the end, each message naming the image by
+ * its URI. */
 static void spill_image(void *ctx, void *data, int n)
 {
 	FILE *f = ctx;
@@ -372,7 +373,8 @@ static void spill_image(void *ctx, void *data, int n)
 }
 
 /* test_dir/name: an 8 x 8 JPEG (or PNG) whose header declares w x h, cut
- * to `keep` bytes (0: whole). */
+ * to `keep` bytes (0: whole); w < 0: a JPEG whose first Huffman table
+ * counts 512 codes. */
 static void write_lying_image(const char *name, int jpeg, int w, int h, size_t keep)
 {
 	unsigned char rgb[8 * 8 * 3];
@@ -388,6 +390,12 @@ static void write_lying_image(const char *name, int jpeg, int w, int h, size_t k
 	unsigned char buf[4096];
 	size_t n = fread(buf, 1, sizeof buf, f);
 	fclose(f);
+	for (size_t i = 0; jpeg && w < 0 && i + 21 < n; i++)
+		if (buf[i] == 0xff && buf[i + 1] == 0xc4) { /* DHT: length, class/id, 16 counts */
+			memset(buf + i + 5, 0x20, 16);   /* 512 codes: stb wrote past its tables */
+			w = h = 8;
+			break;
+		}
 	for (size_t i = 0; jpeg && i + 9 < n; i++)
 		if (buf[i] == 0xff && buf[i + 1] == 0xc0) { /* SOF0: length, precision, height, width */
 			buf[i + 5] = (unsigned char)(h >> 8), buf[i + 6] = (unsigned char)h;
@@ -418,6 +426,7 @@ static void test_lying_images(void **state)
 		{"cut.jpg", 1, 1000, 1000, 0, "'cut.jpg'): the image data is cut short"},
 		{"cut8.jpg", 1, 8, 8, 300, "'cut8.jpg'): the image data is cut short"},
 		{"junk.png", 0, 8, 8, 20, "'junk.png'): "},
+		{"dht.jpg", 1, -1, -1, 0, "'dht.jpg'): corrupt JPEG: a Huffman table of more than 256 codes"},
 	};
 	for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
 		write_lying_image(cases[k].name, cases[k].jpeg, cases[k].w, cases[k].h, cases[k].keep);
