@@ -1,5 +1,5 @@
-/* texture_file.h — a scene's texture images (PNG, JPEG, whatever
- * stb_image reads) decoded with limits (texture_file.c). */
+/* texture_file.h — a scene's texture images (PNG and JPEG, glTF's
+ * formats) decoded by stb_image with limits (texture_file.c). */
 #ifndef AJAR_TEXTURE_FILE_H
 #define AJAR_TEXTURE_FILE_H
 #include <stddef.h>
@@ -12,7 +12,7 @@ extern "C" {
 /* The largest texture side: what GPUs sample, 1 GiB of RGBA8. */
 #define TEXTURE_MAX_SIDE 16384
 
-/* The n bytes of an image file as RGBA, 8 or 16 bits a channel (`bits`)
+/* The n bytes of a PNG or JPEG file as RGBA, 8 or 16 bits a channel (`bits`)
  * as the file has them; *pixels is malloc'ed. The declared size is
  * checked before anything is allocated for it (at most TEXTURE_MAX_SIDE a
  * side, and, for JPEG, a file long enough to code every block), and a

@@ -363,9 +363,9 @@ static void write_lights_gltf(const char *name, const char *scene_nodes, const c
  * tinygltf decoded every image from the size its header declares: a
  * 688-byte JPEG declaring 20000 x 20000 texels loaded (4.7 GB, and a
  * garbage texture, as stb reads past the end as zeros). Refused now before
- * decoding (more than 16384 a side, a Huffman table stb would overflow)
- * or when the decoder reads past the end, each message naming the image by
- * its URI. */
+ * decoding (more than 16384 a side, a Huffman table stb would overflow,
+ * a format other than glTF's PNG and JPEG) or when the decoder reads past
+ * the end, each message naming the image by its URI. */
 static void spill_image(void *ctx, void *data, int n)
 {
 	FILE *f = ctx;
@@ -380,6 +380,13 @@ static void write_lying_image(const char *name, int jpeg, int w, int h, size_t k
 	unsigned char rgb[8 * 8 * 3];
 	for (int i = 0; i < 8 * 8 * 3; i++)
 		rgb[i] = (unsigned char)(i * 37);
+	if (jpeg == 2) { /* a 99-byte TGA declaring 8224 x 8224 texels, which stb would read */
+		unsigned char tga[99];
+		memset(tga, ' ', sizeof tga);
+		memcpy(tga, "\xff\x00\x0a\xd8", 4);
+		write_bytes(name, tga, sizeof tga);
+		return;
+	}
 	char *p = test_tmp(name);
 	FILE *f = fopen(p, "wb");
 	assert_non_null(f);
@@ -427,6 +434,7 @@ static void test_lying_images(void **state)
 		{"cut8.jpg", 1, 8, 8, 300, "'cut8.jpg'): the image data is cut short"},
 		{"junk.png", 0, 8, 8, 20, "'junk.png'): "},
 		{"dht.jpg", 1, -1, -1, 0, "'dht.jpg'): corrupt JPEG: a Huffman table of more than 256 codes"},
+		{"tga.png", 2, 0, 0, 0, "'tga.png'): not a PNG or JPEG image"},
 	};
 	for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
 		write_lying_image(cases[k].name, cases[k].jpeg, cases[k].w, cases[k].h, cases[k].keep);
