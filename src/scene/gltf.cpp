@@ -178,8 +178,24 @@ std::string image_name(const tg::Image *im, int i)
 }
 
 bool load_image(tg::Image *im, const int i, std::string *err, std::string *, int, int, const unsigned char *bytes,
-		int size, void *)
+		int size, void *user)
 {
+	/* tinygltf hands over an image's buffer view unchecked: one that lies
+	 * past its buffer was read past the buffer's end (fuzz_gltf, ASan:
+	 * heap-buffer-overflow). The model is the one being parsed. */
+	const tg::Model &m = ((const Loader *)user)->model;
+	if (im->bufferView >= 0) {
+		size_t v = (size_t)im->bufferView;
+		const tg::BufferView *bv = v < m.bufferViews.size() ? &m.bufferViews[v] : nullptr;
+		size_t have = bv && bv->buffer >= 0 && (size_t)bv->buffer < m.buffers.size()
+				      ? m.buffers[(size_t)bv->buffer].data.size()
+				      : 0;
+		if (!bv || bv->byteLength > have || bv->byteOffset > have - bv->byteLength || bv->byteLength > INT32_MAX) {
+			if (err)
+				*err += image_name(im, i) + ": its bufferView lies outside its buffer\n";
+			return false;
+		}
+	}
 	unsigned char *px = nullptr;
 	int w = 0, h = 0, bits = 8;
 	char why[256];

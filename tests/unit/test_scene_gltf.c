@@ -447,6 +447,17 @@ static void test_lying_images(void **state)
 		load_fails("lying.gltf", AJAR_ERROR_BAD_INPUT, cases[k].why);
 		assert_non_null(strstr(ajar_last_error(), "images[0] ("));
 	}
+	/* An image in a buffer view that runs past its buffer (tinygltf
+	 * passed it on: the decoder read past the buffer, ASan's
+	 * heap-buffer-overflow in fuzz_gltf). */
+	write_text("viewpast.gltf", "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+				    "\"buffers\":[{\"uri\":\"tri.bin\",\"byteLength\":78}],"
+				    "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":36},"
+				    "{\"buffer\":0,\"byteOffset\":36,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":72,\"byteLength\":6},"
+				    "{\"buffer\":0,\"byteOffset\":60,\"byteLength\":4000}],"
+				    "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2}]}],"
+				    TRI_ACCESSORS(3) ",\"images\":[{\"bufferView\":3,\"mimeType\":\"image/png\"}]}");
+	load_fails("viewpast.gltf", AJAR_ERROR_BAD_INPUT, "images[0] (bufferViews[3]): its bufferView lies outside its buffer");
 	/* The same files whole and honest load. */
 	write_lying_image("ok.jpg", 1, 8, 8, 0);
 	write_lying_image("ok.png", 0, 8, 8, 0);
