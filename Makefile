@@ -16,6 +16,9 @@ WARN := -Wall -Wextra -Werror -Wno-unused-parameter
 MODE_FLAGS_release := -O2 -g
 MODE_FLAGS_debug := -O0 -g
 MODE_FLAGS_asan := -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
+# make fuzz builds the library this way with clang (libFuzzer's coverage
+# hooks, no main), into build/fuzz (tests/fuzz/README.md).
+MODE_FLAGS_fuzz := -O1 -g -fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
 MFLAGS := $(MODE_FLAGS_$(MODE))
 CPPFLAGS += -Iinclude -Isrc -Ikernels -MMD -MP
 CFLAGS += -std=c11 -D_GNU_SOURCE -ffp-contract=off $(WARN) $(MFLAGS) -fPIC
@@ -97,13 +100,14 @@ DEPS_test_mpi := $(BUILD)/libajar.a
 DEPS_test_glass := $(BUILD)/libajar.a
 DEPS_test_limits := $(BUILD)/libajar.a
 
-.PHONY: FORCE all lib cli tests test test-unit asan demo bench bench-peers install uninstall clean deps help
+.PHONY: FORCE all lib cli tests test test-unit asan fuzz fuzz-check fuzzers demo bench bench-peers install uninstall clean deps help
 all: lib cli
 
 help:
 	@echo "make demo       install missing packages, build, render scenes/cornell to out/demo.exr + .png"
 	@echo "make test       install missing packages, build and run every test (cmocka)"
 	@echo "make asan       host unit tests under AddressSanitizer + UBSan"
+	@echo "make fuzz       libFuzzer harnesses (glTF, EXR, .hdr, textures, checkpoints), FUZZ_SECONDS each"
 	@echo "make bench      BVH, traversal, samples/s, start-up figures"
 	@echo "make bench-peers  Cycles, Mitsuba 3, LuxCore vs Ajar at equal time (installs them; slow)"
 	@echo "make install    PREFIX=$(PREFIX): ajar, libajar.{a,so}, ajar.h, ajar.pc"
@@ -239,6 +243,55 @@ asan:
 	$(Q)$(MAKE) --no-print-directory deps
 	$(Q)$(MAKE) --no-print-directory MODE=asan $(ASAN_TESTS:%=build/asan/tests/%)
 	$(Q)ASAN_OPTIONS=detect_leaks=1 sh tests/run.sh build/asan $(ASAN_TESTS)
+
+# Fuzzing (tests/fuzz/README.md): libFuzzer harnesses built with clang
+# against the library's objects built the same way (MODE=fuzz, build/fuzz).
+# make fuzz runs each for FUZZ_SECONDS; make fuzz-check is CI's bounded run.
+FUZZ_TARGETS := gltf exr hdr texture checkpoint
+FUZZ_SECONDS ?= 60
+FUZZ_CFLAGS = -std=c11 -D_GNU_SOURCE $(WARN) $(MODE_FLAGS_fuzz) $(CPPFLAGS) -Itests/fuzz $(PKG_CFLAGS)
+FUZZ_LINK = -fsanitize=fuzzer,address,undefined $(shell pkg-config --libs OpenEXR OpenCL 2>/dev/null) $(MPI_LIBS) -lz -lm -lpthread
+FUZZ_SUPPORT := $(addprefix build/fuzz/fuzzers/,fuzz_common.o fuzz_stb.o fuzz_tinygltf.o)
+FUZZERS := $(FUZZ_TARGETS:%=build/fuzz/fuzzers/fuzz_%)
+
+build/fuzz/fuzzers/%.o: tests/fuzz/%.c
+	@mkdir -p $(@D)
+	@echo "  CC      $< (fuzz)"
+	$(Q)clang $(FUZZ_CFLAGS) -c -o $@ $<
+
+# Third-party code (tinygltf, stb) compiled in for its coverage: its own
+# warnings are not ours. Nor are three kinds of UB in stb's arithmetic,
+# which UBSan's pointer-overflow, nonnull-attribute and shift checks would
+# report and which touch no memory: with a zero-length PNG IDAT it computes
+# idata + 0 and memcpy(NULL, p, 0) before it has a buffer; a corrupt JPEG
+# drives its bit count below 0 and a shift to 32 or more (garbage texels).
+# AddressSanitizer still checks all of its memory.
+build/fuzz/fuzzers/fuzz_stb.o: tests/fuzz/fuzz_stb.c
+	@mkdir -p $(@D)
+	@echo "  CC      $< (fuzz)"
+	$(Q)clang -std=c11 -w $(MODE_FLAGS_fuzz) -fno-sanitize=pointer-overflow,nonnull-attribute,shift $(PKG_CFLAGS) -c -o $@ $<
+
+build/fuzz/fuzzers/fuzz_tinygltf.o: tests/fuzz/fuzz_tinygltf.cpp
+	@mkdir -p $(@D)
+	@echo "  CXX     $< (fuzz)"
+	$(Q)clang++ -std=c++14 -w $(MODE_FLAGS_fuzz) $(PKG_CFLAGS) -c -o $@ $<
+
+build/fuzz/fuzzers/fuzz_%: build/fuzz/fuzzers/fuzz_%.o $(FUZZ_SUPPORT) build/fuzz/libajar.a
+	@echo "  LD      $@"
+	$(Q)clang++ -o $@ $^ $(FUZZ_LINK)
+
+fuzzers:
+	$(Q)$(MAKE) --no-print-directory MODE=fuzz CC=clang CXX=clang++ build/fuzz/libajar.a
+	$(Q)$(MAKE) --no-print-directory $(FUZZERS)
+
+fuzz:
+	$(Q)FUZZ=1 sh tests/deps.sh
+	$(Q)$(MAKE) --no-print-directory fuzzers
+	$(Q)sh tests/fuzz/run.sh $(FUZZ_SECONDS) $(FUZZ_TARGETS)
+
+# CI: 20 s a harness, failing on any finding.
+fuzz-check:
+	$(Q)$(MAKE) --no-print-directory fuzz FUZZ_SECONDS=20
 
 demo:
 	$(Q)$(MAKE) --no-print-directory deps

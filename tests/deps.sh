@@ -7,6 +7,9 @@
 PKGS="make gcc g++ pkg-config pocl-opencl-icd ocl-icd-opencl-dev opencl-headers \
 libopenexr-dev libtinygltf-dev libstb-dev libcmocka-dev"
 OPTIONAL="libopenmpi-dev openmpi-bin"
+# make fuzz (FUZZ=1): clang with libFuzzer's runtime, and the JSON parser
+# tinygltf's header includes (the harnesses compile tinygltf in).
+[ "${FUZZ:-0}" = 1 ] && PKGS="$PKGS clang libclang-rt-14-dev nlohmann-json3-dev"
 missing=""
 optional=""
 for p in $PKGS; do
