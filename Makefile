@@ -55,7 +55,7 @@ DEPS_test_lights_fine := $(DEPS_test_lights)
 DEPS_test_scene := $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_read image/hdr)
 DEPS_test_exr := $(call obj,core/error image/exr image/exr_read image/png)
 DEPS_test_confine := $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_read image/hdr image/png)
-DEPS_test_bdpt := $(BUILD)/tests/kernel_host.o $(BUILD)/tests/mis_oracle.o $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_read image/hdr prepare/bvh_build prepare/light_tables prepare/prepare prepare/policy prepare/portal_flux prepare/sky_tables render/render_options)
+DEPS_test_bdpt := $(BUILD)/tests/kernel_host.o $(BUILD)/tests/mis_oracle.o $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_read image/hdr prepare/bvh_build prepare/light_tables prepare/prepare prepare/policy prepare/portal_flux prepare/sky_tables prepare/portal_find prepare/found_portals render/render_options)
 DEPS_test_portal := $(DEPS_test_bdpt)
 DEPS_test_punctual := $(DEPS_test_bdpt)
 # Tests that render need the whole library.

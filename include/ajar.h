@@ -155,6 +155,24 @@ typedef struct {
 } ajar_scene_info;
 ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info);
 
+/* A portal found without markup: a rectangle over an opening (a window, a
+ * door ajar, a roof opening) through which light from outside the camera's
+ * space (a sky, a sun, emitters or lamps beyond it) reaches it. */
+typedef struct {
+	float center[3];
+	float normal[3];            /* unit, facing into the camera's space */
+	float half_u[3], half_v[3]; /* half sides: corners center +- half_u +- half_v */
+	float width, height;        /* 2 |half_u|, 2 |half_v| */
+	float share;                /* its share of the light-carrying rays the search found */
+} ajar_portal;
+/* Searches the scene's openings from its camera, as a render does where
+ * the scene marks no portals (ajar_options.portals): the same scene gives
+ * the same portals. Up to `capacity` of them, largest share first, go to
+ * out; *count gets how many were found, *seconds (may be NULL) the
+ * search's time. Marked portals are not listed. */
+ajar_status ajar_scene_find_portals(const ajar_scene *s, ajar_portal *out, uint32_t capacity, uint32_t *count,
+				    double *seconds);
+
 /* ---- Render options ---------------------------------------------------- */
 
 typedef enum { AJAR_INTEGRATOR_PT = 0, AJAR_INTEGRATOR_BDPT = 1, AJAR_INTEGRATOR_PORTAL = 2 } ajar_integrator;
@@ -162,6 +180,14 @@ typedef enum { AJAR_INTEGRATOR_PT = 0, AJAR_INTEGRATOR_BDPT = 1, AJAR_INTEGRATOR
  * the balance heuristic where a sky image's sun shining in through the
  * portals is the only light, the power heuristic elsewhere. */
 typedef enum { AJAR_MIS_POWER = 0, AJAR_MIS_BALANCE = 1, AJAR_MIS_AUTO = 2 } ajar_mis;
+/* Which portals a render samples through. A portal only steers samples:
+ * every choice gives the same image on average, with more or less noise. */
+typedef enum {
+	AJAR_PORTALS_DEFAULT = 0, /* the scene's marked portals if it marks any, else found ones */
+	AJAR_PORTALS_MARKED = 1,  /* the marked ones only (none where none is marked) */
+	AJAR_PORTALS_FOUND = 2,   /* found ones (ajar_scene_find_portals); marked ones are ignored */
+	AJAR_PORTALS_NONE = 3     /* none */
+} ajar_portals;
 /* Longest path (segments) the bidirectional integrators take. */
 #define AJAR_BIDIR_MAX_DEPTH 32
 
@@ -185,6 +211,7 @@ typedef struct {
 	uint32_t min_depth;      /* paths of fewer segments are left out (0: none) */
 	uint32_t seed;
 	ajar_mis mis;            /* bidirectional integrators' MIS heuristic */
+	ajar_portals portals;    /* which portals: marked, found or none (default: marked, else found) */
 	uint32_t strategy_len;   /* bdpt, portal: keep one image per strategy for paths
 				  * of up to this many segments (1..8), 0 = none */
 	int strategy_unweighted; /* those images without MIS weights */
@@ -244,6 +271,12 @@ ajar_status ajar_renderer_aovs(ajar_renderer *r, float *px);
 ajar_status ajar_renderer_write_strategies(ajar_renderer *r, const char *path);
 /* The device(s) used, for reports. */
 const char *ajar_renderer_device_name(const ajar_renderer *r);
+/* The portals the renderer found over the scene's openings
+ * (ajar_options.portals): up to `capacity` into out, *count how many (0
+ * where it samples through marked portals or none), *seconds (may be
+ * NULL) the search's time. */
+ajar_status ajar_renderer_found_portals(const ajar_renderer *r, ajar_portal *out, uint32_t capacity, uint32_t *count,
+					double *seconds);
 
 /* Per-device figures of a renderer with several devices (ajar_options.device
  * "all" or a comma-separated list), for progress reports. Safe to call during

@@ -30,6 +30,7 @@ typedef struct {
 	uint32_t width, height, integrator, max_depth, min_depth, seed, mis, strategy_len, strategy_unweighted;
 	uint32_t spp;            /* the sample target, 0 = until the time limit */
 	uint32_t aov;            /* AJAR_AOV_* bits */
+	uint32_t portals;        /* ajar_portals */
 	double time_limit, elapsed;
 	SampleRange *ranges;     /* sorted, merged */
 	uint32_t nranges;

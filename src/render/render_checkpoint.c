@@ -64,6 +64,7 @@ static ajar_status checkpoint_gather(ajar_renderer *r, Checkpoint *c)
 	c->strategy_unweighted = (uint32_t)o->strategy_unweighted;
 	c->spp = r->spp_target;
 	c->aov = o->aov;
+	c->portals = (uint32_t)o->portals;
 	c->time_limit = r->time_limit;
 	c->elapsed = r->elapsed;
 	size_t n = r->base.n;
@@ -182,6 +183,7 @@ void options_from_checkpoint(const Checkpoint *c, ajar_options *o)
 	o->strategy_len = c->strategy_len;
 	o->strategy_unweighted = (int)c->strategy_unweighted;
 	o->aov = c->aov;
+	o->portals = (ajar_portals)c->portals;
 }
 
 ajar_status ajar_checkpoint_options(const char *path, ajar_options *o, uint32_t *spp_done)
@@ -295,6 +297,7 @@ ajar_status resume_options(ajar_options *want, const ajar_options *o, const char
 				      : o->strategy_len != want->strategy_len		 ? "strategy_len"
 				      : o->strategy_unweighted != want->strategy_unweighted ? "strategy_unweighted"
 				      : o->aov != want->aov				 ? "aov"
+				      : o->portals != want->portals			 ? "portals"
 											   : NULL;
 		if (differs)
 			return err_set(AJAR_ERROR_INVALID_ARGUMENT,

@@ -46,6 +46,9 @@ ajar_status options_resolve(const ajar_options *in, ajar_options *out)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "set a sample count or a time limit");
 	if (o->time_limit < 0 || o->time_limit != o->time_limit)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "time limit must be positive");
+	if (o->portals != AJAR_PORTALS_DEFAULT && o->portals != AJAR_PORTALS_MARKED && o->portals != AJAR_PORTALS_FOUND &&
+	    o->portals != AJAR_PORTALS_NONE)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "unknown portals choice %d", (int)o->portals);
 	if (o->aov & ~AJAR_AOV_ALL)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "aov: unknown bits 0x%x", o->aov & ~AJAR_AOV_ALL);
 	return AJAR_OK;
