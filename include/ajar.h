@@ -72,6 +72,13 @@ typedef struct {
 	float ior;               /* KHR_materials_ior */
 	float emission[3];       /* emitted radiance, W sr^-1 m^-2 */
 	int double_sided;
+	/* KHR_materials_volume: thickness 0 (the default) makes transmission
+	 * thin-walled (a pane: no refraction); above 0 the mesh is a closed
+	 * solid that refracts and absorbs, attenuation_color remaining after
+	 * attenuation_distance inside (0: no absorption). */
+	float thickness;
+	float attenuation_color[3];
+	float attenuation_distance;
 } ajar_material;
 void ajar_material_default(ajar_material *m); /* white Lambertian */
 ajar_status ajar_scene_add_material(ajar_scene *s, const ajar_material *m, uint32_t *id);

@@ -219,6 +219,23 @@ static void test_mis_glossy_glass_sky(void **state)
 	host_scene_close(&h);
 }
 
+/* Glazed windows: every path that crosses a pane does so by a null event
+ * (no vertex), and its records are those of the whole edge; paths that
+ * reflect off a pane have a delta vertex on it. Window-room with a pane
+ * under its constant sky, and window-room-forest glazed under its sun. */
+static void test_mis_glazed(void **state)
+{
+	HostScene h;
+	host_scene_open(&h, SCENE("window-room/window-room-glazed.gltf"), NULL, 32, 32, INTEGRATOR_BDPT, 8);
+	assert_true(h.data.params->num_panes == 2);
+	assert_true(check_mis(&h, 300) > 300);
+	host_scene_close(&h);
+	host_scene_open(&h, SCENE("window-room-forest/window-room-forest-glazed.gltf"), NULL, 32, 32, INTEGRATOR_BDPT,
+			8);
+	assert_true(check_mis(&h, 300) > 300);
+	host_scene_close(&h);
+}
+
 static void test_mis_living_room(void **state)
 {
 	HostScene h;
@@ -686,7 +703,7 @@ int main(void)
 		cmocka_unit_test(test_mis_cornell),
 		cmocka_unit_test(test_mis_window_room),
 		cmocka_unit_test(test_mis_glossy_glass_sky),
-		cmocka_unit_test(test_mis_living_room),
+		cmocka_unit_test(test_mis_glazed), cmocka_unit_test(test_mis_living_room),
 		cmocka_unit_test(test_layers_sum_to_image),
 		cmocka_unit_test(test_strategies_unbiased),
 		cmocka_unit_test(test_bdpt_matches_pt_glossy),

@@ -195,6 +195,16 @@ static void test_window_room_small_sun(void **state)
 	g_over = (PolicyOverrides){0};
 }
 static void test_door_ajar(void **state) { compare(SCENE("door-ajar/door-ajar.gltf"), 24, 24, 512, 128); }
+/* Glazed windows (scenes/skies/make_glazed.py): a thin pane 2 cm inside
+ * each window, crossed by every strategy (kernels/geom/visibility.h). */
+static void test_window_room_glazed(void **state)
+{
+	compare(SCENE("window-room/window-room-glazed.gltf"), 32, 32, 64, 16);
+}
+static void test_living_room_forest_glazed(void **state)
+{
+	compare(SCENE("living-room-forest/living-room-forest-glazed.gltf"), 32, 18, 64, 16);
+}
 /* The shipped atrium: the forest sky's sun down through a portal in the
  * roof (horizontal, where the other sky scenes' are in walls); portal
  * renders as bdpt there (light subpaths on the portal's lines). */
@@ -333,7 +343,7 @@ int main(void)
 		cmocka_unit_test(test_window_room_small_sun),
 		cmocka_unit_test(test_living_room),
 		cmocka_unit_test(test_bathroom),
-		cmocka_unit_test(test_door_ajar),
+		cmocka_unit_test(test_window_room_glazed), cmocka_unit_test(test_living_room_forest_glazed), cmocka_unit_test(test_door_ajar),
 		cmocka_unit_test(test_door_ajar_lamp),
 		cmocka_unit_test(test_atrium_forest),
 		cmocka_unit_test(test_cornell_punctual),

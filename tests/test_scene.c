@@ -594,8 +594,9 @@ static void test_unread_extension_members(void **state)
 		const char *ext, *want;
 		int warnings;
 	} cases[] = {
-		{"\"KHR_materials_transmission\":{\"transmissionFactor\":0.5,\"transmissionTexture\":{\"index\":0}}",
-		 "KHR_materials_transmission.transmissionTexture is not supported", 1},
+		{"\"KHR_materials_transmission\":{\"transmissionFactor\":0.5},"
+		 "\"KHR_materials_volume\":{\"thicknessFactor\":0.1,\"thicknessTexture\":{\"index\":0}}",
+		 "KHR_materials_volume.thicknessTexture is not supported", 1},
 		{"\"KHR_materials_specular\":{\"specularFactor\":0.5,\"specularColorFactor\":[1,0.5,1],"
 		 "\"specularTexture\":{\"index\":0}}",
 		 "specularColorFactor is not supported", 2},
@@ -1037,6 +1038,79 @@ static const char uv_gltf[] =
 	"{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"},"
 	"{\"bufferView\":2,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"},"
 	"{\"bufferView\":3,\"componentType\":5121,\"normalized\":true,\"count\":3,\"type\":\"VEC4\"}]}";
+
+/* KHR_materials_volume and KHR_materials_transmission's texture: a
+ * thickness above 0 makes a refracting solid (MATERIAL_VOLUME) absorbing
+ * sigma = -ln(attenuationColor) / attenuationDistance; thickness 0 or no
+ * volume is thin-walled, and smooth thin glass is a pane (TRI_PANE) that
+ * shadow rays cross, rough or volume glass is not; the transmission
+ * texture is kept (+1, as the other texture slots). Bad volume values are
+ * bad input naming the member. */
+static void test_volume_and_transmission(void **state)
+{
+	(void)state;
+	static const char head[] =
+		"{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_materials_transmission\",\"KHR_materials_volume\"],"
+		"\"scenes\":[{\"nodes\":[0,1,2,3]}],\"nodes\":[{\"mesh\":0},{\"mesh\":1},{\"mesh\":2},{\"mesh\":3}],"
+		"\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"material\":0}]},"
+		"{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"material\":1}]},"
+		"{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"material\":2}]},"
+		"{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"material\":3}]}],"
+		"\"materials\":[";
+	static const char tail[] =
+		"],\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64," UV_PNG "\"}],"
+		"\"buffers\":[{\"byteLength\":96,\"uri\":\"data:application/octet-stream;base64," UV_BUFFER "\"}],"
+		"\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24}],"
+		"\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+		"{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"}]}";
+	static const char good[] =
+		"{\"pbrMetallicRoughness\":{\"metallicFactor\":0,\"roughnessFactor\":0},\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":1},"
+		"\"KHR_materials_volume\":{\"thicknessFactor\":0.5,\"attenuationColor\":[0.5,0.25,1],\"attenuationDistance\":2}}},"
+		"{\"pbrMetallicRoughness\":{\"metallicFactor\":0,\"roughnessFactor\":0},\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":1},"
+		"\"KHR_materials_volume\":{\"thicknessFactor\":0}}},"
+		"{\"pbrMetallicRoughness\":{\"metallicFactor\":0,\"roughnessFactor\":0},\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":0.8,"
+		"\"transmissionTexture\":{\"index\":0}}}},"
+		"{\"pbrMetallicRoughness\":{\"metallicFactor\":0,\"roughnessFactor\":0.5},\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":1}}}";
+	char json[8192];
+	snprintf(json, sizeof json, "%s%s%s", head, good, tail);
+	write_text("volume.gltf", json);
+	Scene *s = load_ok("volume.gltf");
+	const Material *m = s->materials;
+	assert_true(m[0].flags & MATERIAL_VOLUME);
+	assert_v3(m[0].sigma, (float)(log(2.0) / 2), (float)(log(4.0) / 2), 0.0f);
+	assert_false(m[1].flags & MATERIAL_VOLUME);
+	assert_false(m[2].flags & MATERIAL_VOLUME);
+	assert_int_equal(m[2].transmission_tex, s->materials[2].transmission_tex);
+	assert_true(m[2].transmission_tex >= 1 && m[2].transmission_tex <= (int)s->ntextures);
+	assert_float_equal(m[2].transmission, 0.8f, 1e-7);
+	assert_int_equal(m[1].transmission_tex, 0);
+	/* One triangle a mesh, in node order: the volume is no pane, thin
+	 * smooth glass is (textured or not), rough thin glass is not. */
+	assert_int_equal(s->ntris, 4);
+	assert_false(s->tris[0].flags & TRI_PANE);
+	assert_true(s->tris[1].flags & TRI_PANE);
+	assert_true(s->tris[2].flags & TRI_PANE);
+	assert_false(s->tris[3].flags & TRI_PANE);
+	ajar_scene_destroy(&s);
+	const char *bad[][2] = {
+		{"\"attenuationDistance\":0", "attenuationDistance"},
+		{"\"attenuationColor\":[1,2,1]", "attenuationColor"},
+		{"\"attenuationColor\":[1,1]", "attenuationColor"},
+		{"\"thicknessFactor\":-1", "thicknessFactor"},
+	};
+	for (int k = 0; k < 4; k++) {
+		char mat[512];
+		snprintf(mat, sizeof mat,
+			 "{\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":1},"
+			 "\"KHR_materials_volume\":{\"thicknessFactor\":1,%s}}},{},{},{}",
+			 bad[k][0]);
+		if (k == 3)
+			snprintf(mat, sizeof mat, "{\"extensions\":{\"KHR_materials_volume\":{%s}}},{},{},{}", bad[k][0]);
+		snprintf(json, sizeof json, "%s%s%s", head, mat, tail);
+		write_text("volume.gltf", json);
+		load_fails("volume.gltf", AJAR_ERROR_BAD_INPUT, bad[k][1]);
+	}
+}
 
 /* Texel (x, y)'s red and green, as texture_rgba reads them undecoded. */
 static void assert_texel(Rgba c, int x, int y)
@@ -1523,6 +1597,7 @@ int main(void)
 		cmocka_unit_test(test_no_scenes_all_roots),
 		cmocka_unit_test(test_non_indexed_and_materials),
 		cmocka_unit_test(test_unread_extension_members),
+		cmocka_unit_test(test_volume_and_transmission),
 		cmocka_unit_test(test_interleaved_strip_fan),
 		cmocka_unit_test(test_sparse),
 		cmocka_unit_test(test_data_uri),

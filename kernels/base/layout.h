@@ -6,7 +6,7 @@
 #include "base/types.h"
 
 #define AJAR_LAYOUT_TYPES(X) \
-	X(BvhNode, 256) X(Tri, 48) X(TriShade, 64) X(TriExtra, 128) X(Material, 80) X(Texture, 48) \
+	X(BvhNode, 256) X(Tri, 48) X(TriShade, 64) X(TriExtra, 128) X(Material, 96) X(Texture, 48) \
 	X(Emitter, 16) X(PortalTri, 64) X(Camera, 64) X(Params, 240) \
 	X(PortalPlane, 80) X(PunctualLight, 64)
 
@@ -21,7 +21,7 @@
 	X(Material, metallic) X(Material, roughness) X(Material, transmission)         \
 	X(Material, ior) X(Material, specular) X(Material, flags)                      \
 	X(Material, alpha_cutoff) X(Material, mr_tex) X(Material, emissive_tex)         \
-	X(Material, base_alpha)                                                         \
+	X(Material, base_alpha) X(Material, transmission_tex) X(Material, sigma)       \
 	X(Texture, offset) X(Texture, width) X(Texture, height) X(Texture, flags)      \
 	X(Texture, xf)                                                                  \
 	X(Emitter, tri) X(Emitter, area) X(Emitter, pdf_select) X(Emitter, cell)       \
@@ -46,7 +46,7 @@
 	X(PunctualLight, cos_outer) X(PunctualLight, cone_scale)                       \
 	X(PunctualLight, disk_radius)                                                  \
 	X(Params, num_portal_planes) X(Params, env_rot_cos) X(Params, env_rot_sin)     \
-	X(Params, bdpt_conn) X(Params, env_lines)                                      \
+	X(Params, bdpt_conn) X(Params, env_lines) X(Params, num_panes)                 \
 	X(PortalPlane, o) X(PortalPlane, a0) X(PortalPlane, t) X(PortalPlane, n)      \
 	X(PortalPlane, b1) X(PortalPlane, table)
 #endif

@@ -27,6 +27,8 @@ typedef struct {
 #define TRI_EXTRA 1 /* has TriExtra data (TEXCOORD_1, COLOR_0) */
 #define TRI_ALPHA 2 /* its material may be transparent here: rays test its alpha (bvh.h) */
 #define TRI_TANGENT 4 /* normal-mapped: TriExtra holds its tangents */
+#define TRI_PANE 8    /* thin-walled transmissive material that may be smooth here: a pane that shadow
+		       * rays and connections pass through by its transmittance (geom/visibility.h) */
 typedef struct {
 	V3 p0, p1, p2;
 	int material;
@@ -53,8 +55,10 @@ typedef struct {
 #define MATERIAL_DOUBLE_SIDED 1
 #define MATERIAL_ALPHA_MASK 2   /* alpha below alpha_cutoff is a hole */
 #define MATERIAL_ALPHA_BLEND 4  /* stochastic transparency: rays meet the surface with probability alpha */
+#define MATERIAL_VOLUME 8       /* KHR_materials_volume with a thickness: transmission refracts into a solid
+				 * (absorbing by `sigma` inside); without it glTF's transmission is thin-walled */
 
-/* glTF metallic-roughness, with KHR_materials_specular/transmission/ior. */
+/* glTF metallic-roughness, with KHR_materials_specular/transmission/ior/volume. */
 typedef struct {
 	V3 base_color;      /* linear RGB factor */
 	int base_tex;       /* Texture index or -1; multiplies base_color */
@@ -71,8 +75,10 @@ typedef struct {
 	float base_alpha;   /* baseColorFactor's alpha (MASK, BLEND) */
 	int normal_tex;     /* Texture index + 1 (0: none): tangent-space normal map */
 	float normal_scale; /* its x and y scale */
+	int transmission_tex; /* Texture index + 1 (0: none): R multiplies transmission */
+	V3 sigma;           /* MATERIAL_VOLUME: absorption per unit length inside (Beer-Lambert), 0 = clear */
 	int pad0;
-} Material; /* 80 */
+} Material; /* 96 */
 
 /* A texture as a material uses it: an RGBA8 image in the shared texel
  * array (decoded from sRGB only where it holds colour, surface.h), the
@@ -239,7 +245,7 @@ typedef struct {
 	                         * light vertices (1 or 2; 0 = any; mis.h, mis_conn_in_set) */
 	int env_lines;          /* 232, a sky image's light subpaths start on lines through the
 	                         * portals, their directions from the ENV_LINE_* tables (env.h) */
-	int pad4;
+	int num_panes;          /* TRI_PANE triangles (geom/visibility.h) */
 } Params; /* 240 */
 
 /* Layout of the float array `env`: for an ENV_IMAGE of W x H,

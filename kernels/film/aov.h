@@ -67,10 +67,13 @@ CALLED void aov_sample(const SceneView *sc, V3 o, V3 d, V3 L, uint pixel, uint i
 			v[5] = n.z;
 			break;
 		}
-		/* Mirror, or glass by refraction: on through the chain. */
+		/* Mirror, or glass by refraction (straight through thin glass): on
+		 * through the chain. */
 		V3 wo = v3_neg(d), n = v3_dot(bs.n, wo) < 0.0f ? v3_neg(bs.n) : bs.n, wi;
 		float side = bsdf_side(&bs, wo);
-		if (!(bsdf_w_glass(&bs) > bsdf_w_metal(&bs)) || !bsdf_refract(wo, n, bsdf_eta(&bs, side), &wi))
+		if (bsdf_w_glass(&bs) > bsdf_w_metal(&bs) && bsdf_thin(&bs))
+			wi = d;
+		else if (!(bsdf_w_glass(&bs) > bsdf_w_metal(&bs)) || !bsdf_refract(wo, n, bsdf_eta(&bs, side), &wi))
 			wi = bsdf_reflect(wo, n);
 		o = ray_offset(s.p, s.ng, wi);
 		d = wi;

@@ -21,6 +21,15 @@ typedef struct {
 	int tri;
 } Hit;
 
+/* The panes (TRI_PANE triangles) a shadow ray crosses, kept by the traversal
+ * for their transmittance (geom/visibility.h) instead of ending it. A scene
+ * without panes is built with AJAR_NO_PANES, and no traversal looks. */
+#define PANE_HITS_MAX 8
+typedef struct {
+	int n; /* panes crossed; above PANE_HITS_MAX the list holds the first ones found */
+	Hit hit[PANE_HITS_MAX];
+} PaneHits;
+
 /* Per-ray constants of the watertight test and of the slab test. */
 typedef struct {
 	V3 o;
@@ -181,14 +190,15 @@ INLINE int v3_finite(V3 a)
 }
 
 /* Closest hit with 0 < t < tmax (any_hit = 0), or the first hit found
- * (any_hit = 1). Shared by the two queries so the kernel holds one copy.
+ * (any_hit = 1), where with `panes` a pane is no hit but goes on the list.
+ * Shared by the queries so the kernel holds one copy.
  * Children are visited nearest first; a pushed child whose entry distance
  * lies beyond the closest hit found since is skipped when popped. The
  * limits are widened a little: the triangle test and the slab test round
  * differently, and a triangle whose computed distance lies a few ulps below
  * the current closest hit must still be visited, or coplanar and touching
  * triangles could return a hit a few ulps farther than the closest. */
-INLINE int bvh_traverse(const SceneView *sc, V3 o, V3 d, float tmax, int any_hit, Hit *hit)
+INLINE int bvh_traverse(const SceneView *sc, V3 o, V3 d, float tmax, int any_hit, Hit *hit, PaneHits *panes)
 {
 	if (!v3_finite(o) || !v3_finite(d))
 		return 0;
@@ -257,6 +267,19 @@ INLINE int bvh_traverse(const SceneView *sc, V3 o, V3 d, float tmax, int any_hit
 				    && (!(sc->tris[i].flags & TRI_ALPHA) || alpha_hit(sc, i, u, v, o, d))
 #endif
 				) {
+#ifndef AJAR_NO_PANES
+					if (panes && (sc->tris[i].flags & TRI_PANE)) {
+						if (panes->n < PANE_HITS_MAX) {
+							Hit *ph = &panes->hit[panes->n];
+							ph->t = t;
+							ph->u = u;
+							ph->v = v;
+							ph->tri = i;
+						}
+						panes->n++;
+						continue;
+					}
+#endif
 					found = 1;
 					tmax = t;
 					hit->t = t;
@@ -280,15 +303,25 @@ INLINE int bvh_traverse(const SceneView *sc, V3 o, V3 d, float tmax, int any_hit
 /* Closest hit with 0 < t < tmax; returns 1 if there is one. */
 CALLED int bvh_intersect(const SceneView *sc, V3 o, V3 d, float tmax, Hit *hit)
 {
-	return bvh_traverse(sc, o, d, tmax, 0, hit);
+	return bvh_traverse(sc, o, d, tmax, 0, hit, 0);
 }
 
 /* Whether anything lies on the ray with 0 < t < tmax. */
 CALLED int bvh_occluded(const SceneView *sc, V3 o, V3 d, float tmax)
 {
 	Hit h;
-	return bvh_traverse(sc, o, d, tmax, 1, &h);
+	return bvh_traverse(sc, o, d, tmax, 1, &h, 0);
 }
+
+#ifndef AJAR_NO_PANES
+/* Whether anything but panes lies on the ray; the panes go to *p. */
+CALLED int bvh_occluded_panes(const SceneView *sc, V3 o, V3 d, float tmax, PaneHits *p)
+{
+	Hit h;
+	p->n = 0;
+	return bvh_traverse(sc, o, d, tmax, 1, &h, p);
+}
+#endif
 
 /* Unnormalized geometric normal; its side is the CCW front face. */
 INLINE V3 tri_normal(GLOBAL const Tri *t)

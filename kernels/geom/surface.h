@@ -126,19 +126,23 @@ INLINE V3 surface_base_color(const SceneView *sc, const Surface *s)
 
 /* The BSDF at s with base colour `base` (surface_base_color): metallic and
  * roughness are the factors times the metallic-roughness texture's blue
- * and green channels (glTF 3.9.2), read without sRGB decoding. */
+ * and green channels (glTF 3.9.2), transmission the factor times the
+ * transmission texture's red (KHR_materials_transmission), read without
+ * sRGB decoding. */
 INLINE void surface_bsdf(const SceneView *sc, const Surface *s, V3 base, Bsdf *bs)
 {
 	GLOBAL const Material *m = &sc->materials[s->material];
-	float metallic = m->metallic, roughness = m->roughness;
+	float metallic = m->metallic, roughness = m->roughness, transmission = m->transmission;
 #ifndef AJAR_NO_TEXTURES
 	if (m->mr_tex) {
 		Rgba t = surface_texture(sc, s, m->mr_tex - 1, 0);
 		metallic *= t.rgb.z;
 		roughness *= t.rgb.y;
 	}
+	if (m->transmission_tex)
+		transmission *= surface_texture(sc, s, m->transmission_tex - 1, 0).rgb.x;
 #endif
-	bsdf_setup_mr(bs, m, base, metallic, roughness, s->ns, s->ng);
+	bsdf_setup_mr(bs, m, base, metallic, roughness, transmission, s->ns, s->ng);
 }
 
 #endif

@@ -270,20 +270,35 @@ INLINE float bdpt_weight(const SceneView *sc, VCRef l, int s, VCRef e, int t)
 	return bdpt_weight_cached(sc, l, s, e, t, 0, 0);
 }
 
-/* Unoccluded segment between two vertices (either may be the camera,
- * which sits in free space and is not offset). */
-INLINE int bdpt_visible(const SceneView *sc, const PathVertex *a, const PathVertex *b)
+/* Beer-Lambert over the segment between vertices a and b where it runs
+ * inside a solid that either end lies on (geom/visibility.h). */
+INLINE V3 bdpt_absorption(const SceneView *sc, const PathVertex *a, const PathVertex *b)
+{
+	V3 d = v3_sub(b->p, a->p);
+	float len = v3_len(d);
+	if (a->type == VERTEX_SURFACE && volume_attenuation(sc, a->material, a->ng, d, 1.0f).x < 1.0f)
+		return volume_attenuation(sc, a->material, a->ng, d, len);
+	if (b->type == VERTEX_SURFACE)
+		return volume_attenuation(sc, b->material, b->ng, v3_neg(d), len);
+	return v3(1.0f, 1.0f, 1.0f);
+}
+
+/* What the segment between two vertices lets through (either may be the
+ * camera, which sits in free space and is not offset): 0 if occluded, the
+ * panes' transmittance and a solid's absorption. */
+INLINE V3 bdpt_visible(const SceneView *sc, const PathVertex *a, const PathVertex *b)
 {
 	if (a->type == VERTEX_CAMERA || b->type == VERTEX_CAMERA) {
 		const PathVertex *c = a->type == VERTEX_CAMERA ? a : b, *v = a->type == VERTEX_CAMERA ? b : a;
 		V3 d = v3_sub(c->p, v->p);
 		float len = v3_len(d);
 		if (!(len > 0.0f))
-			return 0;
+			return v3(0.0f, 0.0f, 0.0f);
 		d = v3_scale(d, 1.0f / len);
-		return !bvh_occluded(sc, ray_offset(v->p, v->ng, d), d, len * (1.0f - 1e-4f));
+		return ray_transmittance(sc, ray_offset(v->p, v->ng, d), d, len * (1.0f - 1e-4f));
 	}
-	return segment_clear(sc, a->p, a->ng, b->p, b->ng);
+	V3 T = segment_transmittance(sc, a->p, a->ng, b->p, b->ng);
+	return v3_is_zero(T) ? T : v3_mul(T, bdpt_absorption(sc, a, b));
 }
 
 /* f (with the shading-normal correction on light subpaths) times the
@@ -346,11 +361,13 @@ INLINE int bdpt_punctual_subpath(const SceneView *sc, VRef l, int i, float pf, f
 	y->ng = y->ns = y->wo = dir;
 	VCOMMIT(VAT(l, 0), y);
 	if (!(pdf_dir > 0.0f) || max_verts < 2 ||
-	    !vertex_trace(sc, l, 1, pl->pos, dir, v3(0.0f, 0.0f, 0.0f), pdf_dir, 0, 1, 0))
+	    !vertex_trace(sc, l, 1, pl->pos, dir, v3(1.0f, 1.0f, 1.0f), pdf_dir, 0, 1, 0, rng))
 		return 1;
-	/* I(w) window(d) cos / d^2 over (pf pdf_dir cos / d^2). */
+	/* I(w) window(d) cos / d^2 over (pf pdf_dir cos / d^2), times the panes
+	 * the ray crossed (the beta vertex_trace kept). */
 	V3 beta1 = v3_scale(punctual_intensity(pl, dir, v3_len(v3_sub(VGET3(VAT(l, 1), p), pl->pos))),
 			    1.0f / (pf * pdf_dir));
+	beta1 = v3_mul(beta1, VGET3(VAT(l, 1), beta));
 	VSET3(VAT(l, 1), beta, beta1);
 	if (v3_is_zero(beta1))
 		return 1;
@@ -502,15 +519,18 @@ CALLED V3 bdpt_connect_pdf(const SceneView *sc, const PathVertex *y, const PathV
 	if (v3_is_zero(fy))
 		return fy;
 	V3 fz = bdpt_scatter_pdf(z, v3_neg(w), BSDF_RADIANCE, &pdf_z);
-	if (v3_is_zero(fz) || !bdpt_visible(sc, y, z))
+	if (v3_is_zero(fz))
 		return v3(0.0f, 0.0f, 0.0f);
+	V3 T = bdpt_visible(sc, y, z);
+	if (v3_is_zero(T))
+		return T;
 	if (cp) {
 		cp->l_fwd = pdf_y;
 		cp->e_fwd = pdf_z;
 		cp->l_rev = bdpt_rev_pdf(y, w);
 		cp->e_rev = bdpt_rev_pdf(z, v3_neg(w));
 	}
-	return v3_scale(v3_mul(fy, fz), 1.0f / d2);
+	return v3_scale(v3_mul(v3_mul(fy, fz), T), 1.0f / d2);
 }
 
 INLINE V3 bdpt_connect(const SceneView *sc, const PathVertex *y, const PathVertex *z)
@@ -536,8 +556,12 @@ INLINE V3 bdpt_to_camera_pdf(const SceneView *sc, const PathVertex *y, int origi
 	if (!camera_raster(cam, v3_neg(w), &px, &py, &cos_c))
 		return zero;
 	V3 fy = origin ? v3_scale(bdpt_emitted(sc, y, w), fabs(v3_dot(y->ng, w))) : bdpt_scatter(y, w, BSDF_IMPORTANCE);
-	if (v3_is_zero(fy) || !bdpt_visible(sc, y, cam_v))
+	if (v3_is_zero(fy))
 		return zero;
+	V3 T = bdpt_visible(sc, y, cam_v);
+	if (v3_is_zero(T))
+		return zero;
+	fy = v3_mul(fy, T);
 	if (cp && !origin)
 		cp->l_rev = bdpt_rev_pdf(y, w);
 	*pixel = (uint)py * (uint)cam->width + (uint)px;
@@ -606,12 +630,14 @@ INLINE void bdpt_light_vertex(PathVertex *y, const LightSample *ls)
 	y->pr = 0.0f;
 }
 
-/* Whether the light sample is unoccluded from surface vertex z. */
-INLINE int bdpt_nee_visible(const SceneView *sc, const PathVertex *z, const LightSample *ls)
+/* What reaches surface vertex z from the light sample: 0 if occluded, the
+ * panes' transmittance and a solid's absorption. */
+INLINE V3 bdpt_nee_visible(const SceneView *sc, const PathVertex *z, const LightSample *ls)
 {
 	if (ls->is_env || !(ls->dist < AJAR_INF)) /* the sky, a directional light */
-		return !bvh_occluded(sc, ray_offset(z->p, z->ng, ls->wi), ls->wi, AJAR_INF);
-	return segment_clear(sc, z->p, z->ng, ls->p, ls->n);
+		return ray_transmittance(sc, ray_offset(z->p, z->ng, ls->wi), ls->wi, AJAR_INF);
+	V3 T = segment_transmittance(sc, z->p, z->ng, ls->p, ls->n);
+	return v3_is_zero(T) ? T : v3_mul(T, volume_attenuation(sc, z->material, z->ng, ls->wi, ls->dist));
 }
 
 /* Next-event estimation at eye-side surface vertex z, whose neighbour on
@@ -629,8 +655,12 @@ CALLED V3 bdpt_nee_conn(const SceneView *sc, const PathVertex *z, const PathVert
 		return zero;
 	bdpt_light_vertex(y, &ls);
 	V3 f = bdpt_scatter_pdf(z, ls.wi, BSDF_RADIANCE, &pdf_w);
-	if (v3_is_zero(f) || !bdpt_nee_visible(sc, z, &ls))
+	if (v3_is_zero(f))
 		return zero;
+	V3 T = bdpt_nee_visible(sc, z, &ls);
+	if (v3_is_zero(T))
+		return zero;
+	f = v3_mul(f, T);
 	y->pr = vertex_density_a(z, y, pdf_w);
 	if (cp) {
 		cp->e_fwd = pdf_w;

@@ -128,15 +128,22 @@ CALLED void portal_intermediate(const SceneView *sc, VRef R, int *nR, VRef F, in
 	origin.type = VERTEX_SURFACE;
 	origin.p = w0;
 	origin.ng = origin.ns = n;
+	origin.material = origin.tri = -1;
+	/* Both halves leave from a point a little behind w0 on the line, so that
+	 * a pane lying in the portal's plane is crossed by the -> half alone,
+	 * never by neither. */
+	V3 o = w0;
+	if (prm->num_panes > 0)
+		o = v3_sub(w0, v3_scale(w, 1e-5f * prm->scene_radius));
 	/* Each half's walk starts from the origin in its slot 0 (subpath storage, vertex.h). */
 	VSTORE(VAT(F, 0), &origin);
-	if (!vertex_trace(sc, F, 1, w0, w, v3(1.0f, 1.0f, 1.0f), 0.0f, 0, 1, 0))
+	if (!vertex_trace(sc, F, 1, o, w, v3(1.0f, 1.0f, 1.0f), 0.0f, 0, 1, 0, rng))
 		return; /* -> escaped: nothing in the scene to connect to the eye */
 	VTMP(bt);
 	VTMP(at);
 	PathVertex B = *VLOAD(VAT(F, 1), bt);
 	VSTORE(VAT(R, 0), &origin);
-	if (!vertex_trace(sc, R, 1, w0, v3_neg(w), v3(1.0f, 1.0f, 1.0f), 0.0f, 0, 0, 1))
+	if (!vertex_trace(sc, R, 1, o, v3_neg(w), v3(1.0f, 1.0f, 1.0f), 0.0f, 0, 0, 1, rng))
 		return; /* <- escaped and there is no environment */
 	PathVertex A = *VLOAD(VAT(R, 1), at);
 	if (how == 2 && !portal_guided_reached(sc, &A, w0, guided_env, guided_dist))
@@ -150,8 +157,10 @@ CALLED void portal_intermediate(const SceneView *sc, VRef R, int *nR, VRef F, in
 	if (!(q > 0.0f))
 		return;
 	float k = 1.0f / (pdf_a * q); /* f / p_pair = 1 / (p_A q): G cancels */
+	/* The halves' betas hold what the panes they crossed let through: the
+	 * edge's transmittance, carried on the -> side. */
+	B.beta = v3_scale(v3_mul(A.beta, B.beta), k);
 	A.beta = v3(1.0f, 1.0f, 1.0f);
-	B.beta = v3(k, k, k);
 	VSTORE(VAT(R, 0), &B);
 	VSTORE(VAT(R, 1), &A);
 	VSTORE(VAT(F, 0), &A);

@@ -24,8 +24,10 @@
 #include "sample/rng.h"
 #include "sample/roulette.h"
 #include "geom/surface.h"
+#include "geom/visibility.h"
 
 #define PT_CROSS_EDGES 33
+#define PT_PANES_MAX 64 /* panes one segment may cross (vertex.h's guard) */
 
 /* The test mode's weight of a path of n segments whose eye-side edges
  * (edge 0 leaves the camera) cross portals cnt[j] times; `last` replaces
@@ -47,14 +49,40 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 	float prev_pdf_w = 0.0f;
 	int prev_delta = 1; /* the camera ray counts emission in full */
 	V3 prev_p = o, prev_n = v3(0.0f, 0.0f, 0.0f); /* prev_n: vertex_nee_normal's */
+	V3 prev_ng = prev_n;
+	int prev_mat = -1; /* the material the ray leaves, for a solid's absorption */
 	float beta_ref = 1.0f;
 	int cnt[PT_CROSS_EDGES];
 	for (int depth = 0;; depth++) {
 		Hit h;
-		int hit = bvh_intersect(sc, o, d, AJAR_INF, &h);
-		int c_edge = 0;
-		if (prm->cross_filter)
-			c_edge = hit ? portal_crossings(sc, o, v3_add(o, v3_scale(d, h.t)), 0) : portal_crossings(sc, o, d, 1);
+		Surface s;
+		int hit, c_edge = 0;
+		float edge_t = 0.0f; /* the edge's length before the last pane crossed */
+		/* The next hit, crossing panes by their null event (vertex.h, vertex_trace). */
+		for (int panes = 0;; panes++) {
+			hit = bvh_intersect(sc, o, d, AJAR_INF, &h);
+			if (prm->cross_filter)
+				c_edge += hit ? portal_crossings(sc, o, v3_add(o, v3_scale(d, h.t)), 0)
+					      : portal_crossings(sc, o, d, 1);
+			if (!hit)
+				break;
+			surface_from_hit(sc, &h, &s);
+#ifndef AJAR_NO_PANES
+			if ((sc->tris[s.tri].flags & TRI_PANE) && panes < PT_PANES_MAX) {
+				Bsdf pb;
+				surface_bsdf(sc, &s, surface_base_color(sc, &s), &pb);
+				float pn = bsdf_null_prob(&pb, v3_neg(d));
+				if (pn > 0.0f && rng_f(rng) < pn) {
+					beta = v3_mul(beta, v3_scale(bsdf_null_weight(&pb, d), 1.0f / pn));
+					V3 q = ray_offset(s.p, s.ng, d);
+					edge_t += v3_len(v3_sub(q, o));
+					o = q;
+					continue;
+				}
+			}
+#endif
+			break;
+		}
 		if (depth < PT_CROSS_EDGES)
 			cnt[depth] = c_edge;
 		if (!hit) {
@@ -68,8 +96,8 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 			}
 			break;
 		}
-		Surface s;
-		surface_from_hit(sc, &h, &s);
+		float dist = edge_t + h.t;
+		beta = v3_mul(beta, volume_attenuation(sc, prev_mat, prev_ng, d, dist));
 		V3 wo = v3_neg(d);
 		if (sc->tris[s.tri].emitter >= 0 && depth + 1 >= prm->min_depth) {
 			V3 Le = emitter_radiance(sc, s.tri, s.p, wo);
@@ -77,7 +105,7 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 				float w = 1.0f;
 				if (!prev_delta) {
 					float cos_l = fabs(v3_dot(s.ng, wo));
-					w = mis_power(prev_pdf_w, light_pdf_w(sc, prev_p, prev_n, d, s.tri, h.t, cos_l));
+					w = mis_power(prev_pdf_w, light_pdf_w(sc, prev_p, prev_n, d, s.tri, dist, cos_l));
 				}
 				w *= pt_cross_weight(prm, cnt, depth + 1, c_edge);
 				L = v3_add(L, v3_scale(v3_mul(beta, Le), w));
@@ -100,9 +128,11 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 				V3 f = bsdf_eval_fwd(&bs, wo, ls.wi, BSDF_RADIANCE, &pdf_bsdf_w);
 				if (!v3_is_zero(f)) {
 					int far = ls.is_env || !(ls.dist < AJAR_INF); /* the sky, a directional light */
-					int clear = far ? !bvh_occluded(sc, ray_offset(s.p, s.ng, ls.wi), ls.wi, AJAR_INF)
-							: segment_clear(sc, s.p, s.ng, ls.p, ls.n);
-					if (clear) {
+					V3 T = far ? ray_transmittance(sc, ray_offset(s.p, s.ng, ls.wi), ls.wi, AJAR_INF)
+						   : segment_transmittance(sc, s.p, s.ng, ls.p, ls.n);
+					if (!far && !v3_is_zero(T))
+						T = v3_mul(T, volume_attenuation(sc, s.material, s.ng, ls.wi, ls.dist));
+					if (!v3_is_zero(T)) {
 						int c_nee = !prm->cross_filter ? 0
 								: far ? portal_crossings(sc, s.p, ls.wi, 1)
 									    : portal_crossings(sc, s.p, ls.p, 0);
@@ -110,7 +140,7 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 						float w = (ls.delta ? 1.0f : mis_power(ls.pdf_w, pdf_bsdf_w)) *
 							  pt_cross_weight(prm, cnt, depth + 2, c_nee);
 						float k = fabs(v3_dot(s.ns, ls.wi)) * w / ls.pdf_w;
-						L = v3_add(L, v3_scale(v3_mul(v3_mul(beta, f), ls.Le), k));
+						L = v3_add(L, v3_scale(v3_mul(v3_mul(v3_mul(beta, f), T), ls.Le), k));
 					}
 				}
 			}
@@ -118,13 +148,21 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 		BsdfSample bsm;
 		float u0, u1, u2;
 		rng_f3(rng, &u0, &u1, &u2);
+#ifndef AJAR_NO_PANES
+		if (sc->tris[s.tri].flags & TRI_PANE) /* the null event was decided against where it was hit */
+			u0 *= 1.0f - bsdf_null_prob(&bs, wo);
+#endif
 		if (!bsdf_sample_fwd(&bs, wo, u0, u1, u2, BSDF_RADIANCE, &bsm) || !(bsm.pdf_w > 0.0f))
 			break;
+		if (bsm.delta == BSDF_NULL) /* smooth thin glass that is no pane: a delta vertex */
+			bsm.delta = 1;
 		beta = v3_mul(beta, v3_scale(bsm.f, fabs(v3_dot(s.ns, bsm.wi)) / bsm.pdf_w));
 		prev_pdf_w = bsm.pdf_w;
 		prev_delta = bsm.delta;
 		prev_p = s.p;
 		prev_n = n_nee;
+		prev_ng = s.ng;
+		prev_mat = s.material;
 		o = ray_offset(s.p, s.ng, bsm.wi);
 		d = bsm.wi;
 		if (depth == 0)

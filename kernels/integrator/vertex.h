@@ -17,6 +17,11 @@
 #include "sample/roulette.h"
 #include "geom/portal_crossing.h"
 #include "geom/surface.h"
+#include "geom/visibility.h"
+
+/* Panes one walk segment may cross before it counts as lost (a guard
+ * against a ray caught between coincident panes). */
+#define VERTEX_PANES_MAX 64
 
 #define VERTEX_CAMERA 0
 #define VERTEX_LIGHT 1   /* the point where a light subpath starts on an emitter */
@@ -202,9 +207,18 @@ INLINE float vertex_shading_correction(const PathVertex *v, V3 wo, V3 wi)
  * 1/d^2 applies. `light_side` says which density the walk fills (pf for
  * light subpaths and the portal's -> half). A ray that escapes becomes an
  * environment vertex if `escape_env` and the scene has one. Returns 1 if
- * a vertex was appended. */
+ * a vertex was appended.
+ *
+ * A pane (TRI_PANE) the ray hits is crossed by the null event with
+ * probability bsdf_null_prob, as bsdf_sample would pick it there: no
+ * vertex, the ray goes on, beta times the transmittance over that
+ * probability; the densities stay those of path[n - 1]'s sampling, over
+ * the whole edge. Otherwise the pane becomes the vertex, and its
+ * scattering (vertex_scatter) samples the rest of its BSDF. rng draws only
+ * at panes. The edge also takes Beer-Lambert absorption where it runs
+ * inside a solid. */
 CALLED int vertex_trace(const SceneView *sc, VRef path, int n, V3 o, V3 d, V3 beta, float pdf_w, int parallel,
-			int light_side, int escape_env)
+			int light_side, int escape_env, Rng *rng)
 {
 	VTMP(pt);
 	VTMP(vt);
@@ -212,12 +226,35 @@ CALLED int vertex_trace(const SceneView *sc, VRef path, int n, V3 o, V3 d, V3 be
 	PathVertex *v = VNEW(VAT(path, n), vt);
 	Hit h = {0.0f, 0.0f, 0.0f, -1}; /* gcc cannot see bvh_intersect set it */
 	int portals = PARAMS_INTEGRATOR(sc->params) == INTEGRATOR_PORTAL;
-	v->beta = beta;
 	v->wo = v3_neg(d);
 	v->delta = 0;
 	v->pf = v->pr = 0.0f;
 	v->cross = 0;
-	if (!bvh_intersect(sc, o, d, AJAR_INF, &h)) {
+	int hit;
+	Surface s;
+	for (int panes = 0;; panes++) {
+		hit = bvh_intersect(sc, o, d, AJAR_INF, &h);
+		if (!hit)
+			break;
+		surface_from_hit(sc, &h, &s);
+		v->base = surface_base_color(sc, &s);
+		surface_bsdf(sc, &s, v->base, &v->bs);
+#ifndef AJAR_NO_PANES
+		if (sc->tris[s.tri].flags & TRI_PANE) {
+			float pn = bsdf_null_prob(&v->bs, v->wo);
+			if (pn > 0.0f && rng_f(rng) < pn) {
+				if (panes >= VERTEX_PANES_MAX)
+					return 0;
+				beta = v3_mul(beta, v3_scale(bsdf_null_weight(&v->bs, d), 1.0f / pn));
+				o = ray_offset(s.p, s.ng, d);
+				continue;
+			}
+		}
+#endif
+		break;
+	}
+	v->beta = beta;
+	if (!hit) {
 		if (!escape_env || sc->params->env_type == ENV_NONE)
 			return 0;
 		v->type = VERTEX_ENV;
@@ -234,16 +271,14 @@ CALLED int vertex_trace(const SceneView *sc, VRef path, int n, V3 o, V3 d, V3 be
 		VCOMMIT(VAT(path, n), v);
 		return 1;
 	}
-	Surface s;
-	surface_from_hit(sc, &h, &s);
 	v->type = VERTEX_SURFACE;
 	v->p = s.p;
 	v->ng = s.ng;
 	v->ns = s.ns;
-	v->base = surface_base_color(sc, &s);
 	v->material = s.material;
 	v->tri = s.tri;
-	surface_bsdf(sc, &s, v->base, &v->bs);
+	if (prev->type == VERTEX_SURFACE)
+		v->beta = v3_mul(v->beta, volume_attenuation(sc, prev->material, prev->ng, d, v3_len(v3_sub(s.p, prev->p))));
 	float pa = parallel ? pdf_w * fabs(v3_dot(s.ng, d)) : vertex_density_a(prev, v, pdf_w);
 	if (light_side)
 		v->pf = pa;
@@ -273,9 +308,17 @@ INLINE int vertex_scatter(const SceneView *sc, VRef path, int n, int light_side,
 	const PathVertex *v = VLOAD(VAT(path, n - 1), vt), *prev = VLOAD(VAT(path, n - 2), pt);
 	float u0, u1, u2;
 	rng_f3(rng, &u0, &u1, &u2);
+#ifndef AJAR_NO_PANES
+	/* vertex_trace decided against a pane's null event here: the rest of
+	 * its BSDF, with the lobe probabilities it has (what MIS reads). */
+	if (sc->tris[v->tri].flags & TRI_PANE)
+		u0 *= 1.0f - bsdf_null_prob(&v->bs, v->wo);
+#endif
 	if (!bsdf_sample(&v->bs, v->wo, u0, u1, u2, light_side ? BSDF_IMPORTANCE : BSDF_RADIANCE, &bsm) ||
 	    !(bsm.pdf_w > 0.0f))
 		return 0;
+	if (bsm.delta == BSDF_NULL) /* smooth thin glass that is no pane (emissive): a delta vertex */
+		bsm.delta = 1;
 	float k = fabs(v3_dot(v->ns, bsm.wi)) / bsm.pdf_w;
 	if (light_side)
 		k *= vertex_shading_correction(v, v->wo, bsm.wi);
@@ -309,7 +352,7 @@ CALLED int vertex_extend(const SceneView *sc, VRef path, int n, int max_verts, i
 	while (n < max_verts && vertex_scatter(sc, path, n, light_side, beta_ref, &beta, &o, &d, &pdf_w, rng)) {
 		if (!(beta_ref > 0.0f))
 			beta_ref = fmax(v3_maxc(beta), 1e-30f);
-		if (!vertex_trace(sc, path, n, o, d, beta, pdf_w, 0, light_side, escape_env))
+		if (!vertex_trace(sc, path, n, o, d, beta, pdf_w, 0, light_side, escape_env, rng))
 			break;
 		n++;
 	}
@@ -323,7 +366,7 @@ CALLED int vertex_extend(const SceneView *sc, VRef path, int n, int max_verts, i
 CALLED int vertex_walk(const SceneView *sc, VRef path, int n, int max_verts, V3 o, V3 d, V3 beta,
 		       float pdf_w, int parallel, int light_side, int escape_env, Rng *rng)
 {
-	if (n >= max_verts || !vertex_trace(sc, path, n, o, d, beta, pdf_w, parallel, light_side, escape_env))
+	if (n >= max_verts || !vertex_trace(sc, path, n, o, d, beta, pdf_w, parallel, light_side, escape_env, rng))
 		return n;
 	float beta_ref = light_side ? fmax(v3_maxc(beta), 1e-30f) : 0.0f;
 	return vertex_extend(sc, path, n + 1, max_verts, light_side, escape_env, beta_ref, rng);

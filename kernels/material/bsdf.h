@@ -27,7 +27,10 @@
  *           a black one Et; specular = 0 gives exactly base_color / pi
  *           (KHR_materials_specular scales the whole Fresnel term, as glTF
  *           does);
- *   glass   weight (1 - metallic) transmission: rough dielectric (Walter et
+ *   glass   weight (1 - metallic) transmission, thin-walled as glTF defines a
+ *           material without KHR_materials_volume (bsdf_thin below), or, with
+ *           a volume (MATERIAL_VOLUME), a
+ *           rough dielectric (Walter et
  *           al. 2007) with exact Fresnel, transmission tinted by base_color,
  *           plus Kulla and Conty's multiple scattering for dielectrics: four
  *           cosine-shaped lobes (reflection outside and inside, refraction
@@ -36,6 +39,18 @@
  *           wi's sides, the constants c solved in bsdf_setup so that a white
  *           glass loses nothing from either side and the pair of refraction
  *           lobes obeys the adjoint relation (bsdf_glass_ms).
+ * Thin-walled glass is one interface that does not bend light: reflection
+ * F D G / (4 |cos_o cos_i|) as the dielectric's, and transmission the same
+ * lobe mirrored through the surface (glTF's KHR_materials_transmission:
+ * the reflected direction flipped to the far side), weighted by (1 - F)
+ * and tinted by base_color, plus Kulla and Conty's multiple scattering
+ * split between the two sides as Favg (reflection) and 1 - Favg, so a
+ * white thin glass loses nothing: E1 + (1 - E1) (Favg + 1 - Favg) = 1.
+ * Smooth, its transmission is the note's pass-through vertex (Eq. 5) with
+ * the transmittance wg (1 - F) base_color: a null event (bsdf_null_prob,
+ * bsdf_null_weight) that walks cross without a vertex and shadow rays and
+ * connections cross multiplied by it (geom/visibility.h), its Fresnel
+ * taken in the own shading normal so that both directions see the same.
  * GGX alpha = roughness^2. Metal and glass with alpha < BSDF_DELTA_ALPHA are
  * delta lobes (mirror, smooth glass); the plastic coat never is: its alpha is
  * clamped to >= BSDF_MIN_ALPHA. Microfacet terms: height-correlated Smith G2
@@ -96,6 +111,8 @@
 #define BSDF_RADIANCE 0   /* wo points toward the camera (eye paths) */
 #define BSDF_IMPORTANCE 1 /* wo points toward the light (light paths); no eta^2 scaling on refraction */
 
+#define BSDF_NULL 2 /* BsdfSample.delta of smooth thin glass's pass-through (wi = -wo) */
+
 #define BSDF_DELTA_ALPHA 1e-3f /* metal and glass below this GGX alpha are delta */
 #define BSDF_MIN_ALPHA 1e-3f   /* the plastic coat's alpha floor */
 #define BSDF_MIN_IOR 1.01f     /* eta = 1 makes the refraction half vector vanish */
@@ -128,7 +145,8 @@ typedef struct {
 	/* Rough glass: where (ior, alpha) falls in the glass tables, the share
 	 * of the lost energy that multiple scattering transmits from outside
 	 * (glass_x) and from inside (glass_y), and the lobes' constants c_oo,
-	 * c_ii, c_oi, c_io (bsdf_glass_ms). */
+	 * c_ii, c_oi, c_io (bsdf_glass_ms). Thin-walled rough glass keeps its
+	 * Fresnel mean Favg in glass_x and E1avg in glass_y. */
 	int glass_k, glass_i;
 	float glass_wk, glass_wr, glass_x, glass_y;
 	float glass_c[4];
@@ -206,11 +224,14 @@ INLINE float bsdf_w_metal(const Bsdf *bs) { return bs->metallic; }
 INLINE float bsdf_w_plastic(const Bsdf *bs) { return (1.0f - bs->metallic) * (1.0f - bs->transmission); }
 INLINE float bsdf_w_glass(const Bsdf *bs) { return (1.0f - bs->metallic) * bs->transmission; }
 INLINE int bsdf_smooth(const Bsdf *bs) { return bs->alpha < BSDF_DELTA_ALPHA; }
+/* Thin-walled glass (no KHR_materials_volume): one interface, no bending. */
+INLINE int bsdf_thin(const Bsdf *bs) { return !(bs->flags & MATERIAL_VOLUME); }
 INLINE float bsdf_coat_alpha(const Bsdf *bs) { return fmax(bs->alpha, BSDF_MIN_ALPHA); }
 
-/* The BSDF of material m with metallic and roughness given (textured, surface.h). */
-INLINE void bsdf_setup_mr(Bsdf *bs, GLOBAL const Material *m, V3 base_color, float metallic, float roughness, V3 ns,
-			  V3 ng)
+/* The BSDF of material m with metallic, roughness and transmission given
+ * (textured, surface.h). */
+INLINE void bsdf_setup_mr(Bsdf *bs, GLOBAL const Material *m, V3 base_color, float metallic, float roughness,
+			  float transmission, V3 ns, V3 ng)
 {
 	float lg = v3_len(ng);
 	bs->ng = lg > 0.0f ? v3_scale(ng, 1.0f / lg) : v3(0.0f, 0.0f, 1.0f);
@@ -227,7 +248,7 @@ INLINE void bsdf_setup_mr(Bsdf *bs, GLOBAL const Material *m, V3 base_color, flo
 	bs->metallic = bsdf_clamp01(metallic);
 	float r = bsdf_clamp01(roughness);
 	bs->alpha = r * r;
-	bs->transmission = bsdf_clamp01(m->transmission);
+	bs->transmission = bsdf_clamp01(transmission);
 	bs->ior = fmin(fmax(m->ior, BSDF_MIN_IOR), BSDF_MAX_IOR);
 	bs->specular = bsdf_clamp01(m->specular);
 	int lambert = bs->metallic == 0.0f && bs->transmission == 0.0f && bs->specular == 0.0f &&
@@ -252,7 +273,14 @@ INLINE void bsdf_setup_mr(Bsdf *bs, GLOBAL const Material *m, V3 base_color, flo
 	bs->glass_k = bs->glass_i = 0;
 	bs->glass_wk = bs->glass_wr = bs->glass_x = bs->glass_y = 0.0f;
 	bs->glass_c[0] = bs->glass_c[1] = bs->glass_c[2] = bs->glass_c[3] = 0.0f;
-	if (bsdf_w_glass(bs) > 0.0f && !bsdf_smooth(bs)) {
+	if (bsdf_w_glass(bs) > 0.0f && !bsdf_smooth(bs) && bsdf_thin(bs)) {
+		/* Thin: E1 at alpha and its mean, the Fresnel mean at ior. */
+		float q = (bs->ior - 1.0f) / (bs->ior + 1.0f) * ((BSDF_TAB_GE - 1) / BSDF_TAB_GT_MAX);
+		int k = min((int)q, BSDF_TAB_GE - 2);
+		float wk = bsdf_clamp01(q - (float)k);
+		bs->glass_x = bsdf_tab_gfavg[k] + (bsdf_tab_gfavg[k + 1] - bsdf_tab_gfavg[k]) * wk;
+		bs->glass_y = bsdf_tab1(bsdf_tab_e1avg, bsdf_tab_at(bs->alpha, 1.0f));
+	} else if (bsdf_w_glass(bs) > 0.0f && !bsdf_smooth(bs)) {
 		float q = (bs->ior - 1.0f) / (bs->ior + 1.0f) * ((BSDF_TAB_GE - 1) / BSDF_TAB_GT_MAX);
 		float x = bsdf_clamp01(sqrt(bs->alpha)) * (BSDF_TAB_GR - 1);
 		bs->glass_k = min((int)q, BSDF_TAB_GE - 2);
@@ -288,10 +316,10 @@ INLINE void bsdf_setup_mr(Bsdf *bs, GLOBAL const Material *m, V3 base_color, flo
 	}
 }
 
-/* The BSDF of material m, its metallic and roughness untextured. */
+/* The BSDF of material m, its metallic, roughness and transmission untextured. */
 INLINE void bsdf_setup(Bsdf *bs, GLOBAL const Material *m, V3 base_color, V3 ns, V3 ng)
 {
-	bsdf_setup_mr(bs, m, base_color, m->metallic, m->roughness, ns, ng);
+	bsdf_setup_mr(bs, m, base_color, m->metallic, m->roughness, m->transmission, ns, ng);
 }
 
 /* Contains some delta lobe (smooth metal or glass with a non-zero weight). */
@@ -400,11 +428,18 @@ INLINE BsdfLobes bsdf_lobes(const Bsdf *bs, float cos_o, float eta)
 	p.coat = wp * p.e_coat;
 	p.diffuse = wp * (1.0f - (p.e_coat + cms)) * v3_avg(bs->base_color);
 	float wg = bsdf_w_glass(bs);
-	p.e_glass = wg > 0.0f && !bsdf_smooth(bs) ? bsdf_glass_albedo(bs, eta > 1.0f, cos_o) : 1.0f;
-	float xs = eta > 1.0f ? bs->glass_x : bs->glass_y;
-	p.glass = wg * p.e_glass;
-	p.glass_r = wg * (1.0f - p.e_glass) * (1.0f - xs);
-	p.glass_t = wg * (1.0f - p.e_glass) * xs * v3_avg(bs->base_color);
+	if (bsdf_thin(bs)) { /* E1 (Fresnel 1) and the multiple scattering split by Favg */
+		p.e_glass = wg > 0.0f && !bsdf_smooth(bs) ? bsdf_metal_albedo(bs, cos_o) : 1.0f;
+		p.glass = wg * p.e_glass;
+		p.glass_r = wg * (1.0f - p.e_glass) * bs->glass_x;
+		p.glass_t = wg * (1.0f - p.e_glass) * (1.0f - bs->glass_x) * v3_avg(bs->base_color);
+	} else {
+		p.e_glass = wg > 0.0f && !bsdf_smooth(bs) ? bsdf_glass_albedo(bs, eta > 1.0f, cos_o) : 1.0f;
+		float xs = eta > 1.0f ? bs->glass_x : bs->glass_y;
+		p.glass = wg * p.e_glass;
+		p.glass_r = wg * (1.0f - p.e_glass) * (1.0f - xs);
+		p.glass_t = wg * (1.0f - p.e_glass) * xs * v3_avg(bs->base_color);
+	}
 	float sum = p.metal + p.coat + p.diffuse + p.glass + p.ms + p.glass_r + p.glass_t;
 	float inv = sum > 0.0f ? 1.0f / sum : 0.0f;
 	p.metal *= inv;
@@ -567,12 +602,26 @@ INLINE V3 bsdf_eval_lobes(const Bsdf *bs, V3 wo, V3 wi, float eta, int mode, flo
 			pdf += p.coat * ggx_pdf_visible(wo, h, a) * jac + p.diffuse * pdf_cosine_hemisphere_w(pz);
 		}
 		if (!smooth && bsdf_w_glass(bs) > 0.0f) {
-			float fr = bsdf_fresnel_dielectric(cos_oh, eta);
+			int thin = bsdf_thin(bs);
+			float fr = bsdf_fresnel_dielectric(cos_oh, thin ? bs->ior : eta);
 			float spec = ggx_d(h, bs->alpha) * ggx_g2(wo, wi, bs->alpha) * inv4 * fr;
-			float wg = bsdf_w_glass(bs) * (spec + bsdf_glass_ms(bs, eta > 1.0f, 1, p.e_glass, wi.z)) * gr;
+			float ms = thin ? bs->glass_x * bsdf_kc_factor(p.e_glass, bsdf_metal_albedo(bs, wi.z), bs->glass_y)
+					: bsdf_glass_ms(bs, eta > 1.0f, 1, p.e_glass, wi.z);
+			float wg = bsdf_w_glass(bs) * (spec + ms) * gr;
 			f = v3_add(f, v3(wg, wg, wg));
 			pdf += p.glass * fr * ggx_pdf_visible(wo, h, bs->alpha) * jac + p.glass_r * pdf_cosine_hemisphere_w(wi.z);
 		}
+	} else if (wi.z < 0.0f && !smooth && bsdf_w_glass(bs) > 0.0f && bsdf_thin(bs)) {
+		/* Thin: the reflection lobe at wi mirrored to wo's side, (1 - F). */
+		V3 wm = v3(wi.x, wi.y, -wi.z);
+		V3 h = v3_norm(v3_add(wo, wm));
+		float cos_oh = v3_dot(wo, h);
+		float fr = bsdf_fresnel_dielectric(cos_oh, bs->ior);
+		float t = ggx_d(h, bs->alpha) * ggx_g2(wo, wm, bs->alpha) * (1.0f - fr) / (4.0f * wo.z * wm.z);
+		t += (1.0f - bs->glass_x) * bsdf_kc_factor(p.e_glass, bsdf_metal_albedo(bs, wm.z), bs->glass_y);
+		f = v3_scale(bs->base_color, bsdf_w_glass(bs) * t * gr);
+		pdf = p.glass * (1.0f - fr) * ggx_pdf_visible(wo, h, bs->alpha) / (4.0f * cos_oh) +
+		      p.glass_t * pdf_cosine_hemisphere_w(wm.z);
 	} else if (wi.z < 0.0f && !smooth && bsdf_w_glass(bs) > 0.0f) {
 		V3 h;
 		float t = bsdf_glass_ms(bs, eta > 1.0f, 0, p.e_glass, -wi.z);
@@ -735,6 +784,42 @@ INLINE float bsdf_glass_delta_prob(const Bsdf *bs, V3 wo, float eta, int reflect
 	return bsdf_lobes(bs, wo.z, eta).glass * (reflect ? fr : 1.0f - fr);
 }
 
+/* Smooth thin glass with a weight: its transmission is a null event. */
+INLINE int bsdf_has_null(const Bsdf *bs)
+{
+	return bsdf_thin(bs) && bsdf_smooth(bs) && bsdf_w_glass(bs) > 0.0f;
+}
+
+/* Smooth thin glass's Fresnel for direction w (either way along it): in the
+ * own shading normal, so that a crossing has one transmittance. */
+INLINE float bsdf_thin_fresnel(const Bsdf *bs, V3 w) { return bsdf_fresnel_dielectric(fabs(v3_dot(w, bs->n)), bs->ior); }
+
+/* The probability that bsdf_sample from wo picks the null event (the
+ * glass lobe's share times 1 - F): walks decide it where they hit the
+ * surface, and sample the rest with u0 scaled to [0, 1 - it). */
+INLINE float bsdf_null_prob(const Bsdf *bs, V3 wo)
+{
+	float so = bsdf_side(bs, wo);
+	if (!bsdf_has_null(bs) || so == 0.0f)
+		return 0.0f;
+	int bent;
+	BsdfFrame frame = bsdf_frame_for(bs, wo, &bent);
+	V3 lo = bsdf_local(&frame, wo, so);
+	if (!(lo.z > 0.0f))
+		return 0.0f;
+	return bsdf_lobes(bs, lo.z, bsdf_eta(bs, so)).glass * (1.0f - bsdf_thin_fresnel(bs, wo));
+}
+
+/* The transmittance of smooth thin glass crossed along w: wg (1 - F)
+ * base_color, what a shadow ray or connection through it carries, and
+ * what a walk's null event carries divided by bsdf_null_prob. */
+INLINE V3 bsdf_null_weight(const Bsdf *bs, V3 w)
+{
+	if (!bsdf_has_null(bs))
+		return v3(0.0f, 0.0f, 0.0f);
+	return v3_scale(bs->base_color, bsdf_w_glass(bs) * (1.0f - bsdf_thin_fresnel(bs, w)));
+}
+
 /* Returns 0 if no sample. For delta samples f is the lobe's weight (Fresnel
  * included) divided by |wi.n| (shading normal), so f |wi.n| / pdf_w is the
  * throughput (in a bent normal m, times |wl . m| / |wl . n| as every f, the
@@ -789,6 +874,38 @@ INLINE int bsdf_sample_in(const Bsdf *bs, V3 wo, float u0, float u1, float u2, i
 		li = sample_cosine_hemisphere(u1, u2); /* glass multiple scattering, refraction */
 		li.z = -li.z;
 		reflect = 0;
+	} else if (p.glass > 0.0f && bsdf_thin(bs)) {
+		float ug = fmin((u0 - (p.metal + p.coat + p.diffuse + p.ms + p.glass_r + p.glass_t)) / p.glass, 0.99999994f);
+		if (smooth) {
+			float fr = bsdf_thin_fresnel(bs, wo), c = fabs(v3_dot(wo, bs->n));
+			if (!(lo.z > 1e-7f) || !(c > 1e-7f))
+				return 0;
+			if (ug >= fr) { /* the null event: straight through */
+				s->wi = v3_neg(wo);
+				s->f = v3_scale(bsdf_null_weight(bs, wo), 1.0f / c);
+				s->pdf_w = p.glass * (1.0f - fr);
+				s->pdf_rev_w = bsdf_null_prob(bs, s->wi);
+				s->delta = BSDF_NULL;
+				return s->pdf_w > 0.0f;
+			}
+			li = v3(-lo.x, -lo.y, lo.z);
+			s->f = v3_scale(v3(1.0f, 1.0f, 1.0f), bsdf_w_glass(bs) * fr / lo.z);
+			s->pdf_w = p.glass * fr;
+			s->wi = bsdf_world(&frame, li, so);
+			if (bent)
+				s->f = v3_scale(s->f, bsdf_bend_ratio(bs, frame.n, mode == BSDF_RADIANCE ? s->wi : wo));
+			if (bsdf_side(bs, s->wi) != so)
+				return 0;
+			V3 ri = bsdf_local(&frame, s->wi, so);
+			s->pdf_rev_w = bsdf_lobes(bs, ri.z, bsdf_eta(bs, so)).glass * bsdf_thin_fresnel(bs, s->wi);
+			s->delta = 1;
+			return s->pdf_w > 0.0f;
+		}
+		V3 h = ggx_sample_visible(lo, bs->alpha, u1, u2);
+		reflect = ug < bsdf_fresnel_dielectric(v3_dot(lo, h), bs->ior);
+		li = bsdf_reflect(lo, h);
+		if (!reflect)
+			li.z = -li.z; /* mirrored through the surface */
 	} else if (p.glass > 0.0f) {
 		float ug = fmin((u0 - (p.metal + p.coat + p.diffuse + p.ms + p.glass_r + p.glass_t)) / p.glass, 0.99999994f);
 		V3 h = smooth ? v3(0.0f, 0.0f, 1.0f) : ggx_sample_visible(lo, bs->alpha, u1, u2);

@@ -524,7 +524,8 @@ void device_render_options(const Device *d, int integrator, const DevicePlan *p,
 	} omit[] = {{DEVICE_OMIT_ALPHA, "-DAJAR_NO_ALPHA "},
 		    {DEVICE_OMIT_BENT_NORMALS, "-DAJAR_NO_BENT_NORMALS "},
 		    {DEVICE_OMIT_TEXTURES, "-DAJAR_NO_TEXTURES "},
-		    {DEVICE_OMIT_TRI_EXTRA, "-DAJAR_NO_TRI_EXTRA "}};
+		    {DEVICE_OMIT_TRI_EXTRA, "-DAJAR_NO_TRI_EXTRA "},
+		    {DEVICE_OMIT_PANES, "-DAJAR_NO_PANES "}};
 	device_build_options(d, integrator, NULL, buf, cap);
 	size_t n = strlen(buf);
 	if (p->soa)

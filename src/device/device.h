@@ -70,6 +70,7 @@ typedef struct {
 #define DEVICE_OMIT_BENT_NORMALS 2u /* -DAJAR_NO_BENT_NORMALS: no shading normal tilted from ng, no normal map */
 #define DEVICE_OMIT_TEXTURES 4u     /* -DAJAR_NO_TEXTURES: no material reads a texture */
 #define DEVICE_OMIT_TRI_EXTRA 8u    /* -DAJAR_NO_TRI_EXTRA: no TRI_EXTRA triangle (TEXCOORD_1, COLOR_0, tangents) */
+#define DEVICE_OMIT_PANES 16u       /* -DAJAR_NO_PANES: no TRI_PANE triangle (thin glass that rays cross) */
 /* The plan of integrator `integrator` for an image of npix pixels on d:
  * private arrays on CPUs and for pt, the scratch on other devices; one lane
  * per pixel on CPUs, on other devices enough for compute units x

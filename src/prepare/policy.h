@@ -47,6 +47,7 @@ typedef struct {
 	int bdpt_conn_given;  /* bdpt_conn (0, 1 or 2) for bdpt */
 	int bdpt_conn;
 	int sky_res;          /* 128, 256 or 512; 0: the policy's */
+	int panes_opaque;     /* panes are surfaces no connection crosses (delta transmission): a brute force */
 } PolicyOverrides;
 
 /* The sun's share of the light through the portals (PolicyInput.sun_share)

@@ -26,6 +26,7 @@
 #include "light/lights.h"
 #include "sample/rng.h"
 #include "geom/surface.h"
+#include "geom/visibility.h"
 
 #define FLUX_SAMPLES 2048
 #define SIDE_FLOOR 0.1f
@@ -44,8 +45,10 @@ static void side_flux(const SceneView *sc, const PortalTri *pt, uint32_t index, 
 		sample_triangle_point(pt->p0, pt->p1, pt->p2, rng_f(&rng), rng_f(&rng), &p, &ng);
 		float u1 = rng_f(&rng), u2 = rng_f(&rng);
 		V3 d = v3_from_local(sample_cosine_hemisphere(u1, u2), t, b, n);
-		if (!bvh_occluded(sc, p, d, AJAR_INF))
-			se += v3_lum(env_radiance(sc, d));
+		/* Panes in the opening let the sky through (geom/visibility.h). */
+		V3 Tsky = ray_transmittance(sc, p, d, AJAR_INF);
+		if (!v3_is_zero(Tsky))
+			se += v3_lum(v3_mul(env_radiance(sc, d), Tsky));
 		/* The emitters: a point by power, seen from this side; or a
 		 * punctual light, chosen in the same table. */
 		/* Drawn in the order gcc evaluated the three arguments of the
@@ -64,9 +67,10 @@ static void side_flux(const SceneView *sc, const PortalTri *pt, uint32_t index, 
 			float cos_p = v3_dot(wi, n);
 			if (!(cos_p > 0.0f) || !(l->pdf_select > 0.0f) || v3_is_zero(E))
 				continue;
-			int clear = dist < AJAR_INF ? segment_clear(sc, p, n, l->pos, v3_neg(wi)) : !bvh_occluded(sc, p, wi, AJAR_INF);
-			if (clear)
-				sl += v3_lum(E) * cos_p / l->pdf_select;
+			V3 T = dist < AJAR_INF ? segment_transmittance(sc, p, n, l->pos, v3_neg(wi))
+					       : ray_transmittance(sc, p, wi, AJAR_INF);
+			if (!v3_is_zero(T))
+				sl += v3_lum(v3_mul(E, T)) * cos_p / l->pdf_select;
 			continue;
 		}
 		int tri = emitter_point(sc, k, ua, ub, &q, &nq, &pdf_a);
@@ -78,9 +82,12 @@ static void side_flux(const SceneView *sc, const PortalTri *pt, uint32_t index, 
 			continue;
 		V3 w = v3_scale(to, 1.0f / sqrt(d2));
 		float cos_p = v3_dot(w, n), cos_q = -v3_dot(w, nq);
-		if (!(cos_p > 0.0f) || !(cos_q > 0.0f) || !segment_clear(sc, p, n, q, nq))
+		if (!(cos_p > 0.0f) || !(cos_q > 0.0f))
 			continue;
-		sl += v3_lum(emitter_emission(sc, tri, q)) * cos_p * cos_q / (d2 * pdf_a);
+		V3 T = segment_transmittance(sc, p, n, q, nq);
+		if (v3_is_zero(T))
+			continue;
+		sl += v3_lum(v3_mul(emitter_emission(sc, tri, q), T)) * cos_p * cos_q / (d2 * pdf_a);
 	}
 	*env = pt->area * AJAR_PI * se / FLUX_SAMPLES;
 	*emit = pt->area * sl / FLUX_SAMPLES;

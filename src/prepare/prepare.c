@@ -62,10 +62,12 @@ static int tri_may_tilt(const Tri *t, const TriShade *sh)
  * TriExtra data. Emitters with textures or alpha count as using them. */
 static unsigned kernel_omit(const SceneData *d)
 {
-	unsigned omit = DEVICE_OMIT_ALPHA | DEVICE_OMIT_BENT_NORMALS | DEVICE_OMIT_TRI_EXTRA;
+	unsigned omit = DEVICE_OMIT_ALPHA | DEVICE_OMIT_BENT_NORMALS | DEVICE_OMIT_TRI_EXTRA | DEVICE_OMIT_PANES;
 	for (size_t i = 0; i < d->n_tris; i++) {
 		if (d->tris[i].flags & TRI_ALPHA)
 			omit &= ~DEVICE_OMIT_ALPHA;
+		if (d->tris[i].flags & TRI_PANE)
+			omit &= ~DEVICE_OMIT_PANES;
 		if (d->tris[i].flags & (TRI_EXTRA | TRI_TANGENT))
 			omit &= ~DEVICE_OMIT_TRI_EXTRA;
 		if ((omit & DEVICE_OMIT_BENT_NORMALS) && tri_may_tilt(&d->tris[i], &d->shade[i]))
@@ -74,7 +76,7 @@ static unsigned kernel_omit(const SceneData *d)
 	int textured = 0;
 	for (size_t i = 0; i < d->n_materials; i++) {
 		const Material *m = &d->materials[i];
-		textured |= m->base_tex >= 0 || m->mr_tex || m->emissive_tex || m->normal_tex;
+		textured |= m->base_tex >= 0 || m->mr_tex || m->emissive_tex || m->normal_tex || m->transmission_tex;
 	}
 	if (!textured)
 		omit |= DEVICE_OMIT_TEXTURES;
@@ -223,6 +225,9 @@ ajar_status prepare_scene(const Scene *s, const ajar_options *o, uint32_t width,
 			d->extra[i] = s->extra[d->bvh.order[i]];
 	}
 	d->n_tris = d->n_shade = n;
+	if (over && over->panes_opaque) /* a test's brute force: smooth thin glass is a delta surface */
+		for (uint32_t i = 0; i < n; i++)
+			d->tris[i].flags &= ~TRI_PANE;
 	d->materials = s->materials;
 	d->n_materials = s->nmaterials;
 	d->textures = s->textures;
@@ -261,6 +266,8 @@ ajar_status prepare_scene(const Scene *s, const ajar_options *o, uint32_t width,
 		return st;
 	}
 	p->num_tris = (int)n;
+	for (uint32_t i = 0; i < n; i++)
+		p->num_panes += (d->tris[i].flags & TRI_PANE) != 0;
 	p->num_emitters = (int)d->lights.nemitters;
 	p->num_lights = (int)d->lights.nlights;
 	p->light_power = d->lights.light_power;

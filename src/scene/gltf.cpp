@@ -40,7 +40,8 @@ namespace tg = tinygltf;
  * other cannot be shown correctly and is refused. */
 const char *const supported_extensions[] = {
 	"KHR_materials_emissive_strength", "KHR_materials_ior", "KHR_materials_specular",
-	"KHR_materials_transmission", "KHR_mesh_quantization", "KHR_lights_punctual", "KHR_texture_transform",
+	"KHR_materials_transmission", "KHR_materials_volume", "KHR_mesh_quantization", "KHR_lights_punctual",
+	"KHR_texture_transform",
 };
 
 struct Loader {
@@ -707,6 +708,70 @@ ajar_status texture_use(Loader &L, int mi, const char *slot, int index, int texc
 	return st;
 }
 
+/* A texture named inside a material extension (extensions[ext][key], a
+ * textureInfo: index, texCoord and its own extensions), or *id = -1. */
+ajar_status ext_texture(Loader &L, int mi, const tg::ExtensionMap &exts, const char *ext, const char *key, int *id)
+{
+	*id = -1;
+	auto it = exts.find(ext);
+	const tg::Value *info = it == exts.end() ? nullptr : value_member(it->second, key);
+	if (!info)
+		return AJAR_OK;
+	const tg::Value *index = value_member(*info, "index"), *texcoord = value_member(*info, "texCoord");
+	if (!index || !index->IsNumber() || (texcoord && !texcoord->IsNumber()))
+		return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d]: %s.%s needs a numeric index (and texCoord)", mi, ext,
+			    key);
+	tg::ExtensionMap own;
+	const tg::Value *e = value_member(*info, "extensions");
+	if (e && e->IsObject())
+		for (const std::string &k : e->Keys())
+			own[k] = e->Get(k);
+	char slot[96];
+	snprintf(slot, sizeof slot, "%s.%s", ext, key);
+	return texture_use(L, mi, slot, (int)index->GetNumberAsDouble(), texcoord ? (int)texcoord->GetNumberAsDouble() : 0,
+			   own, id);
+}
+
+/* KHR_materials_volume: a thickness above 0 makes the material a solid
+ * that transmission refracts into (MATERIAL_VOLUME), absorbing by
+ * sigma = -ln(attenuationColor) / attenuationDistance inside; without it
+ * (or with thickness 0) transmission is thin-walled, as glTF defines. */
+ajar_status load_volume(Loader &L, int mi, const tg::ExtensionMap &exts, ::Material *m)
+{
+	double thickness, distance;
+	ajar_status st;
+	if ((st = ext_number(L, mi, exts, "KHR_materials_volume", "thicknessFactor", 0.0, 0.0, 1e30, &thickness)) ||
+	    (st = ext_number(L, mi, exts, "KHR_materials_volume", "attenuationDistance", INFINITY, 0.0, INFINITY,
+			     &distance)))
+		return st;
+	if (!(thickness > 0.0))
+		return AJAR_OK;
+	ext_unread(L, mi, exts, "KHR_materials_volume", "thicknessTexture", "thicknessFactor alone is used");
+	m->flags |= MATERIAL_VOLUME;
+	auto it = exts.find("KHR_materials_volume");
+	const tg::Value *c = value_member(it->second, "attenuationColor");
+	double col[3] = {1.0, 1.0, 1.0};
+	if (c) {
+		if (!c->IsArray() || c->ArrayLen() != 3)
+			return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d]: KHR_materials_volume.attenuationColor needs 3 numbers",
+				    mi);
+		for (int k = 0; k < 3; k++) {
+			if (!c->Get(k).IsNumber() || !(c->Get(k).GetNumberAsDouble() >= 0.0 && c->Get(k).GetNumberAsDouble() <= 1.0))
+				return fail(L, AJAR_ERROR_BAD_INPUT,
+					    "materials[%d]: KHR_materials_volume.attenuationColor must be in [0, 1]", mi);
+			col[k] = c->Get(k).GetNumberAsDouble();
+		}
+	}
+	if (!(distance > 0.0))
+		return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d]: KHR_materials_volume.attenuationDistance must be above 0",
+			    mi);
+	float sigma[3];
+	for (int k = 0; k < 3; k++) /* a colour of 0 absorbs everything: a large finite coefficient */
+		sigma[k] = std::isinf(distance) ? 0.0f : (float)fmin(-log(fmax(col[k], 1e-30)) / distance, 1e30);
+	m->sigma = v3(sigma[0], sigma[1], sigma[2]);
+	return AJAR_OK;
+}
+
 ajar_status in_unit(const Loader &L, int mi, const char *name, double v)
 {
 	if (!(v >= 0.0 && v <= 1.0))
@@ -746,8 +811,6 @@ ajar_status load_material(Loader &L, int mi, uint32_t *id)
 	    (st = ext_number(L, mi, gm.extensions, "KHR_materials_specular", "specularFactor", 1.0, 0.0, 1.0,
 			     &specular)))
 		return st;
-	ext_unread(L, mi, gm.extensions, "KHR_materials_transmission", "transmissionTexture",
-		   "transmissionFactor alone is used");
 	ext_unread(L, mi, gm.extensions, "KHR_materials_specular", "specularTexture", "specularFactor alone is used");
 	ext_unread(L, mi, gm.extensions, "KHR_materials_specular", "specularColorTexture", "ignored");
 	if (specular_tinted(gm.extensions))
@@ -795,6 +858,11 @@ ajar_status load_material(Loader &L, int mi, uint32_t *id)
 		return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d]: normalTexture.scale is not finite", mi);
 	m.normal_tex = nrm + 1;
 	m.normal_scale = (float)nt.scale;
+	int tr = -1;
+	if ((st = ext_texture(L, mi, gm.extensions, "KHR_materials_transmission", "transmissionTexture", &tr)) ||
+	    (st = load_volume(L, mi, gm.extensions, &m)))
+		return st;
+	m.transmission_tex = tr + 1;
 	return scene_add_material(L.s, &m, id);
 }
 

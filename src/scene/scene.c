@@ -14,6 +14,7 @@
 #include "core/error.h"
 #include "image/exr.h"
 #include "image/hdr.h"
+#include "material/bsdf.h"
 #include "material/texture.h"
 
 /* Device code indexes with int, so no array may pass INT32_MAX entries. */
@@ -89,7 +90,8 @@ ajar_status scene_add_material(Scene *s, const Material *m, uint32_t *id)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: material %u: texture %d does not exist (%u textures)",
 			       s->source, s->nmaterials, m->base_tex, s->ntextures);
 	if (m->mr_tex < 0 || m->mr_tex > (int)s->ntextures || m->emissive_tex < 0 ||
-	    m->emissive_tex > (int)s->ntextures || m->normal_tex < 0 || m->normal_tex > (int)s->ntextures)
+	    m->emissive_tex > (int)s->ntextures || m->normal_tex < 0 || m->normal_tex > (int)s->ntextures ||
+	    m->transmission_tex < 0 || m->transmission_tex > (int)s->ntextures)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: material %u: texture %d or %d does not exist (%u textures)",
 			       s->source, s->nmaterials, m->mr_tex - 1, m->emissive_tex - 1, s->ntextures);
 	ajar_status st = grow32((void **)&s->materials, &s->cap_materials, (size_t)s->nmaterials + 1,
@@ -257,6 +259,12 @@ ajar_status scene_add_triangles_ex(Scene *s, const char *what, const float *pos,
 	int alpha = (mat->flags & (MATERIAL_ALPHA_MASK | MATERIAL_ALPHA_BLEND)) &&
 		    (mat->base_tex >= 0 || colors ||
 		     !(mat->base_alpha >= (mat->flags & MATERIAL_ALPHA_MASK ? mat->alpha_cutoff : 1.0f)));
+	/* Panes: thin-walled glass that may be smooth (its roughness factor
+	 * below the delta limit, or a roughness texture): shadow rays and
+	 * connections cross them (kernels/geom/visibility.h). Emissive glass
+	 * stays a surface that emits where it is hit. */
+	int pane = !(mat->flags & MATERIAL_VOLUME) && mat->transmission > 0.0f && (mat->metallic < 1.0f || mat->mr_tex) &&
+		   (mat->roughness * mat->roughness < BSDF_DELTA_ALPHA || mat->mr_tex) && v3_is_zero(mat->emission);
 	if (normals)
 		for (uint32_t v = 0; v < nverts; v++)
 			if (!all_finite(normals + 3 * (size_t)v, 3))
@@ -300,6 +308,8 @@ ajar_status scene_add_triangles_ex(Scene *s, const char *what, const float *pos,
 		tri->emitter = -1;
 		if (alpha)
 			tri->flags |= TRI_ALPHA;
+		if (pane)
+			tri->flags |= TRI_PANE;
 		if (normals) {
 			V3 n[3];
 			sh->has_normals = 1;

@@ -65,6 +65,7 @@ void ajar_material_default(ajar_material *m)
 	m->transmission = 0.0f;
 	m->ior = 1.5f;
 	m->double_sided = 1;
+	m->attenuation_color[0] = m->attenuation_color[1] = m->attenuation_color[2] = 1.0f;
 }
 
 /* NaN fails every comparison, so `!(lo <= v && v <= hi)` rejects it too. */
@@ -91,6 +92,13 @@ ajar_status ajar_scene_add_material(ajar_scene *s, const ajar_material *m, uint3
 		bad = "transmission must be in [0, 1]";
 	else if (!in_range(m->ior, 1.0f, 10.0f))
 		bad = "ior must be in [1, 10]";
+	else if (!in_range(m->thickness, 0.0f, AJAR_INF))
+		bad = "thickness must be finite and >= 0";
+	else if (!in_range(m->attenuation_distance, 0.0f, AJAR_INF))
+		bad = "attenuation_distance must be finite and >= 0";
+	for (int i = 0; i < 3 && !bad; i++)
+		if (!in_range(m->attenuation_color[i], 0.0f, 1.0f))
+			bad = "attenuation_color must be in [0, 1]";
 	if (bad)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: material %u: %s", s->source, s->nmaterials, bad);
 
@@ -106,6 +114,15 @@ ajar_status ajar_scene_add_material(ajar_scene *s, const ajar_material *m, uint3
 	d.specular = m->specular;
 	d.flags = m->double_sided ? MATERIAL_DOUBLE_SIDED : 0;
 	d.alpha_cutoff = 0.5f;
+	if (m->thickness > 0.0f) {
+		d.flags |= MATERIAL_VOLUME;
+		float sg[3];
+		for (int i = 0; i < 3; i++)
+			sg[i] = m->attenuation_distance > 0.0f
+					? fminf(-logf(fmaxf(m->attenuation_color[i], 1e-30f)) / m->attenuation_distance, 1e30f)
+					: 0.0f;
+		d.sigma = v3(sg[0], sg[1], sg[2]);
+	}
 	return scene_add_material(s, &d, id);
 }
 
