@@ -57,6 +57,7 @@ DEPS_test_exr := $(call obj,core/error image/exr image/exr_read image/png)
 DEPS_test_confine := $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_read image/hdr image/png)
 DEPS_test_bdpt := $(BUILD)/tests/kernel_host.o $(BUILD)/tests/mis_oracle.o $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_read image/hdr prepare/bvh_build prepare/light_tables prepare/prepare prepare/policy prepare/portal_flux prepare/sky_tables prepare/portal_find prepare/found_portals render/render_options)
 DEPS_test_portal := $(DEPS_test_bdpt)
+DEPS_test_portal_find := $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_read image/hdr prepare/bvh_build prepare/light_tables prepare/prepare prepare/policy prepare/portal_flux prepare/sky_tables prepare/portal_find prepare/found_portals render/render_options)
 DEPS_test_punctual := $(DEPS_test_bdpt)
 # Tests that render need the whole library.
 DEPS_test_layout := $(BUILD)/libajar.a
@@ -197,7 +198,7 @@ test:
 	$(Q)sh tests/run.sh $(BUILD) $(TESTS)
 
 # Host tests that need no OpenCL device, under ASan + UBSan.
-ASAN_TESTS := test_bsdf test_sampling test_bvh test_lights test_lights_fine test_scene test_exr test_bdpt test_portal test_confine test_punctual
+ASAN_TESTS := test_bsdf test_sampling test_bvh test_lights test_lights_fine test_scene test_exr test_bdpt test_portal test_confine test_punctual test_portal_find
 asan:
 	$(Q)$(MAKE) --no-print-directory deps
 	$(Q)$(MAKE) --no-print-directory MODE=asan $(ASAN_TESTS:%=build/asan/tests/%)
