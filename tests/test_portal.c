@@ -411,6 +411,50 @@ static void test_mis_door_ajar(void **state)
 	host_scene_close(&h);
 }
 
+/* ---- Found portals ------------------------------------------------------ */
+
+static void check_directions(HostScene *h, int j, int SUB, const char *name);
+
+/* `path` as an exporter hands it over: its marked portals taken out, so
+ * the render finds its own (src/prepare/portal_find.c). */
+static Scene *without_portals(const char *path)
+{
+	Scene *s;
+	if (ajar_scene_load(path, &s) != AJAR_OK)
+		fail_msg("%s", ajar_last_error());
+	s->nportal_tris = 0;
+	s->nportals = 0;
+	return s;
+}
+
+/* MIS over the union and the <- directions' chi-square with the portals
+ * the search finds: a window (a constant sky, every strategy as well) and a
+ * door's gap with an emitter behind it. */
+static void test_found_portals(void **state)
+{
+	(void)state;
+	HostScene h;
+	host_scene_open(&h, NULL, without_portals(SCENE("window-room/window-room.gltf")), 24, 24, INTEGRATOR_PORTAL, 8);
+	assert_int_equal(h.data.portal_source, POLICY_PORTALS_FOUND);
+	assert_true(h.data.n_portals >= 2);
+	assert_true(check_scene_mis(&h, 200).portal_paths > 100);
+	use_all_portal_strategies(&h);
+	assert_true(check_scene_mis(&h, 300).portal_paths > 150);
+	host_scene_close(&h);
+	host_scene_open(&h, NULL, without_portals(SCENE("window-room/window-room.gltf")), 8, 8, INTEGRATOR_PORTAL, 8);
+	check_directions(&h, 0, 8, "window-room, found portal");
+	host_scene_close(&h);
+
+	host_scene_open(&h, NULL, without_portals(SCENE("door-ajar/door-ajar.gltf")), 24, 24, INTEGRATOR_PORTAL, 8);
+	assert_int_equal(h.data.portal_source, POLICY_PORTALS_FOUND);
+	assert_true(h.data.n_portals >= 2);
+	assert_true(check_scene_mis(&h, 300).portal_paths > 50);
+	host_scene_close(&h);
+	host_scene_open(&h, NULL, without_portals(SCENE("door-ajar/door-ajar.gltf")), 8, 8, INTEGRATOR_PORTAL, 8);
+	check_directions(&h, 0, 64, "door-ajar, found portal");
+	host_scene_close(&h);
+}
+
 /* ---- Punctual lights --------------------------------------------------- */
 
 /* `path` with a directional light at `dir` and, if `inside`, a point light
@@ -1427,6 +1471,7 @@ int main(void)
 		cmocka_unit_test(test_mis_glazed), cmocka_unit_test(test_mis_living_room),
 		cmocka_unit_test(test_mis_bathroom),
 		cmocka_unit_test(test_mis_door_ajar),
+		cmocka_unit_test(test_found_portals),
 		cmocka_unit_test(test_mis_portal_surface_portal),
 		cmocka_unit_test(test_mis_window_room_sun),
 		cmocka_unit_test(test_join_weights),

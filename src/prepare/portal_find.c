@@ -83,11 +83,13 @@
 #define PATCH_DN 0.3f      /* lines that cross a plane at a shallower cosine do not count there */
 #define MAX_ROUNDS 32
 #define MEET_DN 0.05f      /* a line crossing a portal at a shallower cosine does not count */
+#define PLANE_OFFSET 1e-3f /* x R: a portal lies this far beyond the surface it was found in */
 #define GRID 64            /* step 6: cells a side */
 #define CELL_ORIGINS 3
 #define GROW_TRIES 3       /* the grid grows where open cells touch its border */
 #define CONNECT 2          /* open cells this many cells apart join */
 #define MERGE_AREA 1.25    /* step 7 */
+#define MERGE_GAP 0.03f    /* x R: rectangles of planes this close may merge */
 #define MIN_SHARE 0.02f    /* step 8 */
 #define MAX_PORTALS 16
 
@@ -864,7 +866,9 @@ static double best_patch(Ctx *c, const Crossings *xs, const uint8_t *alive, cons
 static void test_cells(Ctx *c, const Crossing *xs, const uint32_t *yl, const float *u1, const float *u2, uint32_t k,
 		       V3 o, V3 a1, V3 a2, V3 n, float l1, float l2, float c1, float c2, float deep, uint8_t *open)
 {
-	float back = fmax(1e-4f * c->R, 0.25f * fmin(c1, c2));
+	/* Rays start a little before the cell (the plane lies PLANE_OFFSET R
+	 * beyond a surface: a quarter of that). */
+	float back = 0.25f * PLANE_OFFSET * c->R;
 	memset(open, 0, GRID * GRID);
 	for (int j = 0; j < GRID; j++)
 		for (int i = 0; i < GRID; i++) {
@@ -899,6 +903,10 @@ static void test_cells(Ctx *c, const Crossing *xs, const uint32_t *yl, const flo
 				if (!go && c->nlp && !line->from->sees[pick])
 					go = lit_by(c, sol.p, sol.ng, &c->lp[(line->from->base + pick) % c->nlp]);
 				open[j * GRID + i] = (uint8_t)go;
+#ifdef PORTAL_FIND_DEBUG
+				if (go && (i < 3 || j < 3 || i > GRID - 4 || j > GRID - 4))
+					fprintf(stderr, "edge cell %d,%d X(%.3f %.3f %.3f) P(%.3f %.3f %.3f) back %.4f sol.t %.4f emit %d dn %.3f\n", i, j, X.x, X.y, X.z, P.x, P.y, P.z, back, sol.t, sol.emit, v3_dot(d, n));
+#endif
 			}
 		}
 }
@@ -937,7 +945,16 @@ static ajar_status open_rects(Ctx *c, const Crossing *xs, const uint32_t *idx, u
 	if (v3_dot(room, n) < 0.0f) { /* face the room */
 		n = v3_neg(n);
 		s = -s;
-		o = v3_scale(n, s);
+	}
+	/* Candidate planes are surfaces' (a wall, a jamb): a portal in one
+	 * would share points with it, where a path vertex on the surface lies
+	 * exactly in the portal and its crossings hang on rounding. The portal
+	 * goes PLANE_OFFSET R beyond it, along the lines' way out. */
+	s -= PLANE_OFFSET * R;
+	o = v3_scale(n, s);
+	for (uint32_t i = 0; i < k; i++) {
+		const Crossing *x = &xs[yl[i]];
+		y[i] = v3_madd(x->P, x->d, (s - v3_dot(n, x->P)) / v3_dot(n, x->d));
 	}
 	/* The footprint's narrowest frame, in 2-degree turns. */
 	V3 f1, f2;
@@ -1053,31 +1070,34 @@ done:
 }
 
 /* Steps 5 to 7 for the lines idx[0..m) of one opening. */
-/* Rectangles of one plane merge while one rectangle covers two with at
- * most MERGE_AREA times their areas. */
-static void merge_rects(Rects *rs, uint32_t from)
+/* Rectangles of one plane (normals within 1 degree, planes within
+ * MERGE_GAP R: a window found twice, at its frame and at its blind) merge
+ * while one rectangle covers two with at most MERGE_AREA times the area
+ * they cover together. The merged one lies in the first's plane. */
+static void merge_rects(Rects *rs, uint32_t from, float R)
 {
 	for (int changed = 1; changed;) {
 		changed = 0;
 		for (uint32_t i = from; i < rs->n; i++)
 			for (uint32_t j = i + 1; j < rs->n; j++) {
 				Rect *a = &rs->r[i], *b = &rs->r[j];
-				float ax = fabs(v3_dot(a->a1, b->a1));
-				if (!a->alive || !b->alive || v3_dot(a->n, b->n) < 0.9999f || (ax < 0.9999f && ax > 1e-4f) ||
-				    fabs(v3_dot(a->n, v3_sub(a->o, b->o))) > 1e-4f)
+				if (!a->alive || !b->alive || v3_dot(a->n, b->n) < 0.9998f ||
+				    fabs(v3_dot(a->n, v3_sub(a->o, b->o))) > MERGE_GAP * R)
 					continue;
-				/* b's corners in a's frame (axes parallel or crossed). */
-				float lo1 = a->lo1, hi1 = a->hi1, lo2 = a->lo2, hi2 = a->hi2;
+				/* b's corners in a's frame. */
+				float lo1 = AJAR_INF, hi1 = -AJAR_INF, lo2 = AJAR_INF, hi2 = -AJAR_INF;
 				for (int k = 0; k < 4; k++) {
 					V3 p = v3_add(b->o, v3_add(v3_scale(b->a1, k & 1 ? b->hi1 : b->lo1),
 								   v3_scale(b->a2, k & 2 ? b->hi2 : b->lo2)));
 					float q1 = v3_dot(v3_sub(p, a->o), a->a1), q2 = v3_dot(v3_sub(p, a->o), a->a2);
 					lo1 = fmin(lo1, q1), hi1 = fmax(hi1, q1), lo2 = fmin(lo2, q2), hi2 = fmax(hi2, q2);
 				}
-				double area = (double)(hi1 - lo1) * (hi2 - lo2);
-				double sum = (double)(a->hi1 - a->lo1) * (a->hi2 - a->lo2) +
-					     (double)(b->hi1 - b->lo1) * (b->hi2 - b->lo2);
-				if (area > MERGE_AREA * sum)
+				double ov1 = fmin(a->hi1, hi1) - fmax(a->lo1, lo1), ov2 = fmin(a->hi2, hi2) - fmax(a->lo2, lo2);
+				double overlap = ov1 > 0 && ov2 > 0 ? ov1 * ov2 : 0.0;
+				double area_a = (double)(a->hi1 - a->lo1) * (a->hi2 - a->lo2);
+				double area_b = (double)(hi1 - lo1) * (hi2 - lo2);
+				lo1 = fmin(lo1, a->lo1), hi1 = fmax(hi1, a->hi1), lo2 = fmin(lo2, a->lo2), hi2 = fmax(hi2, a->hi2);
+				if ((double)(hi1 - lo1) * (hi2 - lo2) > MERGE_AREA * (area_a + area_b - overlap))
 					continue;
 				a->lo1 = lo1, a->hi1 = hi1, a->lo2 = lo2, a->hi2 = hi2;
 				a->share += b->share;
@@ -1209,7 +1229,7 @@ ajar_status portal_find(const SceneView *v, uint32_t ntris, const PortalFindInpu
 		uint32_t from = rs.n;
 		if ((st = open_rects(&c, xs.x, idx, m, pn[q], po[q], n, scratch, &rs)) != AJAR_OK)
 			goto done;
-		merge_rects(&rs, from);
+		merge_rects(&rs, from, c.R);
 		for (uint32_t i = 0; i < m; i++)
 			alive[idx[i]] = 0; /* the patch is settled, caught or not */
 		for (uint32_t r = from; r < rs.n; r++) {
@@ -1239,7 +1259,7 @@ ajar_status portal_find(const SceneView *v, uint32_t ntris, const PortalFindInpu
 	 * one rectangle covers them with little more area. */
 	for (uint32_t r = 0; r < rs.n; r++)
 		rs.r[r].alive = rs.r[r].accepted;
-	merge_rects(&rs, 0);
+	merge_rects(&rs, 0, c.R);
 	for (uint32_t r = 0; r < rs.n && out->count < MAX_PORTALS; r++) {
 		const Rect *rc = &rs.r[r];
 		if (!rc->alive)
