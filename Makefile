@@ -72,9 +72,10 @@ DEPS_test_checkpoint := $(BUILD)/libajar.a
 DEPS_test_aov := $(BUILD)/libajar.a
 DEPS_test_subpaths := $(BUILD)/libajar.a
 DEPS_test_mpi := $(BUILD)/libajar.a
+DEPS_test_found_portals := $(BUILD)/libajar.a
 DEPS_test_glass := $(BUILD)/libajar.a
 
-.PHONY: FORCE all lib cli tests test test-unit asan demo bench bench-peers install uninstall clean deps help
+.PHONY: FORCE all lib cli tests test test-unit asan demo bench bench-portals bench-peers install uninstall clean deps help
 all: lib cli
 
 help:
@@ -82,6 +83,7 @@ help:
 	@echo "make test       install missing packages, build and run every test (cmocka)"
 	@echo "make asan       host unit tests under AddressSanitizer + UBSan"
 	@echo "make bench      BVH, traversal, samples/s, start-up figures"
+	@echo "make bench-portals  found portals vs marked ones at equal time, every portal scene"
 	@echo "make bench-peers  Cycles, Mitsuba 3, LuxCore vs Ajar at equal time (installs them; slow)"
 	@echo "make install    PREFIX=$(PREFIX): ajar, libajar.{a,so}, ajar.h, ajar.pc"
 	@echo "make all        library and CLI (MODE=release|debug|asan, V=1 for commands)"
@@ -190,6 +192,10 @@ $(BUILD)/tests/bench: $(BUILD)/tests/bench.o $(BUILD)/libajar.a
 	@echo "  LD      $@"
 	$(Q)$(CXX) $(LDFLAGS) -o $@ $^ $(LDLIBS)
 
+$(BUILD)/tests/bench_portals: $(BUILD)/tests/bench_portals.o $(BUILD)/libajar.a
+	@echo "  LD      $@"
+	$(Q)$(CXX) $(LDFLAGS) -o $@ $^ $(LDLIBS)
+
 tests: $(TESTS:%=$(BUILD)/tests/%) build/ajar $(BUILD)/tests/ajar_faults
 
 test:
@@ -219,6 +225,12 @@ bench:
 	$(Q)$(MAKE) --no-print-directory deps
 	$(Q)$(MAKE) --no-print-directory all $(BUILD)/tests/bench
 	$(BUILD)/tests/bench
+
+# Found portals against marked ones at equal time (tests/bench_portals.c).
+bench-portals:
+	$(Q)$(MAKE) --no-print-directory deps
+	$(Q)$(MAKE) --no-print-directory all $(BUILD)/tests/bench_portals
+	$(BUILD)/tests/bench_portals
 
 # The shared library is installed under its full version with the soname
 # (libajar.so.0, as the link rule sets it) and the development name as links.
