@@ -43,22 +43,46 @@ LIB_CXX := $(foreach d,$(LIB_DIRS),$(wildcard src/$(d)/*.cpp))
 LIB_OBJS := $(LIB_C:src/%.c=$(BUILD)/src/%.o) $(LIB_CXX:src/%.cpp=$(BUILD)/src/%.o) $(BUILD)/kernel_source.o
 CLI_OBJS := $(patsubst src/cli/%.c,$(BUILD)/cli/%.o,$(wildcard src/cli/*.c))
 KERNELS := $(wildcard kernels/*.cl kernels/*/*.h)
-TESTS := $(patsubst tests/%.c,%,$(wildcard tests/test_*.c)) test_lights_fine
+# Tests in folders by what they need (tests/README.md): unit/ the host
+# alone (no OpenCL device), render/ an OpenCL device, api/ the library, the
+# program and Open MPI as a user meets them; bench/ is `make bench`, support/
+# the helpers they share. Objects and binaries stay flat in $(BUILD)/tests.
+UNIT_TESTS := $(notdir $(basename $(wildcard tests/unit/test_*.c))) test_lights_sky_planes_fine
+TESTS := $(UNIT_TESTS) $(notdir $(basename $(wildcard tests/render/test_*.c tests/api/test_*.c)))
 
 # One test binary per module, linking only what it tests (plus error.o).
 obj = $(addprefix $(BUILD)/src/,$(addsuffix .o,$(1)))
 DEPS_test_bsdf := $(call obj,core/error)
 DEPS_test_sampling := $(call obj,core/error)
 DEPS_test_bvh := $(call obj,core/error scene/scene prepare/bvh_build scene/gltf scene/tangents image/exr image/exr_read image/hdr)
-DEPS_test_lights := $(call obj,core/error scene/scene prepare/light_tables image/exr image/exr_read image/hdr prepare/sky_tables prepare/portal_flux)
-DEPS_test_lights_fine := $(DEPS_test_lights)
-DEPS_test_scene := $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_read image/hdr)
+# The light tests share tests/support/lit.c (the kernels' light code inside).
+LIGHT_DEPS := $(BUILD)/tests/lit.o $(call obj,core/error scene/scene prepare/light_tables image/exr image/exr_read image/hdr)
+DEPS_test_lights_env := $(LIGHT_DEPS) $(call obj,prepare/portal_flux)
+DEPS_test_lights_emitters := $(LIGHT_DEPS)
+DEPS_test_lights_sample := $(LIGHT_DEPS)
+DEPS_test_lights_sky_planes := $(LIGHT_DEPS) $(call obj,prepare/sky_tables)
+DEPS_test_lights_sky_planes_fine := $(patsubst %/lit.o,%/lit_fine.o,$(DEPS_test_lights_sky_planes))
+# The scene module: the loader, the API's scene calls, the images a scene reads.
+SCENE_DEPS := $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_read image/hdr)
+DEPS_test_scene_shipped := $(BUILD)/tests/scene_files.o $(SCENE_DEPS)
+DEPS_test_scene_api := $(BUILD)/tests/scene_files.o $(SCENE_DEPS)
+DEPS_test_scene_gltf := $(BUILD)/tests/scene_files.o $(SCENE_DEPS)
+DEPS_test_scene_materials := $(BUILD)/tests/scene_files.o $(SCENE_DEPS)
+DEPS_test_scene_env := $(BUILD)/tests/scene_files.o $(SCENE_DEPS)
 DEPS_test_exr := $(call obj,core/error image/exr image/exr_read image/png)
-DEPS_test_confine := $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_read image/hdr image/png)
-DEPS_test_bdpt := $(BUILD)/tests/kernel_host.o $(BUILD)/tests/mis_oracle.o $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_read image/hdr prepare/bvh_build prepare/light_tables prepare/prepare prepare/policy prepare/portal_flux prepare/sky_tables prepare/portal_find prepare/found_portals render/render_options)
-DEPS_test_portal := $(DEPS_test_bdpt)
-DEPS_test_portal_find := $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_read image/hdr prepare/bvh_build prepare/light_tables prepare/prepare prepare/policy prepare/portal_flux prepare/sky_tables prepare/portal_find prepare/found_portals render/render_options)
-DEPS_test_punctual := $(DEPS_test_bdpt)
+DEPS_test_confine := $(SCENE_DEPS) $(call obj,image/png)
+# The kernels' integrators run on the host (tests/support/kernel_host.c) on
+# scenes as prepare_scene makes them; the MIS tests add the oracle.
+HOST_DEPS := $(BUILD)/tests/kernel_host.o $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_read image/hdr prepare/bvh_build prepare/light_tables prepare/prepare prepare/policy prepare/portal_flux prepare/sky_tables prepare/portal_find prepare/found_portals render/render_options)
+DEPS_test_bdpt := $(BUILD)/tests/mis_oracle.o $(HOST_DEPS)
+DEPS_test_punctual := $(HOST_DEPS)
+PORTAL_DEPS := $(BUILD)/tests/portal_scenes.o $(HOST_DEPS)
+DEPS_test_portal_mis := $(BUILD)/tests/mis_oracle.o $(PORTAL_DEPS)
+DEPS_test_portal_groups := $(PORTAL_DEPS)
+DEPS_test_portal_sampling := $(PORTAL_DEPS)
+DEPS_test_portal_policy := $(PORTAL_DEPS)
+# The portal search on the host: scenes, the BVH, prepare_scene for the portals a render takes.
+DEPS_test_portal_find := $(HOST_DEPS)
 # Tests that render need the whole library.
 DEPS_test_layout := $(BUILD)/libajar.a
 DEPS_test_render := $(BUILD)/libajar.a
@@ -73,6 +97,7 @@ DEPS_test_aov := $(BUILD)/libajar.a
 DEPS_test_subpaths := $(BUILD)/libajar.a
 DEPS_test_mpi := $(BUILD)/libajar.a
 DEPS_test_found_portals := $(BUILD)/libajar.a
+DEPS_test_cli_scene := $(BUILD)/libajar.a
 DEPS_test_glass := $(BUILD)/libajar.a
 
 .PHONY: FORCE all lib cli tests test test-unit asan demo bench bench-portals bench-peers install uninstall clean deps help
@@ -162,17 +187,30 @@ kernels/material/bsdf_tables.h: build/tools/bsdf_tables
 	@echo "  GEN     $@"
 	$(Q)$< > $@.tmp && mv $@.tmp $@
 
-$(BUILD)/tests/%.o: tests/%.c
-	@mkdir -p $(@D)
-	@echo "  CC      $<"
-	$(Q)$(CC) $(CPPFLAGS) -Itests $(PKG_CFLAGS) $(CFLAGS) -c -o $@ $<
+define compile_test
+@mkdir -p $(@D)
+@echo "  CC      $<$(if $(TEST_CFLAGS), ($(TEST_CFLAGS)))"
+$(Q)$(CC) $(CPPFLAGS) -Itests/support $(PKG_CFLAGS) $(CFLAGS) $(TEST_CFLAGS) -c -o $@ $<
+endef
+$(BUILD)/tests/%.o: tests/unit/%.c
+	$(compile_test)
+$(BUILD)/tests/%.o: tests/render/%.c
+	$(compile_test)
+$(BUILD)/tests/%.o: tests/api/%.c
+	$(compile_test)
+$(BUILD)/tests/%.o: tests/bench/%.c
+	$(compile_test)
+$(BUILD)/tests/%.o: tests/support/%.c
+	$(compile_test)
 
-# test_lights again with the planes' sky tables at 512 cells a side, as pt
-# takes them under skies of 2048 columns or more (src/prepare/prepare.c).
-$(BUILD)/tests/test_lights_fine.o: tests/test_lights.c
-	@mkdir -p $(@D)
-	@echo "  CC      $< (PORTAL_SKY_RES=512)"
-	$(Q)$(CC) $(CPPFLAGS) -Itests $(PKG_CFLAGS) $(CFLAGS) -DPORTAL_SKY_RES=512 -c -o $@ $<
+# test_lights_sky_planes again with the planes' sky tables at 512 cells a
+# side, as pt takes them under skies of 2048 columns or more
+# (src/prepare/policy.c); lit.c holds the kernels' light code, so it too.
+$(BUILD)/tests/test_lights_sky_planes_fine.o $(BUILD)/tests/lit_fine.o: TEST_CFLAGS := -DPORTAL_SKY_RES=512
+$(BUILD)/tests/test_lights_sky_planes_fine.o: tests/unit/test_lights_sky_planes.c
+	$(compile_test)
+$(BUILD)/tests/lit_fine.o: tests/support/lit.c
+	$(compile_test)
 
 # Test binaries link their module objects (secondary expansion of DEPS_*).
 .SECONDEXPANSION:
@@ -188,9 +226,9 @@ $(BUILD)/tests/ajar_faults: $(BUILD)/tests/ajar_faults.o $(filter-out $(BUILD)/c
 	@echo "  LD      $@"
 	$(Q)$(CXX) $(LDFLAGS) -o $@ $^ $(LDLIBS)
 
-$(BUILD)/tests/bench: $(BUILD)/tests/bench.o $(BUILD)/libajar.a
+$(BUILD)/tests/bench: $(BUILD)/tests/bench.o $(BUILD)/tests/testutil.o $(BUILD)/libajar.a
 	@echo "  LD      $@"
-	$(Q)$(CXX) $(LDFLAGS) -o $@ $^ $(LDLIBS)
+	$(Q)$(CXX) $(LDFLAGS) -o $@ $^ $(LDLIBS) -lcmocka
 
 $(BUILD)/tests/bench_portals: $(BUILD)/tests/bench_portals.o $(BUILD)/libajar.a
 	@echo "  LD      $@"
@@ -203,8 +241,8 @@ test:
 	$(Q)$(MAKE) --no-print-directory tests
 	$(Q)sh tests/run.sh $(BUILD) $(TESTS)
 
-# Host tests that need no OpenCL device, under ASan + UBSan.
-ASAN_TESTS := test_bsdf test_sampling test_bvh test_lights test_lights_fine test_scene test_exr test_bdpt test_portal test_confine test_punctual test_portal_find
+# Host tests that need no OpenCL device (tests/unit), under ASan + UBSan.
+ASAN_TESTS := $(UNIT_TESTS)
 asan:
 	$(Q)$(MAKE) --no-print-directory deps
 	$(Q)$(MAKE) --no-print-directory MODE=asan $(ASAN_TESTS:%=build/asan/tests/%)
@@ -226,7 +264,7 @@ bench:
 	$(Q)$(MAKE) --no-print-directory all $(BUILD)/tests/bench
 	$(BUILD)/tests/bench
 
-# Found portals against marked ones at equal time (tests/bench_portals.c).
+# Found portals against marked ones at equal time (tests/bench/bench_portals.c).
 bench-portals:
 	$(Q)$(MAKE) --no-print-directory deps
 	$(Q)$(MAKE) --no-print-directory all $(BUILD)/tests/bench_portals
@@ -256,5 +294,10 @@ uninstall:
 
 clean:
 	rm -rf build out
+
+# Where the test sources were before tests/ had folders, as older builds'
+# dependency files still name them: nothing to make, so make rebuilds the
+# objects from where the sources are now instead of stopping.
+$(addprefix tests/,$(notdir $(wildcard tests/*/*.c))):
 
 -include $(shell find build -name '*.d' 2>/dev/null)

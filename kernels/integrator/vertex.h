@@ -82,7 +82,7 @@ typedef union {
 	PathVertex v;
 	uint w[sizeof(PathVertex) / 4];
 } VertexWords;
-/* The host reserves AJAR_SUBPATH_WORDS words a vertex slot (src/device/device.h). */
+/* The host reserves AJAR_SUBPATH_WORDS words a vertex slot (src/device/device_plan.h). */
 typedef char vertex_fits_slot[sizeof(PathVertex) <= 4 * (AJAR_SUBPATH_WORDS) ? 1 : -1];
 #define VSTRIDE ((size_t)(AJAR_SUBPATH_SOA))
 #define VOFF(f) ((size_t)(__builtin_offsetof(PathVertex, f) / 4) * VSTRIDE)

@@ -13,7 +13,7 @@ byte-for-byte the same on every run.
 
     python3 make_sky_scenes.py          # writes ../<variant>/ (glTF and copies)
 
-The sun of each sky is its brightest pixel (SOURCE.md; tests/test_exr.c checks
+The sun of each sky is its brightest pixel (SOURCE.md; tests/unit/test_exr.c checks
 it). Ajar's convention (README, kernels/light/env.h): pixel (x, y) of a W x H
 equirectangular image has u = (x + 0.5) / W, v = (y + 0.5) / H and looks along
     d = (sin v pi sin phi, cos v pi, -sin v pi cos phi),  phi = 2 pi (u - 0.5)

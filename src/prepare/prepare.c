@@ -10,7 +10,6 @@
 #include <string.h>
 #include <time.h>
 
-#include "device/device.h"
 #include "core/error.h"
 #include "prepare/found_portals.h"
 #include "prepare/policy.h"
@@ -57,21 +56,21 @@ static int tri_may_tilt(const Tri *t, const TriShade *sh)
 	return 0;
 }
 
-/* The DEVICE_OMIT_* features that no triangle or material of the prepared
+/* The KERNEL_OMIT_* features that no triangle or material of the prepared
  * scene uses: alpha tests, tilted shading normals (the bend), textures,
  * TriExtra data. Emitters with textures or alpha count as using them. */
 static unsigned kernel_omit(const SceneData *d)
 {
-	unsigned omit = DEVICE_OMIT_ALPHA | DEVICE_OMIT_BENT_NORMALS | DEVICE_OMIT_TRI_EXTRA | DEVICE_OMIT_PANES;
+	unsigned omit = KERNEL_OMIT_ALPHA | KERNEL_OMIT_BENT_NORMALS | KERNEL_OMIT_TRI_EXTRA | KERNEL_OMIT_PANES;
 	for (size_t i = 0; i < d->n_tris; i++) {
 		if (d->tris[i].flags & TRI_ALPHA)
-			omit &= ~DEVICE_OMIT_ALPHA;
+			omit &= ~KERNEL_OMIT_ALPHA;
 		if (d->tris[i].flags & TRI_PANE)
-			omit &= ~DEVICE_OMIT_PANES;
+			omit &= ~KERNEL_OMIT_PANES;
 		if (d->tris[i].flags & (TRI_EXTRA | TRI_TANGENT))
-			omit &= ~DEVICE_OMIT_TRI_EXTRA;
-		if ((omit & DEVICE_OMIT_BENT_NORMALS) && tri_may_tilt(&d->tris[i], &d->shade[i]))
-			omit &= ~DEVICE_OMIT_BENT_NORMALS;
+			omit &= ~KERNEL_OMIT_TRI_EXTRA;
+		if ((omit & KERNEL_OMIT_BENT_NORMALS) && tri_may_tilt(&d->tris[i], &d->shade[i]))
+			omit &= ~KERNEL_OMIT_BENT_NORMALS;
 	}
 	int textured = 0;
 	for (size_t i = 0; i < d->n_materials; i++) {
@@ -79,7 +78,7 @@ static unsigned kernel_omit(const SceneData *d)
 		textured |= m->base_tex >= 0 || m->mr_tex || m->emissive_tex || m->normal_tex || m->transmission_tex;
 	}
 	if (!textured)
-		omit |= DEVICE_OMIT_TEXTURES;
+		omit |= KERNEL_OMIT_TEXTURES;
 	return omit;
 }
 

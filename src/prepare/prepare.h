@@ -8,6 +8,16 @@
 #include "prepare/portal_find.h"
 #include "scene/scene.h"
 
+/* Scene features render_pass can be built without (kernel specialisation,
+ * kernels/materials.md "Feature-specialised programs"): prepare_scene says
+ * which a scene lacks (kernel_omit); device_render_options makes each a -D
+ * option, and the cache keys on it. */
+#define KERNEL_OMIT_ALPHA 1u        /* -DAJAR_NO_ALPHA: no TRI_ALPHA triangle */
+#define KERNEL_OMIT_BENT_NORMALS 2u /* -DAJAR_NO_BENT_NORMALS: no shading normal tilted from ng, no normal map */
+#define KERNEL_OMIT_TEXTURES 4u     /* -DAJAR_NO_TEXTURES: no material reads a texture */
+#define KERNEL_OMIT_TRI_EXTRA 8u    /* -DAJAR_NO_TRI_EXTRA: no TRI_EXTRA triangle (TEXCOORD_1, COLOR_0, tangents) */
+#define KERNEL_OMIT_PANES 16u       /* -DAJAR_NO_PANES: no TRI_PANE triangle (thin glass that rays cross) */
+
 typedef struct {
 #define AJAR_DATA_FIELD(type, name) type *name; size_t n_##name;
 	AJAR_SCENE_BUFFERS(AJAR_DATA_FIELD)
@@ -20,7 +30,7 @@ typedef struct {
 	int portal_source;       /* POLICY_PORTALS_*: where the portals came from */
 	PortalSearch found;      /* the search's portals and cost, where they were found */
 	V3 bmin, bmax;
-	unsigned kernel_omit; /* DEVICE_OMIT_* (device.h): features no triangle or material uses */
+	unsigned kernel_omit; /* KERNEL_OMIT_*: features no triangle or material uses */
 } SceneData;
 
 /* Prepares s for a width x height image rendered with the options o

@@ -1,6 +1,6 @@
 /* checkpoint_file.h — the file a render can be continued from: its films as
  * integer sums, the sample ranges they hold, the options and hashes of the
- * prepared scene and of the render parameters (checkpoint.c).
+ * prepared scene and of the render parameters (checkpoint_file.c).
  *
  * render_checkpoint.c gathers and applies the state; this module only writes the file
  * atomically (temporary name, fsync, rename: a failed write keeps the

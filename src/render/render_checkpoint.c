@@ -1,37 +1,24 @@
-/* render_checkpoint.c — the renderer's side of checkpoints (checkpoint.c
- * holds the file format). A checkpoint holds the reduced integer films and
- * the sample ranges they hold. Resumed, the films become the salvage (the host part every image
- * adds), the ranges the base, and the gaps below the highest range go back
- * to the pool, so the continued render hands out exactly the sample indices
- * an uninterrupted one would have: the sums, and so the image, are the same
- * bits. The scene hash covers the prepared arrays (what the kernels read:
- * geometry, materials, textures, environment, light tables), the params
- * hash the kernels' parameters (options and derived rates). */
+/* render_checkpoint.c — the renderer's side of checkpoints
+ * (checkpoint_file.c holds the file format): writing one, also during a
+ * render, and resuming one, also as a job of several ranks. A checkpoint
+ * holds the reduced integer films and the sample ranges they hold, with
+ * the hashes of the prepared scene and of the render parameters
+ * (render_state.c). Resumed, the films become the salvage (the host part
+ * every image adds), the ranges the base, and the gaps below the highest
+ * range go back to the pool, so the continued render hands out exactly the
+ * sample indices an uninterrupted one would have: the sums, and so the
+ * image, are the same bits. */
+#include "render/render_checkpoint.h"
+
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/checkpoint_file.h"
-#include "render/cluster.h"
 #include "core/error.h"
-#include "render/render_internal.h"
-
-void render_ensure_hashes(ajar_renderer *r)
-{
-	if (r->hashed)
-		return;
-	const SceneData *d = &r->data;
-	uint64_t h = 0;
-#define AJAR_HASH_FIELD(type, name) \
-	if ((void *)d->name != (void *)d->params) \
-		h = checkpoint_hash(h, d->name, sizeof(type) * d->n_##name);
-	AJAR_SCENE_BUFFERS(AJAR_HASH_FIELD)
-#undef AJAR_HASH_FIELD
-	r->scene_hash = h;
-	r->params_hash = checkpoint_hash(0, d->params, sizeof *d->params);
-	r->hashed = 1;
-}
+#include "render/cluster.h"
+#include "render/render_film.h"
+#include "render/render_job.h"
 
 static int range_before(const void *a, const void *b)
 {
@@ -44,7 +31,7 @@ static int range_before(const void *a, const void *b)
 static ajar_status checkpoint_gather(ajar_renderer *r, Checkpoint *c)
 {
 	memset(c, 0, sizeof *c);
-	ajar_status st = render_reduce(r);
+	ajar_status st = film_reduce(r);
 	if (st != AJAR_OK)
 		return st;
 	render_ensure_hashes(r);
@@ -101,9 +88,9 @@ static ajar_status checkpoint_gather(ajar_renderer *r, Checkpoint *c)
 	c->film[CKPT_ACCUM] = r->film;
 	c->nfilm[CKPT_ACCUM] = 3 * (size_t)r->width * r->height;
 	c->film[CKPT_SPLAT] = r->film_splat;
-	c->nfilm[CKPT_SPLAT] = render_aov_offset(r);
-	c->film[CKPT_AOV] = r->film_splat + render_aov_offset(r);
-	c->nfilm[CKPT_AOV] = render_splat_count(r) - render_aov_offset(r);
+	c->nfilm[CKPT_SPLAT] = film_aov_offset(r);
+	c->film[CKPT_AOV] = r->film_splat + film_aov_offset(r);
+	c->nfilm[CKPT_AOV] = film_splat_count(r) - film_aov_offset(r);
 	return AJAR_OK;
 }
 
@@ -168,7 +155,7 @@ ajar_status ajar_renderer_set_checkpoint(ajar_renderer *r, const char *path, dou
 	return AJAR_OK;
 }
 
-void options_from_checkpoint(const Checkpoint *c, ajar_options *o)
+static void options_from_checkpoint(const Checkpoint *c, ajar_options *o)
 {
 	ajar_options_default(o);
 	o->width = c->width;
@@ -223,13 +210,13 @@ ajar_status render_checkpoint_check(ajar_renderer *r, const Checkpoint *c, const
 
 ajar_status render_checkpoint_apply(ajar_renderer *r, Checkpoint *c, const char *path)
 {
-	size_t n = 3 * (size_t)r->width * r->height, ns = render_aov_offset(r);
-	if (c->nfilm[CKPT_ACCUM] != n || c->nfilm[CKPT_SPLAT] != ns || c->nfilm[CKPT_AOV] != render_splat_count(r) - ns)
+	size_t n = 3 * (size_t)r->width * r->height, ns = film_aov_offset(r);
+	if (c->nfilm[CKPT_ACCUM] != n || c->nfilm[CKPT_SPLAT] != ns || c->nfilm[CKPT_AOV] != film_splat_count(r) - ns)
 		return err_set(AJAR_ERROR_BAD_INPUT, "%s: checkpoint is corrupted (film sizes)", path);
-	long *splat = realloc(c->film[CKPT_SPLAT], sizeof *splat * (render_splat_count(r) ? render_splat_count(r) : 1));
+	long *splat = realloc(c->film[CKPT_SPLAT], sizeof *splat * (film_splat_count(r) ? film_splat_count(r) : 1));
 	if (!splat)
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory");
-	memcpy(splat + ns, c->film[CKPT_AOV], sizeof *splat * (render_splat_count(r) - ns));
+	memcpy(splat + ns, c->film[CKPT_AOV], sizeof *splat * (film_splat_count(r) - ns));
 	c->film[CKPT_SPLAT] = splat;
 	uint32_t end = 0;
 	uint64_t done = 0;
@@ -256,35 +243,10 @@ ajar_status render_checkpoint_apply(ajar_renderer *r, Checkpoint *c, const char 
 	return AJAR_OK;
 }
 
-ajar_status ajar_renderer_resume(const ajar_scene *scene, const char *path, const ajar_options *o,
-				 ajar_renderer **out)
-{
-	if (!out)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_resume: out is NULL");
-	*out = NULL;
-	if (!scene || !path)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_renderer_resume: NULL argument");
-	if (cluster_size() > 1)
-		return job_resume(scene, path, o, out);
-	Checkpoint c;
-	ajar_status st = checkpoint_read(path, &c, 0);
-	if (st != AJAR_OK)
-		return st;
-	ajar_options want;
-	options_from_checkpoint(&c, &want);
-	if ((st = resume_options(&want, o, path)) != AJAR_OK) {
-		checkpoint_free(&c);
-		return st;
-	}
-	st = renderer_new(scene, &want, NULL, &c, path, out);
-	checkpoint_free(&c);
-	return st;
-}
-
 /* The options of a resumed render: the checkpoint's (want), with the
  * budget and the devices of o if o is not NULL; anything else in o must
  * agree with the checkpoint. */
-ajar_status resume_options(ajar_options *want, const ajar_options *o, const char *path)
+static ajar_status resume_options(ajar_options *want, const ajar_options *o, const char *path)
 {
 	if (o) {
 		/* Only the budget and the devices may change. */
@@ -308,5 +270,46 @@ ajar_status resume_options(ajar_options *want, const ajar_options *o, const char
 		want->time_limit = o->time_limit;
 		want->device = o->device;
 	}
+	return AJAR_OK;
+}
+
+ajar_status render_checkpoint_read(const char *path, const ajar_options *o, ajar_options *want, Checkpoint *c,
+				   int *have)
+{
+	ajar_status st = AJAR_OK;
+	*have = 0;
+	if (cluster_size() <= 1) {
+		if ((st = checkpoint_read(path, c, 0)) != AJAR_OK)
+			return st;
+		*have = 1;
+		options_from_checkpoint(c, want);
+		return resume_options(want, o, path);
+	}
+	/* A job: rank 0 reads the file, the other ranks receive its options
+	 * (they need no copy of the file). */
+	struct {
+		int32_t status;
+		char error[1024];
+		ajar_options want;
+	} msg;
+	memset(&msg, 0, sizeof msg);
+	if (cluster_rank() == 0) {
+		st = checkpoint_read(path, c, 0);
+		*have = st == AJAR_OK;
+		if (*have) {
+			options_from_checkpoint(c, &msg.want);
+			st = resume_options(&msg.want, o, path);
+		}
+		msg.status = (int32_t)st;
+		if (st != AJAR_OK)
+			snprintf(msg.error, sizeof msg.error, "%s", ajar_last_error());
+		msg.want.device = NULL;
+	}
+	if (cluster_bcast(&msg, sizeof msg, NULL) != 1)
+		return AJAR_ERROR_DEVICE;
+	msg.want.device = o ? o->device : NULL;
+	*want = msg.want;
+	if (msg.status != AJAR_OK)
+		return cluster_rank() == 0 ? st : err_set((ajar_status)msg.status, "rank 0: %s", msg.error);
 	return AJAR_OK;
 }

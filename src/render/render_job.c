@@ -4,17 +4,21 @@
  * rank of a failure anywhere). Rank 0 adds one device per device of the
  * other ranks to its scheduler, each driven by a proxy thread
  * (job_proxy_thread) that takes ranges with scheduler_take_range like a
- * device thread, sends them to that rank and counts them done when the answer comes: the dealing by measured
- * speed, the time limit, cancels, checkpoints and device failures are rank
- * 0's, exactly as for its own devices. The other ranks serve (job_serve):
- * they render the ranges they are sent, and on a gather (at a checkpoint
- * and at the end) sum their films into rank 0's `remote` films with an MPI
- * reduction. Every sum is of integers, so the image is the same bits as
- * one process that rendered the same sample indices. A device that fails
- * on another rank is dropped like a local one (that rank keeps its film
- * when it can, as the salvage does here). A rank that stops answering
- * (killed; mpirun then stops the whole job) cannot be summed: the render
- * ends with an error and nothing but the last checkpoint is kept. */
+ * device thread, sends them to that rank and counts them done when the
+ * answer comes: the dealing by measured speed, the time limit, cancels,
+ * checkpoints and device failures are rank 0's, exactly as for its own
+ * devices. The other ranks serve (job_serve): they render the ranges they
+ * are sent, and on a gather (at a checkpoint and at the end) sum their
+ * films into rank 0's `remote` films with an MPI reduction. Every sum is
+ * of integers, so the image is the same bits as one process that rendered
+ * the same sample indices. A device that fails on another rank is dropped
+ * like a local one (that rank keeps its film when it can, as the salvage
+ * does here). A rank that stops answering (killed; mpirun then stops the
+ * whole job) cannot be summed: the render ends with an error and nothing
+ * but the last checkpoint is kept. A resumed job reads its checkpoint in
+ * render_checkpoint.c. */
+#include "render/render_job.h"
+
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -22,10 +26,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/checkpoint_file.h"
-#include "render/cluster.h"
 #include "core/error.h"
-#include "render/render_internal.h"
+#include "render/cluster.h"
+#include "render/render_device.h"
+#include "render/render_film.h"
+#include "render/render_scheduler.h"
 
 enum { JOB_PASS = 1, JOB_GATHER, JOB_END };
 /* TAG_PASS, TAG_DONE and TAG_WHY + the device's index on its rank */
@@ -57,6 +62,40 @@ typedef struct {
 	char name[MAX_RENDER_DEVICES][256];
 	char selector[MAX_RENDER_DEVICES][16];
 } JobHello;
+
+/* Rank 0 deals to every device of every rank: the other ranks' devices
+ * join r->devs, each driven by a proxy thread, and every name says its rank. */
+static ajar_status add_remote_devices(ajar_renderer *r, const JobHello *all, int size)
+{
+	uint32_t total = r->ndev;
+	for (int k = 1; k < size; k++)
+		total += all[k].ndev;
+	RenderDevice *devs = realloc(r->devs, sizeof *devs * total);
+	if (!devs)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory");
+	r->devs = devs;
+	memset(devs + r->ndev, 0, sizeof *devs * (total - r->ndev));
+	size_t len = 0;
+	for (uint32_t i = 0; i < r->ndev; i++) {
+		snprintf(devs[i].dev.selector, sizeof devs[i].dev.selector, "rank 0, %s", all[0].selector[i]);
+		len += (size_t)snprintf(r->device_names + len, sizeof r->device_names - len, "%s%s (%s)",
+					i ? " + " : "", devs[i].dev.name, devs[i].dev.selector);
+	}
+	for (int k = 1; k < size; k++)
+		for (uint32_t j = 0; j < all[k].ndev; j++) {
+			RenderDevice *rd = &devs[r->ndev++];
+			rd->r = r;
+			rd->alive = 1;
+			rd->rank = k;
+			rd->remote = j;
+			snprintf(rd->dev.name, sizeof rd->dev.name, "%s", all[k].name[j]);
+			snprintf(rd->dev.selector, sizeof rd->dev.selector, "rank %d, %s", k % 100000, all[k].selector[j]);
+			if (len < sizeof r->device_names)
+				len += (size_t)snprintf(r->device_names + len, sizeof r->device_names - len, " + %s (%s)",
+							rd->dev.name, rd->dev.selector);
+		}
+	return AJAR_OK;
+}
 
 ajar_status job_join(ajar_renderer *r, ajar_status st)
 {
@@ -96,81 +135,48 @@ ajar_status job_join(ajar_renderer *r, ajar_status st)
 				     "rank %d (%s) prepared another scene or other options than rank 0 (%s): every rank "
 				     "must read the same scene files with the same options",
 				     k, all[k].host, all[0].host);
-	uint32_t total = r->ndev;
-	for (int k = 1; k < size; k++)
-		total += all[k].ndev;
-	RenderDevice *devs = st == AJAR_OK && me == 0 ? realloc(r->devs, sizeof *devs * total) : NULL;
-	if (st == AJAR_OK && me == 0 && !devs)
-		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "out of memory");
-	if (st == AJAR_OK && me == 0) {
-		/* Rank 0 deals to every device of every rank. */
-		r->devs = devs;
-		memset(devs + r->ndev, 0, sizeof *devs * (total - r->ndev));
-		size_t len = 0;
-		for (uint32_t i = 0; i < r->ndev; i++) {
-			snprintf(devs[i].dev.selector, sizeof devs[i].dev.selector, "rank 0, %s", all[0].selector[i]);
-			len += (size_t)snprintf(r->device_names + len, sizeof r->device_names - len, "%s%s (%s)",
-						i ? " + " : "", devs[i].dev.name, devs[i].dev.selector);
-		}
-		for (int k = 1; k < size; k++)
-			for (uint32_t j = 0; j < all[k].ndev; j++) {
-				RenderDevice *rd = &devs[r->ndev++];
-				rd->r = r;
-				rd->alive = 1;
-				rd->rank = k;
-				rd->remote = j;
-				snprintf(rd->dev.name, sizeof rd->dev.name, "%s", all[k].name[j]);
-				snprintf(rd->dev.selector, sizeof rd->dev.selector, "rank %d, %s", k % 100000, all[k].selector[j]);
-				if (len < sizeof r->device_names)
-					len += (size_t)snprintf(r->device_names + len, sizeof r->device_names - len, " + %s (%s)",
-								rd->dev.name, rd->dev.selector);
-			}
-	}
+	if (st == AJAR_OK && me == 0)
+		st = add_remote_devices(r, all, size);
 	free(all);
 	return st;
 }
 
-/* Rank 0: the options of a resumed job come from the checkpoint, read
- * here only; the other ranks receive them (they need no copy of the file). */
-ajar_status job_resume(const ajar_scene *scene, const char *path, const ajar_options *o,
-		       ajar_renderer **out)
+/* Rank 0, under the lock (left while it receives): range g of rd came back
+ * failed (rc 1, with the device's answer d) or not at all (rc from
+ * cluster_recv: the rank stopped answering). rd is dropped, and the nq
+ * ranges queued behind g there come back unrendered. */
+static void proxy_drop(ajar_renderer *r, RenderDevice *rd, Range g, const Range *q, int nq, int rc, JobDone *d)
 {
-	struct {
-		int32_t status;
-		char error[1024];
-		ajar_options want;
-	} msg;
-	memset(&msg, 0, sizeof msg);
-	Checkpoint c;
-	int have = 0;
-	ajar_status st = AJAR_OK;
-	if (cluster_rank() == 0) {
-		st = checkpoint_read(path, &c, 0);
-		have = st == AJAR_OK;
-		if (have) {
-			options_from_checkpoint(&c, &msg.want);
-			st = resume_options(&msg.want, o, path);
-		}
-		msg.status = (int32_t)st;
-		if (st != AJAR_OK)
-			snprintf(msg.error, sizeof msg.error, "%s", ajar_last_error());
-		msg.want.device = NULL;
+	int tag_done = TAG_DONE + (int)rd->remote, tag_why = TAG_WHY + (int)rd->remote;
+	if (rc == 1) {
+		JobWhy why = {"?"};
+		pthread_mutex_unlock(&r->lock);
+		rc = cluster_recv(rd->rank, tag_why, &why, sizeof why, NULL, NULL, &r->cancel);
+		pthread_mutex_lock(&r->lock);
+		why.text[sizeof why.text - 1] = '\0';
+		snprintf(rd->error, sizeof rd->error, "%s", why.text);
 	}
-	if (cluster_bcast(&msg, sizeof msg, NULL) != 1) {
-		if (have)
-			checkpoint_free(&c);
-		return AJAR_ERROR_DEVICE;
+	if (rc != 1) {
+		snprintf(rd->error, sizeof rd->error, "rank %d stopped answering%s%s", rd->rank,
+			 rc < 0 ? ": " : " (killed, or its machine failed)", rc < 0 ? ajar_last_error() : "");
+		if (!r->job_lost)
+			r->job_lost = rd->rank;
 	}
-	msg.want.device = o ? o->device : NULL;
-	if (msg.status != AJAR_OK) {
-		if (have)
-			checkpoint_free(&c);
-		return cluster_rank() == 0 ? st : err_set((ajar_status)msg.status, "rank 0: %s", msg.error);
+	scheduler_drop_device(r, rd, g, NULL, NULL, rc == 1 && d->kept);
+	for (int k = 0; k < nq; k++) { /* queued there, never rendered */
+		if (!range_list_push(&r->holes, q[k]))
+			r->out_of_memory = 1;
+		r->in_flight--;
 	}
-	st = renderer_new(scene, &msg.want, NULL, have ? &c : NULL, have ? path : NULL, out);
-	if (have)
-		checkpoint_free(&c);
-	return st;
+	if (rc == 1 && nq) { /* their answers, so no message is left behind */
+		pthread_mutex_unlock(&r->lock);
+		JobWhy why;
+		for (int k = 0; k < nq; k++)
+			if (cluster_recv(rd->rank, tag_done, d, sizeof *d, NULL, NULL, &r->cancel) == 1 && !d->ok)
+				cluster_recv(rd->rank, tag_why, &why, sizeof why, NULL, NULL, &r->cancel);
+		pthread_mutex_lock(&r->lock);
+	}
+	pthread_cond_broadcast(&r->cond);
 }
 
 /* Rank 0: the thread of a device of another rank. It keeps two ranges
@@ -187,8 +193,7 @@ void *job_proxy_thread(void *arg)
 	ajar_renderer *r = rd->r;
 	Range q[PIPELINE];
 	double sent[PIPELINE], last = 0;
-	int nq = 0, tag_pass = TAG_PASS + (int)rd->remote, tag_done = TAG_DONE + (int)rd->remote,
-	    tag_why = TAG_WHY + (int)rd->remote;
+	int nq = 0, tag_pass = TAG_PASS + (int)rd->remote, tag_done = TAG_DONE + (int)rd->remote;
 	pthread_mutex_lock(&r->lock);
 	for (;;) {
 		int lost = 0;
@@ -220,12 +225,7 @@ void *job_proxy_thread(void *arg)
 		r->in_flight--;
 		r->events++;
 		if (rc == 1 && d.ok) {
-			if (!range_list_push(&rd->done, g))
-				r->out_of_memory = 1;
-			rd->spp_kept += g.count;
-			rd->busy_seconds += t - start;
-			rd->per_spp = (t - start) / g.count;
-			r->spp_done += g.count;
+			scheduler_range_done(r, rd, g, t - start);
 			if (d.idle >= 0) {
 				rd->job_ranges++;
 				rd->job_idle += d.idle;
@@ -234,35 +234,7 @@ void *job_proxy_thread(void *arg)
 			pthread_cond_broadcast(&r->cond);
 			continue;
 		}
-		if (rc == 1) {
-			JobWhy why = {"?"};
-			pthread_mutex_unlock(&r->lock);
-			rc = cluster_recv(rd->rank, tag_why, &why, sizeof why, NULL, NULL, &r->cancel);
-			pthread_mutex_lock(&r->lock);
-			why.text[sizeof why.text - 1] = '\0';
-			snprintf(rd->error, sizeof rd->error, "%s", why.text);
-		}
-		if (rc != 1) {
-			snprintf(rd->error, sizeof rd->error, "rank %d stopped answering%s%s", rd->rank,
-				 rc < 0 ? ": " : " (killed, or its machine failed)", rc < 0 ? ajar_last_error() : "");
-			if (!r->job_lost)
-				r->job_lost = rd->rank;
-		}
-		render_drop_device(r, rd, g, NULL, NULL, rc == 1 && d.kept);
-		for (int k = 0; k < nq; k++) { /* queued there, never rendered */
-			if (!range_list_push(&r->holes, q[k]))
-				r->out_of_memory = 1;
-			r->in_flight--;
-		}
-		if (rc == 1 && nq) { /* their answers, so no message is left behind */
-			pthread_mutex_unlock(&r->lock);
-			JobWhy why;
-			for (int k = 0; k < nq; k++)
-				if (cluster_recv(rd->rank, tag_done, &d, sizeof d, NULL, NULL, &r->cancel) == 1 && !d.ok)
-					cluster_recv(rd->rank, tag_why, &why, sizeof why, NULL, NULL, &r->cancel);
-			pthread_mutex_lock(&r->lock);
-		}
-		pthread_cond_broadcast(&r->cond);
+		proxy_drop(r, rd, g, q, nq, rc, &d);
 		break;
 	}
 	r->running--;
@@ -274,7 +246,7 @@ void *job_proxy_thread(void *arg)
 /* Rank 0: the other ranks' films summed into r->remote. */
 ajar_status job_gather(ajar_renderer *r)
 {
-	size_t n = 3 * (size_t)r->width * r->height, ns = render_splat_count(r);
+	size_t n = 3 * (size_t)r->width * r->height, ns = film_splat_count(r);
 	if (!r->remote) {
 		r->remote = calloc(n ? n : 1, sizeof *r->remote);
 		r->remote_splat = calloc(ns ? ns : 1, sizeof *r->remote_splat);
@@ -370,19 +342,19 @@ static void *job_device_thread(void *arg)
 		int film_ok = 0;
 		double t0 = render_seconds();
 		d.idle = ended < 0 ? -1.0 : t0 - ended;
-		d.ok = rd->alive && render_run_pass(rd, g, &film_ok);
+		d.ok = rd->alive && render_device_pass(rd, g, &film_ok);
 		ended = render_seconds();
 		long *accum = NULL, *splat = NULL;
 		if (!d.ok && rd->alive) {
 			if (film_ok)
-				render_read_films(rd, &accum, &splat);
+				film_read(rd, &accum, &splat);
 			snprintf(why.text, sizeof why.text, "%s", rd->error);
 		} else if (!d.ok) {
 			snprintf(why.text, sizeof why.text, "device %d of rank %d was dropped before", index, cluster_rank());
 		}
 		if (!d.ok && rd->alive) {
 			pthread_mutex_lock(&r->lock);
-			d.kept = accum && render_salvage_add(r, accum, splat);
+			d.kept = accum && film_salvage_add(r, accum, splat);
 			rd->alive = 0; /* its film is in the salvage, or lost: rank 0 renders those ranges again */
 			pthread_mutex_unlock(&r->lock);
 		}
@@ -419,10 +391,10 @@ ajar_status job_serve(ajar_renderer *r)
 		}
 		if (c.op == JOB_GATHER) {
 			/* Rank 0 gathers only while no pass is in flight anywhere. */
-			size_t n = 3 * (size_t)r->width * r->height, ns = render_splat_count(r);
+			size_t n = 3 * (size_t)r->width * r->height, ns = film_splat_count(r);
 			JobDone d = {1, 0, -1.0};
 			JobWhy why = {""};
-			if (render_reduce(r) != AJAR_OK) {
+			if (film_reduce(r) != AJAR_OK) {
 				d.ok = 0;
 				snprintf(why.text, sizeof why.text, "%s", ajar_last_error());
 				memset(r->film, 0, n * sizeof *r->film);

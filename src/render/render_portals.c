@@ -2,7 +2,7 @@
  * (ajar_renderer_found_portals), for reports and `ajar render --portals-out`. */
 #include "core/error.h"
 #include "prepare/found_portals.h"
-#include "render/render_internal.h"
+#include "render/render_state.h"
 
 ajar_status ajar_renderer_found_portals(const ajar_renderer *r, ajar_portal *out, uint32_t capacity, uint32_t *count,
 					double *seconds)

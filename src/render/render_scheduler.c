@@ -1,13 +1,21 @@
 /* render_scheduler.c — which device renders which sample range: every
  * idle device takes the next range (the holes first), sized so a pass
- * takes about PASS_SECONDS at that device's measured speed, and near the
- * end of a fixed-count render the rest is split by the devices' speeds.
- * Device threads (render.c) and the other ranks' proxies (render_job.c)
- * call it alike, all under r->lock. */
+ * takes about PASS_SECONDS at that device's measured speed (the first pass
+ * is one sample: it also pays PoCL's work-group compile), and near the end
+ * of a fixed-count render the rest is split by the devices' speeds, so no
+ * device holds the render back by more than one pass. It keeps the ledger
+ * of which ranges each device's film holds: a dropped device's range goes
+ * back to the pool, and so do its completed ranges unless its film was
+ * kept; every range covers all pixels, so the image is always the exact
+ * mean of the sample indices it holds. Device threads (render_loop.c) and
+ * the other ranks' proxies (render_job.c) call it alike, all under
+ * r->lock. */
+#include "render/render_scheduler.h"
+
 #include <math.h>
 #include <stdatomic.h>
 
-#include "render/render_internal.h"
+#include "render/render_film.h"
 #include "render/render_overrides.h"
 
 #define PASS_SECONDS 0.25
@@ -17,7 +25,6 @@ double scheduler_time_left(const ajar_renderer *r)
 	return r->time_limit > 0 ? r->time_limit - (render_seconds() - r->t0) : 1e30;
 }
 
-/* Sample indices not yet handed out (UINT64_MAX: no sample target). */
 uint64_t scheduler_work_left(const ajar_renderer *r)
 {
 	uint64_t n = r->spp_target ? r->spp_target - r->next_first : UINT64_MAX;
@@ -26,13 +33,11 @@ uint64_t scheduler_work_left(const ajar_renderer *r)
 	return n;
 }
 
-/* The stop conditions other than running out of work. */
 int scheduler_stopping(const ajar_renderer *r)
 {
 	return atomic_load(&r->cancel) || r->out_of_memory || r->job_lost || scheduler_time_left(r) <= 0;
 }
 
-/* The next range for device rd, or 0 if there is none now. */
 int scheduler_take_range(ajar_renderer *r, RenderDevice *rd, Range *g)
 {
 	uint64_t left = scheduler_work_left(r);
@@ -73,4 +78,32 @@ int scheduler_take_range(ajar_renderer *r, RenderDevice *rd, Range *g)
 	g->count = count;
 	r->next_first += count;
 	return 1;
+}
+
+void scheduler_range_done(ajar_renderer *r, RenderDevice *rd, Range g, double seconds)
+{
+	if (!range_list_push(&rd->done, g))
+		r->out_of_memory = 1;
+	rd->spp_kept += g.count;
+	rd->busy_seconds += seconds;
+	rd->per_spp = seconds / g.count;
+	r->spp_done += g.count;
+}
+
+void scheduler_drop_device(ajar_renderer *r, RenderDevice *rd, Range g, const long *accum, const long *splat,
+			   int kept_there)
+{
+	int kept = kept_there || (accum && film_salvage_add(r, accum, splat));
+	rd->alive = 0;
+	r->last_dropped = rd;
+	if (!range_list_push(&r->holes, g))
+		r->out_of_memory = 1;
+	if (!kept) {
+		for (size_t i = 0; i < rd->done.n; i++)
+			if (!range_list_push(&r->holes, rd->done.r[i]))
+				r->out_of_memory = 1;
+		r->spp_done -= (uint32_t)rd->spp_kept;
+		rd->spp_kept = 0;
+		rd->done.n = 0;
+	}
 }

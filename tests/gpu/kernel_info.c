@@ -9,7 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "device/device.h"
+#include "device/device_build.h"
+#include "device/device_plan.h"
 #include "device/kernel_source.h"
 
 int main(int argc, char **argv)

@@ -7,7 +7,7 @@ each in its own process; then the image mean against the reference's and
 the relative MSE against it, with the reference's own noise subtracted
 (relMSE(X, R) ~ relMSE_true(X) + relMSE(R)) and normalised to the nominal
 time (relMSE x t_actual / T: variance falls as 1/time for unbiased
-renderers). relMSE is tests/bench.c's formula (images.rel_mse).
+renderers). relMSE is tests/bench/bench.c's formula (images.rel_mse).
 
 Environment: PEERS_SECONDS (20), PEERS_SCENES ("window-room living-room
 door-ajar"; cornell also works, and "sky" names the sky- and lamp-lit scenes
@@ -374,7 +374,7 @@ def bench_scene(name, seconds, size_spec, depth, ref_seconds, renderers, rows):
 
 def table(rows, seconds, size_spec, depth, refs):
 	out = [f"Equal time {seconds:g} s per render, image width {size_spec}, max depth {depth}, "
-	       f"{env_threads()} thread{'' if env_threads() == 1 else 's'} each. relMSE is tests/bench.c's (mean over pixels and channels of "
+	       f"{env_threads()} thread{'' if env_threads() == 1 else 's'} each. relMSE is tests/bench/bench.c's (mean over pixels and channels of "
 	       "(x - r)^2 / (r^2 + (0.1 mean r)^2)), minus the reference's own noise, times t/T. "
 	       "ratio = relMSE / relMSE of ajar-portal (above 1: Ajar's portal integrator is better).", ""]
 	for name, ri in refs.items():

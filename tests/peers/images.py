@@ -2,7 +2,7 @@
 benchmark.
 
 EXR files are read and written with Mitsuba's Bitmap (its core needs no
-variant), so no other EXR package is needed. rel_mse is tests/bench.c's
+variant), so no other EXR package is needed. rel_mse is tests/bench/bench.c's
 formula exactly: the mean over pixels and the three channels of
 (a - b)^2 / (b^2 + eps), eps = (0.1 mean(b))^2, mean(b) over pixels and
 channels, so dark pixels are not judged by absolute error alone.
@@ -49,7 +49,7 @@ def write_png(path, rgb, exposure=0.0):
 
 
 def rel_mse(a, b, mean_b=None):
-	"""tests/bench.c's rel_mse (see the module comment)."""
+	"""tests/bench/bench.c's rel_mse (see the module comment)."""
 	if mean_b is None:
 		mean_b = float(np.mean(b))
 	eps = 0.01 * mean_b * mean_b
@@ -57,7 +57,7 @@ def rel_mse(a, b, mean_b=None):
 
 
 def reference_noise(r1, r2, mean):
-	"""relMSE of R = (R1 + R2) / 2 against the truth, estimated as tests/bench.c
+	"""relMSE of R = (R1 + R2) / 2 against the truth, estimated as tests/bench/bench.c
 	does: E|R1 - R2|^2 / 4 is the variance of R, over R^2 + eps."""
 	r = 0.5 * (r1 + r2)
 	return float(np.mean((r2 - r1) ** 2 / 4.0 / (r * r + 0.01 * mean * mean)))

@@ -5,7 +5,7 @@ A path sample's cost is mostly its ray queries (kernels/README.md, "Cost"), so t
 compares the two tracers alone: closest-hit rays per second for 2^20
 incoherent rays (origins uniform in the scene's bounds, directions uniform on
 the sphere), one thread each, on the same core. Ajar's figure is
-tests/bench.c's `trace_closest` kernel (AJAR_BENCH_FILES); Embree's is
+tests/bench/bench.c's `trace_closest` kernel (AJAR_BENCH_FILES); Embree's is
 Mitsuba 3's `ray_intersect_preliminary` (its llvm_ad_rgb variant traces with
 the Embree it bundles), on the same triangles and the same distribution of
 rays. Runs alternate so the machine's drift reaches both; the best of each

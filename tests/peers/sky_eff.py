@@ -10,7 +10,7 @@ renders seeds 1 and 2 (or seeds=A,B) at 64 x 64 with one PoCL thread (depth=N: a
 --mis NAME), and prints spp, the
 relative variance of one render (mean over pixels and channels of
 (a - b)^2 / 2 / (r^2 + (0.1 mean r)^2), r the two seeds' mean, the error
-measure of tests/bench.c without a reference), relvar x spp (the variance
+measure of tests/bench/bench.c without a reference), relvar x spp (the variance
 per sample), the CPU seconds per sample (user + system of the render minus
 that of a 1-spp render: set-up left out) and their product, the
 inefficiency (lower is better; relMSE at equal CPU time is proportional to
