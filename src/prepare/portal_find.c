@@ -65,16 +65,16 @@
 #define ROOM_SEES 3
 #define ROOM_RAYS 65536    /* step 2, over all room points */
 #define MAX_CANDIDATES 2048
-#define FOCUS_TARGET 96   /* crossings an opening should have */
-#define FOCUS_RAYS 4      /* aimed rays per crossing wanted */
+#define FOCUS_TARGET 96    /* crossings a place (and direction) should have */
+#define FOCUS_NEAR 0.05f   /* x R: a place's radius */
+#define FOCUS_MAX 32768    /* aimed rays a round at most */
 #define LIGHT_POINTS 64    /* light samples of emitters and lamps */
+#define BOUNCE_POINTS 64   /* and of what they light */
 #define RING_DIRS 8        /* step 3 */
 #define RING_NEED 7
 #define RING_NEAR 0.85f
 #define RING_NORMALS 16    /* hit normals kept per crossing */
 #define NEAR_START 0.1f    /* x R: crossings nearer their start are left out */
-#define JOIN_COS 0.906f    /* step 4: cos 25 degrees */
-#define JOIN_DIST 0.1f     /* x R */
 #define MAX_PLANES 32      /* step 5: surfaces around the holes tried */
 #define PATCH_CELL 0.01f   /* x R: cells of the crossings' raster on a plane */
 #define PATCH_JOIN 3       /* crossings this many cells apart join one patch */
@@ -82,11 +82,18 @@
 #define PATCH_MAX 384      /* at most this many a side */
 #define PATCH_DN 0.3f      /* lines that cross a plane at a shallower cosine do not count there */
 #define MAX_ROUNDS 32
+#define RUNNER_UP 0.5      /* a patch on another plane this close to the best is tried too */
 #define MEET_DN 0.05f      /* a line crossing a portal at a shallower cosine does not count */
 #define PLANE_OFFSET 1e-3f /* x R: a portal lies this far beyond the surface it was found in */
 #define GRID 64            /* step 6: cells a side */
 #define CELL_ORIGINS 3
+#define SKY_RAYS 4         /* a point under the sky: SKY_SEEN of SKY_RAYS rays escape */
+#define SKY_SEEN 2
+#define REFRAME 0.6f       /* open cells this much narrower in a turned frame: the grid turns */
 #define GROW_TRIES 3       /* the grid grows where open cells touch its border */
+#define EDGE_STEPS 4       /* bisections of each edge of a rectangle (to 1/16 cell) */
+#define EDGE_PROBES 16     /* points along it each */
+#define EDGE_MARGIN 0.25f  /* x a cell: a rectangle's margin beyond its opening */
 #define CONNECT 2          /* open cells this many cells apart join */
 #define MERGE_AREA 1.25    /* step 7 */
 #define MERGE_GAP 0.03f    /* x R: rectangles of planes this close may merge */
@@ -330,7 +337,7 @@ static ajar_status room_points(Ctx *c, V3 cam, RoomPts *r)
 
 /* ---- Step 2: the light ---------------------------------------------------- */
 
-static ajar_status light_points(Ctx *c, uint32_t ntris, const PortalFindInput *in)
+static ajar_status light_points(Ctx *c, uint32_t ntris, const PortalFindInput *in, const RoomPts *room)
 {
 	const SceneView *v = c->v;
 	c->sky = in->env_type != ENV_NONE;
@@ -348,7 +355,7 @@ static ajar_status light_points(Ctx *c, uint32_t ntris, const PortalFindInput *i
 			total += 0.5 * v3_len(tri_normal(&v->tris[i])) * v3_lum(m->emission);
 	}
 	uint32_t nemit = total > 0.0 ? LIGHT_POINTS : 0;
-	c->lp = malloc(sizeof *c->lp * (lamps + nemit + 1));
+	c->lp = malloc(sizeof *c->lp * (lamps + nemit + BOUNCE_POINTS + 1));
 	if (!c->lp)
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "portal search: out of memory");
 	for (uint32_t i = 0; i < in->nlights; i++)
@@ -375,6 +382,33 @@ static ajar_status light_points(Ctx *c, uint32_t ntris, const PortalFindInput *i
 			k++;
 		}
 	}
+	/* Points the lights light, one bounce on (virtual lights): light that
+	 * comes in only after a bounce behind the opening (over a door leaf's
+	 * top, from the lit floor of the room behind) shows on what they
+	 * light. From each light point in turn, a ray (cosine about an
+	 * emitter's normal, any way from a lamp); a point just in front of its
+	 * hit, lighting that side. */
+	uint32_t direct = c->nlp;
+	for (uint32_t i = 0; direct && i < BOUNCE_POINTS; i++) {
+		const LightPoint *l = &c->lp[i % direct];
+		V3 d = dir_about(&rng, l->n, !v3_is_zero(l->n));
+		Solid s;
+		if (!trace(c, l->p, d, AJAR_INF, &s))
+			continue;
+		/* Only behind the openings: one the room sees (light already
+		 * in, or a lamp's own room) would make the room's walls look lit
+		 * from outside. */
+		V3 q = v3_madd(s.p, s.ng, 1e-4f * c->R);
+		int seen = 0;
+		for (uint32_t k = 0; k < ROOM_PEERS && k < room->n && !seen; k++) {
+			V3 from = room->pt[(k * 2654435761u + i) % room->n].p;
+			seen = v3_dot(v3_sub(from, q), s.ng) > 0.0f && clear(c, from, q);
+		}
+		if (!seen) {
+			c->lp[c->nlp].p = q;
+			c->lp[c->nlp++].n = s.ng;
+		}
+	}
 	return AJAR_OK;
 }
 
@@ -386,6 +420,7 @@ typedef struct {
 	V3 P, d;      /* the ray */
 	float t;      /* its far hit, AJAR_INF escaped */
 	int strong;   /* escaped or met an emitter (else: a point lit by a light P does not see) */
+	int weight;   /* 1: a ray of the first sample, which the shares count; 0: an aimed one */
 	float ring;   /* the ring's angle that found the wall, radians */
 	V3 X;         /* where it crosses the wall */
 	V3 wn;        /* the wall's normal, facing the room */
@@ -521,33 +556,6 @@ static int ring_all(Ctx *c, Rng *rng, const Crossings *l, uint32_t most, Crossin
 	return 1;
 }
 
-/* ---- Step 4: openings ------------------------------------------------------- */
-
-static uint32_t uf_find(uint32_t *p, uint32_t i)
-{
-	while (p[i] != i)
-		i = p[i] = p[p[i]];
-	return i;
-}
-
-/* Each crossing's opening: root[i], the smallest index in it. */
-static void openings(const Crossings *xs, float R, uint32_t *root)
-{
-	uint32_t n = xs->n;
-	for (uint32_t i = 0; i < n; i++)
-		root[i] = i;
-	float join2 = JOIN_DIST * R * JOIN_DIST * R;
-	for (uint32_t i = 0; i < n; i++)
-		for (uint32_t j = i + 1; j < n; j++)
-			if (v3_dot(xs->x[i].wn, xs->x[j].wn) > JOIN_COS && v3_len2(v3_sub(xs->x[i].X, xs->x[j].X)) < join2) {
-				uint32_t a = uf_find(root, i), b = uf_find(root, j);
-				if (a != b)
-					root[a > b ? a : b] = a < b ? a : b;
-			}
-	for (uint32_t i = 0; i < n; i++)
-		root[i] = uf_find(root, i);
-}
-
 /* Rays aimed near crossing x: from room points within 0.3 R of its
  * origin (up to 16 of them, the origin's own among them), within its
  * ring's angle of the line to its far end (its opening as seen from
@@ -585,7 +593,7 @@ static ajar_status find_crossings(Ctx *c, const RoomPts *r, Crossings *out)
 	if (per < 8)
 		per = 8;
 	Crossings strong = {0}, weak = {0}, more = {0};
-	uint32_t *root = NULL, *size = NULL;
+	uint32_t *size = NULL;
 	Rng rng = rng_init(0x70a7a1u, 3u, 0u, 0u);
 	for (uint32_t i = 0; i < r->n; i++)
 		for (uint32_t j = 0; j < per; j++)
@@ -597,42 +605,53 @@ static ajar_status find_crossings(Ctx *c, const RoomPts *r, Crossings *out)
 	if (!ring_all(c, &rng, &strong, MAX_CANDIDATES, out) ||
 	    !ring_all(c, &rng, &weak, MAX_CANDIDATES - (out->n < MAX_CANDIDATES / 2 ? out->n : MAX_CANDIDATES / 2), out))
 		goto oom;
-	/* Small openings get few rays: FOCUS_TARGET more for each opening of
-	 * fewer crossings, aimed near its crossings, in two rounds. */
+	/* Small openings get few rays: more, aimed near each crossing, the
+	 * fewer the more crossings already pass near it (within FOCUS_NEAR R,
+	 * directions within 10 degrees: a slit above a door leaf is not a
+	 * crowded gap beside it), in two rounds. Only the first rays weigh
+	 * in the portals' shares: they sample the room's lines as they are. */
+	for (uint32_t i = 0; i < out->n; i++)
+		out->x[i].weight = 1;
 	for (int round = 0; round < 2; round++) {
 		uint32_t n = out->n;
-		root = realloc(root, sizeof *root * (n ? n : 1));
-		size = calloc(n ? n : 1, sizeof *size);
-		if (!root || !size)
+		size = realloc(size, sizeof *size * (n ? n : 1));
+		if (!size)
 			goto oom;
-		openings(out, c->R, root);
+		float near2 = FOCUS_NEAR * c->R * FOCUS_NEAR * c->R;
 		for (uint32_t i = 0; i < n; i++)
-			size[root[i]]++;
+			size[i] = 1;
+		for (uint32_t i = 0; i < n; i++)
+			for (uint32_t j = i + 1; j < n; j++)
+				if (v3_dot(out->x[i].d, out->x[j].d) > 0.985f && v3_len2(v3_sub(out->x[i].X, out->x[j].X)) < near2)
+					size[i]++, size[j]++;
 		strong.n = weak.n = 0;
+		/* A place with m < FOCUS_TARGET crossings gets 2 (FOCUS_TARGET - m)
+		 * aimed rays (about half come through), shared by its crossings;
+		 * at most FOCUS_MAX a round. */
+		uint64_t want = 0;
+		for (uint32_t i = 0; i < n; i++)
+			want += size[i] < FOCUS_TARGET ? 2u * (FOCUS_TARGET - size[i]) / size[i] : 0u;
+		double scale = want > FOCUS_MAX ? (double)FOCUS_MAX / (double)want : 1.0;
 		for (uint32_t i = 0; i < n; i++) {
-			uint32_t m = size[root[i]];
-			if (m >= FOCUS_TARGET)
-				continue;
-			/* Each member takes its part of FOCUS_TARGET * FOCUS_RAYS. */
-			uint32_t rays = (FOCUS_TARGET * FOCUS_RAYS + m - 1) / m;
-			if (!focus_rays(c, &rng, r, &out->x[i], rays, &strong, &weak))
+			uint32_t rays = size[i] < FOCUS_TARGET ? (uint32_t)(scale * (2u * (FOCUS_TARGET - size[i]) / size[i])) : 0u;
+			if (rays && !focus_rays(c, &rng, r, &out->x[i], rays, &strong, &weak))
 				goto oom;
 		}
-		free(size);
-		size = NULL;
 		more.n = 0;
 		if (!ring_all(c, &rng, &strong, MAX_CANDIDATES, &more) || !ring_all(c, &rng, &weak, MAX_CANDIDATES, &more))
 			goto oom;
-		for (uint32_t i = 0; i < more.n; i++)
+		for (uint32_t i = 0; i < more.n; i++) {
+			more.x[i].weight = 0;
 			if (!push(out, &more.x[i]))
 				goto oom;
+		}
 		PF_DEBUG("round %d: focus strong %u weak %u -> %u more, total %u\n", round, strong.n, weak.n, more.n, out->n);
 	}
 	PF_DEBUG("rooms %u R %.3f nlp %u crossings %u\n", r->n, c->R, c->nlp, out->n);
-	free(strong.x), free(weak.x), free(more.x), free(root);
+	free(strong.x), free(weak.x), free(more.x), free(size);
 	return AJAR_OK;
 oom:
-	free(strong.x), free(weak.x), free(more.x), free(root), free(size);
+	free(strong.x), free(weak.x), free(more.x), free(size);
 	return err_set(AJAR_ERROR_OUT_OF_MEMORY, "portal search: out of memory");
 }
 
@@ -752,8 +771,14 @@ static int candidate_planes(const Crossings *xs, float R, V3 *cand, float *offs)
  * is seen from all over the room; lines from a few points meet near
  * them by chance) over its bounding box's area to the power 0.75 (two
  * windows a little apart score lower together than the larger alone), the
- * area at least PATCH_FLOOR squared. The best patch's lines go to idx (*m
- * of them), its plane to *q; returns its score (0: none). */
+ * area at least PATCH_FLOOR squared. best[0] gets the best patch, best[1]
+ * the best on another plane (score 0: none). */
+typedef struct {
+	double score; /* 0: none */
+	int q;        /* its plane */
+	uint32_t *idx, m; /* its lines */
+} Patch;
+
 typedef struct {
 	float cell;
 	int w, h;
@@ -769,10 +794,11 @@ static int cmp_u64(const void *a, const void *b)
 	return x < y ? -1 : x > y;
 }
 
-static double best_patch(Ctx *c, const Crossings *xs, const uint8_t *alive, const V3 *pn, const float *po, int np,
-			 V3 blo, V3 bhi, Raster *g, int *q, uint32_t *idx, uint32_t *m)
+static void best_patch(Ctx *c, const Crossings *xs, const uint8_t *alive, const V3 *pn, const float *po, int np,
+		       V3 blo, V3 bhi, Raster *g, Patch best[2])
 {
-	double best = 0.0;
+	best[0].score = best[1].score = 0.0;
+	best[0].q = best[1].q = -1;
 	float R = c->R;
 	for (int k = 0; k < np; k++) {
 		V3 a1, a2;
@@ -844,71 +870,130 @@ static double best_patch(Ctx *c, const Crossings *xs, const uint8_t *alive, cons
 			const int *box = g->box[patch];
 			double area = (double)(box[1] - box[0] + 1) * (box[3] - box[2] + 1) * g->cell * g->cell;
 			double score = sqrt((double)lines * origins) / pow(fmax(area, PATCH_FLOOR * PATCH_FLOOR * R * R), 0.75);
-			if (score > best) {
-				best = score;
-				*q = k;
-				*m = 0;
-				for (uint32_t j = 0; j < xs->n; j++)
-					if (g->cellof[j] >= 0 && g->comp[g->cellof[j]] == (int)patch)
-						idx[(*m)++] = j;
+			/* The best, and the best on another plane. */
+			int slot = score > best[0].score ? 0 : score > best[1].score && best[0].q != k ? 1 : -1;
+			if (slot < 0)
+				continue;
+			if (slot == 0 && best[0].q != k) {
+				Patch t = best[1];
+				best[1] = best[0];
+				best[0] = t;
 			}
+			Patch *b = &best[slot];
+			b->score = score;
+			b->q = k;
+			b->m = 0;
+			for (uint32_t j = 0; j < xs->n; j++)
+				if (g->cellof[j] >= 0 && g->comp[g->cellof[j]] == (int)patch)
+					b->idx[b->m++] = j;
 		}
 	}
-	return best;
 }
 
-/* The cell test (step 6) on a GRID x GRID grid from (l1, l2) in cells
- * c1 x c2 of the plane through o with axes a1, a2 and normal n: a cell is
- * open if, from the origin of one of the CELL_ORIGINS lines that cross the
- * plane nearest it, a ray through the cell's centre goes on: escapes,
- * meets an emitter or a point lit by a light that origin does not see,
- * or goes `deep` beyond the plane. */
-static void test_cells(Ctx *c, const Crossing *xs, const uint32_t *yl, const float *u1, const float *u2, uint32_t k,
-		       V3 o, V3 a1, V3 a2, V3 n, float l1, float l2, float c1, float c2, float deep, uint8_t *open)
+/* The plane of a cell test: its point o, axes a1, a2 and normal n, and
+ * the lines crossing it (yl, at u1, u2 in the plane's coordinates). */
+typedef struct {
+	const Crossing *xs;
+	const uint32_t *yl;
+	const float *u1, *u2;
+	uint32_t k;
+	V3 o, a1, a2, n;
+} CellPlane;
+
+/* Whether surface point p (normal n, facing where the ray came from) is
+ * under the open sky: at least SKY_SEEN of SKY_RAYS cosine rays escape. */
+static int sees_sky(Ctx *c, V3 p, V3 n, uint32_t seed)
 {
-	/* Rays start a little before the cell (the plane lies PLANE_OFFSET R
+	Rng rng = rng_init(0x70a7a1u, 6u, seed, 0u);
+	V3 o = v3_madd(p, n, 1e-4f * c->R);
+	int seen = 0;
+	for (int i = 0; i < SKY_RAYS && seen < SKY_SEEN; i++) {
+		Solid s;
+		seen += !trace(c, o, dir_about(&rng, n, 1), AJAR_INF, &s);
+	}
+	return seen >= SKY_SEEN;
+}
+
+/* The cell test (step 6) at (p1, p2) of the plane: open if, from the
+ * origin of one of the CELL_ORIGINS lines that cross the plane nearest it,
+ * a ray through the point goes on: escapes, meets an emitter, a point lit
+ * by a light that origin does not see, or a point
+ * lit from outside (under the sky). `pick` chooses the origin's light
+ * sample. */
+static int point_open(Ctx *c, const CellPlane *cp, float p1, float p2, uint32_t pick)
+{
+	/* Rays start a little before the point (the plane lies PLANE_OFFSET R
 	 * beyond a surface: a quarter of that). */
 	float back = 0.25f * PLANE_OFFSET * c->R;
-	memset(open, 0, GRID * GRID);
-	for (int j = 0; j < GRID; j++)
-		for (int i = 0; i < GRID; i++) {
-			float p1 = l1 + ((float)i + 0.5f) * c1, p2 = l2 + ((float)j + 0.5f) * c2;
-			V3 X = v3_add(o, v3_add(v3_scale(a1, p1), v3_scale(a2, p2)));
-			uint32_t near[CELL_ORIGINS];
-			float nd[CELL_ORIGINS];
-			int nn = 0;
-			for (uint32_t q = 0; q < k; q++) {
-				float dd = (u1[q] - p1) * (u1[q] - p1) + (u2[q] - p2) * (u2[q] - p2);
-				int pos = nn < CELL_ORIGINS ? nn++ : CELL_ORIGINS;
-				while (pos > 0 && nd[pos - 1] > dd) {
-					if (pos < CELL_ORIGINS)
-						near[pos] = near[pos - 1], nd[pos] = nd[pos - 1];
-					pos--;
-				}
-				if (pos < CELL_ORIGINS)
-					near[pos] = q, nd[pos] = dd;
-			}
-			for (int q = 0; q < nn && !open[j * GRID + i]; q++) {
-				const Crossing *line = &xs[yl[near[q]]];
-				V3 P = line->P, d = v3_sub(X, P);
-				float l = v3_len(d);
-				d = v3_scale(d, 1.0f / l);
-				V3 start = v3_madd(X, d, -back);
-				if (!clear(c, P, start))
-					continue;
-				Solid sol;
-				trace(c, start, d, AJAR_INF, &sol);
-				int go = sol.t == AJAR_INF || sol.emit || (sol.t - back) * fabs(v3_dot(d, n)) >= deep;
-				uint32_t pick = (uint32_t)(i + j) % 4;
-				if (!go && c->nlp && !line->from->sees[pick])
-					go = lit_by(c, sol.p, sol.ng, &c->lp[(line->from->base + pick) % c->nlp]);
-				open[j * GRID + i] = (uint8_t)go;
-#ifdef PORTAL_FIND_DEBUG
-				if (go && (i < 3 || j < 3 || i > GRID - 4 || j > GRID - 4))
-					fprintf(stderr, "edge cell %d,%d X(%.3f %.3f %.3f) P(%.3f %.3f %.3f) back %.4f sol.t %.4f emit %d dn %.3f\n", i, j, X.x, X.y, X.z, P.x, P.y, P.z, back, sol.t, sol.emit, v3_dot(d, n));
-#endif
-			}
+	V3 X = v3_add(cp->o, v3_add(v3_scale(cp->a1, p1), v3_scale(cp->a2, p2)));
+	uint32_t near[CELL_ORIGINS];
+	float nd[CELL_ORIGINS];
+	int nn = 0;
+	for (uint32_t q = 0; q < cp->k; q++) {
+		float dd = (cp->u1[q] - p1) * (cp->u1[q] - p1) + (cp->u2[q] - p2) * (cp->u2[q] - p2);
+		int pos = nn < CELL_ORIGINS ? nn++ : CELL_ORIGINS;
+		while (pos > 0 && nd[pos - 1] > dd) {
+			if (pos < CELL_ORIGINS)
+				near[pos] = near[pos - 1], nd[pos] = nd[pos - 1];
+			pos--;
 		}
+		if (pos < CELL_ORIGINS)
+			near[pos] = q, nd[pos] = dd;
+	}
+	for (int q = 0; q < nn; q++) {
+		const Crossing *line = &cp->xs[cp->yl[near[q]]];
+		V3 P = line->P, d = v3_sub(X, P);
+		float l = v3_len(d);
+		d = v3_scale(d, 1.0f / l);
+		V3 start = v3_madd(X, d, -back);
+		if (!clear(c, P, start))
+			continue;
+		Solid sol;
+		trace(c, start, d, AJAR_INF, &sol);
+		if (sol.t == AJAR_INF || sol.emit)
+			return 1;
+		pick %= 4;
+		if (c->nlp && !line->from->sees[pick] &&
+		    lit_by(c, sol.p, sol.ng, &c->lp[(line->from->base + pick) % c->nlp]))
+			return 1;
+		/* Something outside under the sky (a garden, a facade): it sees
+		 * the sky more than a room's wall does. */
+		if (c->sky && sees_sky(c, sol.p, sol.ng, pick))
+			return 1;
+	}
+	return 0;
+}
+
+/* The cell test on a GRID x GRID grid from (l1, l2) in cells c1 x c2. */
+static void test_cells(Ctx *c, const CellPlane *cp, float l1, float l2, float c1, float c2, uint8_t *open)
+{
+	for (int j = 0; j < GRID; j++)
+		for (int i = 0; i < GRID; i++)
+			open[j * GRID + i] = (uint8_t)point_open(c, cp, l1 + ((float)i + 0.5f) * c1, l2 + ((float)j + 0.5f) * c2,
+							(uint32_t)(i + j));
+}
+
+/* Moves one edge of rectangle r onto the opening's: the edge lies between
+ * `closed` (a coordinate along axis `axis` where the grid found no open
+ * cell next to the part) and `open` (its outermost open cell's centre);
+ * EDGE_STEPS bisections, each probing EDGE_PROBES points along the edge
+ * within the part's extent [from, to] on the other axis. Returns the
+ * coordinate, on the closed side of the opening's edge. */
+static float refine_edge(Ctx *c, const CellPlane *cp, int axis, float closed, float open, float from, float to)
+{
+	for (int step = 0; step < EDGE_STEPS; step++) {
+		float mid = 0.5f * (closed + open);
+		int any = 0;
+		for (int q = 0; q < EDGE_PROBES && !any; q++) {
+			float along = from + (to - from) * ((float)q + 0.5f) / EDGE_PROBES;
+			any = axis == 0 ? point_open(c, cp, mid, along, (uint32_t)q) : point_open(c, cp, along, mid, (uint32_t)q);
+		}
+		if (any)
+			open = mid;
+		else
+			closed = mid;
+	}
+	return closed;
 }
 
 /* Open cells of plane (n, s) over the footprint, their connected parts as
@@ -983,32 +1068,70 @@ static ajar_status open_rects(Ctx *c, const Crossing *xs, const uint32_t *idx, u
 	trimmed(w1, (int)k, 0.01f, &l1, &h1);
 	trimmed(w2, (int)k, 0.01f, &l2, &h2);
 	float e1 = h1 - l1, e2 = h2 - l2;
-	float deep = fmax(0.5f * fmin(e1, e2), 0.05f * R); /* how deep beyond the plane an open cell's ray goes */
 	l1 -= 0.25f * e1 + 0.02f * R, h1 += 0.25f * e1 + 0.02f * R;
 	l2 -= 0.25f * e2 + 0.02f * R, h2 += 0.25f * e2 + 0.02f * R;
-	/* The grid grows (by half, up to GROW_TRIES times) on each side where
-	 * an open cell touches its border: the opening goes on there. */
+	CellPlane cp = {.xs = xs, .yl = yl, .u1 = u1, .u2 = u2, .k = k, .o = o, .a1 = a1, .a2 = a2, .n = n};
 	float c1 = 0.0f, c2 = 0.0f;
 	int touch = 0;
-	for (int attempt = 0; attempt <= GROW_TRIES; attempt++) {
-		c1 = (h1 - l1) / GRID, c2 = (h2 - l2) / GRID;
-		test_cells(c, xs, yl, u1, u2, k, o, a1, a2, n, l1, l2, c1, c2, deep, open);
-		touch = 0;
-		for (int q = 0; q < GRID; q++) {
-			touch |= open[q * GRID] ? 1 : 0;                    /* low a1 */
-			touch |= open[q * GRID + GRID - 1] ? 2 : 0;         /* high a1 */
-			touch |= open[q] ? 4 : 0;                           /* low a2 */
-			touch |= open[(GRID - 1) * GRID + q] ? 8 : 0;       /* high a2 */
+	for (int pass = 0; pass < 2; pass++) {
+		/* The grid grows (by half, up to GROW_TRIES times) on each side
+		 * where an open cell touches its border: the opening goes on. */
+		for (int attempt = 0; attempt <= GROW_TRIES; attempt++) {
+			c1 = (h1 - l1) / GRID, c2 = (h2 - l2) / GRID;
+			test_cells(c, &cp, l1, l2, c1, c2, open);
+			touch = 0;
+			for (int q = 0; q < GRID; q++) {
+				touch |= open[q * GRID] ? 1 : 0;              /* low a1 */
+				touch |= open[q * GRID + GRID - 1] ? 2 : 0;   /* high a1 */
+				touch |= open[q] ? 4 : 0;                     /* low a2 */
+				touch |= open[(GRID - 1) * GRID + q] ? 8 : 0; /* high a2 */
+			}
+			if (!touch || attempt == GROW_TRIES)
+				break;
+			float g1 = 0.5f * (h1 - l1), g2 = 0.5f * (h2 - l2);
+			l1 -= touch & 1 ? g1 : 0.0f, h1 += touch & 2 ? g1 : 0.0f;
+			l2 -= touch & 4 ? g2 : 0.0f, h2 += touch & 8 ? g2 : 0.0f;
 		}
-		if (!touch || attempt == GROW_TRIES)
+		if (pass == 1)
 			break;
-		float g1 = 0.5f * (h1 - l1), g2 = 0.5f * (h2 - l2);
-		l1 -= touch & 1 ? g1 : 0.0f, h1 += touch & 2 ? g1 : 0.0f;
-		l2 -= touch & 4 ? g2 : 0.0f, h2 += touch & 8 ? g2 : 0.0f;
+		/* An opening askew to the lines' frame (a thin wedge over a door
+		 * leaf's top): the open cells' own narrowest frame, if it is much
+		 * narrower, and the grid again in it. */
+		float bestq = AJAR_INF, bq = 0.0f, box[4] = {0, 0, 0, 0}, axis_area = 0.0f;
+		for (int r = 0; r < 45; r++) {
+			float a = (float)r * AJAR_PI / 90.0f, ca = cos(a), sa = sin(a);
+			float q0 = AJAR_INF, q1 = -AJAR_INF, q2 = AJAR_INF, q3 = -AJAR_INF;
+			for (int j = 0; j < GRID; j++)
+				for (int i = 0; i < GRID; i++) {
+					if (!open[j * GRID + i])
+						continue;
+					float p1 = l1 + ((float)i + 0.5f) * c1, p2 = l2 + ((float)j + 0.5f) * c2;
+					float r1 = ca * p1 + sa * p2, r2 = -sa * p1 + ca * p2;
+					q0 = fmin(q0, r1), q1 = fmax(q1, r1), q2 = fmin(q2, r2), q3 = fmax(q3, r2);
+				}
+			float area = (q1 - q0 + c1) * (q3 - q2 + c2);
+			if (r == 0)
+				axis_area = area;
+			if (area < bestq)
+				bestq = area, bq = a, box[0] = q0, box[1] = q1, box[2] = q2, box[3] = q3;
+		}
+		if (!(bestq < REFRAME * axis_area))
+			break;
+		float ca = cos(bq), sa = sin(bq);
+		a1 = v3_add(v3_scale(cp.a1, ca), v3_scale(cp.a2, sa));
+		a2 = v3_cross(n, a1);
+		cp.a1 = a1, cp.a2 = a2;
+		for (uint32_t i = 0; i < k; i++) {
+			u1[i] = v3_dot(v3_sub(y[i], o), a1);
+			u2[i] = v3_dot(v3_sub(y[i], o), a2);
+		}
+		float m = fmax(c1, c2);
+		l1 = box[0] - 2.0f * m - 0.25f * (box[1] - box[0]), h1 = box[1] + 2.0f * m + 0.25f * (box[1] - box[0]);
+		l2 = box[2] - 2.0f * m - 0.25f * (box[3] - box[2]), h2 = box[3] + 2.0f * m + 0.25f * (box[3] - box[2]);
 	}
 #ifdef PORTAL_FIND_DEBUG
 	{
-		fprintf(stderr, "grid n(%.3f %.3f %.3f) s %.4f a1(%.3f %.3f %.3f) [%.3f %.3f] a2(%.3f %.3f %.3f) [%.3f %.3f] deep %.3f\n", n.x, n.y, n.z, s, a1.x, a1.y, a1.z, l1, h1, a2.x, a2.y, a2.z, l2, h2, deep);
+		fprintf(stderr, "grid n(%.3f %.3f %.3f) s %.4f a1(%.3f %.3f %.3f) [%.3f %.3f] a2(%.3f %.3f %.3f) [%.3f %.3f]\n", n.x, n.y, n.z, s, a1.x, a1.y, a1.z, l1, h1, a2.x, a2.y, a2.z, l2, h2);
 		for (int j = GRID - 1; j >= 0; j--) {
 			for (int i = 0; i < GRID; i++)
 				fputc(open[j * GRID + i] ? '#' : '.', stderr);
@@ -1050,8 +1173,15 @@ static ajar_status open_rects(Ctx *c, const Crossing *xs, const uint32_t *idx, u
 		    ((touch & 8) && j1 == GRID - 1))
 			continue;
 		Rect r = {.o = o, .a1 = a1, .a2 = a2, .n = n, .alive = 1};
-		r.lo1 = l1 + ((float)i0 - 0.5f) * c1, r.hi1 = l1 + ((float)i1 + 1.5f) * c1;
-		r.lo2 = l2 + ((float)j0 - 0.5f) * c2, r.hi2 = l2 + ((float)j1 + 1.5f) * c2;
+		/* Each edge between its outermost open cell's centre and the next
+		 * centre out, bisected onto the opening's edge, then EDGE_MARGIN
+		 * of a cell beyond it. */
+		float in1 = l1 + ((float)i0 + 0.5f) * c1, out1 = in1 - c1, in2 = l1 + ((float)i1 + 0.5f) * c1, out2 = in2 + c1;
+		float in3 = l2 + ((float)j0 + 0.5f) * c2, out3 = in3 - c2, in4 = l2 + ((float)j1 + 0.5f) * c2, out4 = in4 + c2;
+		r.lo1 = refine_edge(c, &cp, 0, out1, in1, in3 - 0.5f * c2, in4 + 0.5f * c2) - EDGE_MARGIN * c1;
+		r.hi1 = refine_edge(c, &cp, 0, out2, in2, in3 - 0.5f * c2, in4 + 0.5f * c2) + EDGE_MARGIN * c1;
+		r.lo2 = refine_edge(c, &cp, 1, out3, in3, in1 - 0.5f * c1, in2 + 0.5f * c1) - EDGE_MARGIN * c2;
+		r.hi2 = refine_edge(c, &cp, 1, out4, in4, in1 - 0.5f * c1, in2 + 0.5f * c1) + EDGE_MARGIN * c2;
 		uint32_t hits = 0;
 		for (uint32_t q = 0; q < k; q++)
 			if (u1[q] >= r.lo1 && u1[q] <= r.hi1 && u2[q] >= r.lo2 && u2[q] <= r.hi2) {
@@ -1172,13 +1302,13 @@ ajar_status portal_find(const SceneView *v, uint32_t ntris, const PortalFindInpu
 	Crossings xs = {0};
 	Rects rs = {0};
 	Raster g = {0};
-	uint32_t *idx = NULL;
+	Patch best[2] = {{0.0, -1, NULL, 0}, {0.0, -1, NULL, 0}};
 	uint8_t *alive = NULL, *caught = NULL, *scratch = NULL;
 	V3 pn[MAX_PLANES];
 	float po[MAX_PLANES];
 	ajar_status st = room_points(&c, in->camera, &room);
 	if (st == AJAR_OK && c.R > 0.0f)
-		st = light_points(&c, ntris, in);
+		st = light_points(&c, ntris, in, &room);
 	if (st == AJAR_OK && c.R > 0.0f) {
 		room_lights(&c, &room);
 		st = find_crossings(&c, &room, &xs);
@@ -1186,9 +1316,12 @@ ajar_status portal_find(const SceneView *v, uint32_t ntris, const PortalFindInpu
 	if (st != AJAR_OK || xs.n == 0)
 		goto done;
 
-	uint32_t n = xs.n;
+	uint32_t n = xs.n, nfirst = 0;
+	for (uint32_t k = 0; k < n; k++)
+		nfirst += (uint32_t)xs.x[k].weight;
 	int np = candidate_planes(&xs, c.R, pn, po);
-	idx = malloc(sizeof *idx * n);
+	best[0].idx = malloc(sizeof *best[0].idx * n);
+	best[1].idx = malloc(sizeof *best[1].idx * n);
 	alive = malloc(n);
 	caught = calloc(n, 1);
 	scratch = calloc(n, 1);
@@ -1199,7 +1332,7 @@ ajar_status portal_find(const SceneView *v, uint32_t ntris, const PortalFindInpu
 	g.cellof = malloc(sizeof *g.cellof * n);
 	g.pairs = malloc(sizeof *g.pairs * n);
 	out->portals = malloc(sizeof *out->portals * MAX_PORTALS);
-	if (np < 0 || !idx || !alive || !caught || !scratch || !g.count || !g.comp || !g.stack || !g.box || !g.cellof ||
+	if (np < 0 || !best[0].idx || !best[1].idx || !alive || !caught || !scratch || !g.count || !g.comp || !g.stack || !g.box || !g.cellof ||
 	    !g.pairs || !out->portals) {
 		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "portal search: out of memory");
 		goto done;
@@ -1220,31 +1353,66 @@ ajar_status portal_find(const SceneView *v, uint32_t ntris, const PortalFindInpu
 	uint32_t left = n;
 	uint32_t accepted = 0;
 	for (int round = 0; round < MAX_ROUNDS && accepted < MAX_PORTALS; round++) {
-		int q = -1;
-		uint32_t m = 0;
-		double sc = best_patch(&c, &xs, alive, pn, po, np, blo, bhi, &g, &q, idx, &m);
-		PF_DEBUG("round %d best %.1f plane %d m %u\n", round, sc, q, m);
-		if (sc <= 0.0 || (float)m < MIN_SHARE * (float)n)
+		best_patch(&c, &xs, alive, pn, po, np, blo, bhi, &g, best);
+		PF_DEBUG("round %d best %.1f plane %d m %u; next %.1f plane %d m %u\n", round, best[0].score, best[0].q,
+			 best[0].m, best[1].score, best[1].q, best[1].m);
+		if (best[0].score <= 0.0 || (float)best[0].m < MIN_SHARE * (float)n)
 			break;
+		/* The best patch, or the runner-up on another plane where its
+		 * score comes close: the one whose rectangles catch the open lines
+		 * more tightly (lines per area^0.75) wins. */
 		uint32_t from = rs.n;
-		if ((st = open_rects(&c, xs.x, idx, m, pn[q], po[q], n, scratch, &rs)) != AJAR_OK)
-			goto done;
-		merge_rects(&rs, from, c.R);
+		int pick = 0;
+		double tight[2] = {0.0, 0.0};
+		for (int b = 0; b < 2; b++) {
+			if (b == 1 && !(best[1].score >= RUNNER_UP * best[0].score && (float)best[1].m >= MIN_SHARE * (float)n))
+				break;
+			uint32_t mark = rs.n;
+			if ((st = open_rects(&c, xs.x, best[b].idx, best[b].m, pn[best[b].q], po[best[b].q], n, scratch, &rs)) !=
+			    AJAR_OK)
+				goto done;
+			merge_rects(&rs, mark, c.R);
+			double area = 0.0;
+			uint32_t lines = 0;
+			for (uint32_t k = 0; k < n; k++) {
+				int in = 0;
+				for (uint32_t r = mark; r < rs.n && !in; r++)
+					in = rs.r[r].alive && rect_catches(&rs.r[r], &xs.x[k], c.R);
+				lines += alive[k] && in;
+			}
+			for (uint32_t r = mark; r < rs.n; r++)
+				if (rs.r[r].alive)
+					area += (double)(rs.r[r].hi1 - rs.r[r].lo1) * (rs.r[r].hi2 - rs.r[r].lo2);
+			tight[b] = area > 0.0 ? lines / pow(area, 0.75) : 0.0;
+			if (b == 1) {
+				pick = tight[1] > tight[0];
+				/* The loser's rectangles are dropped. */
+				for (uint32_t r = pick ? from : mark; r < (pick ? mark : rs.n); r++)
+					rs.r[r].alive = 0;
+			}
+		}
+		PF_DEBUG("  tightness %.1f / %.1f: plane %d\n", tight[0], tight[1], best[pick].q);
+		int q = best[pick].q;
+		uint32_t m = best[pick].m, *idx = best[pick].idx;
+		(void)q;
 		for (uint32_t i = 0; i < m; i++)
 			alive[idx[i]] = 0; /* the patch is settled, caught or not */
 		for (uint32_t r = from; r < rs.n; r++) {
 			Rect *rc = &rs.r[r];
 			if (!rc->alive || !light_behind(&c, rc))
 				continue;
-			/* Its share: the lines it catches that no portal caught. */
-			uint32_t gain = 0;
+			/* The lines it catches that no portal caught: their count
+			 * decides (aimed rays count: a small opening found is
+			 * kept), the first sample's share is its share. */
+			uint32_t gain = 0, first = 0;
 			for (uint32_t k = 0; k < n; k++)
 				if (!caught[k] && rect_catches(rc, &xs.x[k], c.R)) {
 					caught[k] = 1;
 					alive[k] = 0;
 					gain++;
+					first += (uint32_t)xs.x[k].weight;
 				}
-			rc->share = (float)gain / (float)n;
+			rc->share = nfirst ? (float)first / (float)nfirst : 0.0f;
 			rc->accepted = (float)gain >= MIN_SHARE * (float)n;
 			accepted += rc->accepted;
 		}
@@ -1281,7 +1449,7 @@ done:
 	free(room.pt);
 	free(xs.x);
 	free(rs.r);
-	free(idx);
+	free(best[0].idx), free(best[1].idx);
 	free(alive);
 	free(caught);
 	free(scratch);
