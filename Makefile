@@ -98,6 +98,7 @@ DEPS_test_subpaths := $(BUILD)/libajar.a
 DEPS_test_mpi := $(BUILD)/libajar.a
 DEPS_test_found_portals := $(BUILD)/libajar.a
 DEPS_test_cli_scene := $(BUILD)/libajar.a
+DEPS_test_noise := $(BUILD)/libajar.a
 DEPS_test_glass := $(BUILD)/libajar.a
 
 .PHONY: FORCE all lib cli tests test test-unit asan demo bench bench-portals bench-peers install uninstall clean deps help

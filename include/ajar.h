@@ -211,8 +211,10 @@ typedef enum {
 
 typedef struct {
 	uint32_t width, height;  /* 0: scene's suggestion, else 512 x 512/aspect */
-	uint32_t spp;            /* samples per pixel; 0 = until time_limit */
+	uint32_t spp;            /* samples per pixel; 0 = until time_limit or noise */
 	double time_limit;       /* seconds; 0 = none */
+	double noise;            /* stop once the image's estimated relative error (ajar_renderer_noise)
+				  * is below this, e.g. 0.05 for 5%; spp and time_limit bound it; 0 = none */
 	ajar_integrator integrator;
 	uint32_t max_depth;      /* maximum path segments (camera segment included) */
 	uint32_t min_depth;      /* paths of fewer segments are left out (0: none) */
@@ -239,6 +241,8 @@ typedef struct {
 	double samples_per_second; /* pixel samples per second */
 	double eta;              /* seconds, < 0 if unknown */
 	double fraction;         /* 0..1 */
+	double noise;            /* with ajar_options.noise: the image's estimated relative
+				  * error (ajar_renderer_noise), < 0 until known */
 } ajar_progress;
 /* Called after each pass; return non-zero to stop after that pass. */
 typedef int (*ajar_progress_fn)(const ajar_progress *p, void *user);
@@ -261,6 +265,13 @@ void ajar_renderer_cancel(ajar_renderer *r);
  * estimates cost no set-up. Not while a render runs. */
 ajar_status ajar_renderer_restart(ajar_renderer *r, uint32_t seed);
 uint32_t ajar_renderer_spp(const ajar_renderer *r);
+/* With ajar_options.noise, the image's estimated relative error when it was
+ * last estimated (< 0 before): sqrt of the mean over pixels and channels of
+ * var(I) / (I^2 + (0.1 mean I)^2), var(I) from the difference of two
+ * disjoint halves of the samples (src/render/README.md, "Stopping at a
+ * noise level"); light-traced splats included, the same for every
+ * integrator. */
+double ajar_renderer_noise(const ajar_renderer *r);
 /* The current estimate: width * height RGBA floats, row-major, top row first.
  * Not while ajar_renderer_render runs (call it before or after). */
 ajar_status ajar_renderer_image(ajar_renderer *r, float *rgba, uint32_t *width, uint32_t *height);

@@ -284,7 +284,7 @@ int args_parse_render(int argc, char **argv, RenderArgs *a)
 {
 	memset(a, 0, sizeof *a);
 	ajar_options_default(&a->opt);
-	int spp_given = 0, time_given = 0;
+	int spp_given = 0, time_given = 0, noise_given = 0;
 	uint32_t strategy_len = 0;
 	for (int i = 0; i < argc; i++) {
 		const char *arg = argv[i];
@@ -336,7 +336,7 @@ int args_parse_render(int argc, char **argv, RenderArgs *a)
 						    "--mis", "--strategies", "--strategy-len", "--exposure",
 						    "--checkpoint", "--checkpoint-every", "--resume", "--aov", "--portals",
 						    "--portals-out", "--sky", "--sky-color", "--sky-strength", "--sky-rotation",
-						    "--sun"};
+						    "--sun", "--noise"};
 		size_t k = 0;
 		while (k < sizeof known / sizeof known[0] && strcmp(name, known[k]) != 0)
 			k++;
@@ -368,7 +368,14 @@ int args_parse_render(int argc, char **argv, RenderArgs *a)
 			a->resume = val;
 		else if (!strcmp(name, "--aov"))
 			rc = parse_aov(name, val, &a->opt.aov);
-		else if (!strcmp(name, "--checkpoint-every"))
+		else if (!strcmp(name, "--noise")) {
+			float pct;
+			rc = parse_number(name, val, 0.0, 100.0, &pct);
+			if (rc == EXIT_OK && !(pct > 0.0f && pct < 100.0f))
+				rc = args_usage_error("--noise: %s is not a percentage between 0 and 100 (excluded)", val);
+			a->opt.noise = pct / 100.0;
+			noise_given = 1;
+		} else if (!strcmp(name, "--checkpoint-every"))
 			rc = parse_seconds(name, val, &a->checkpoint_every);
 		else if (!strcmp(name, "--spp")) {
 			rc = parse_u32(name, val, 1, UINT32_MAX, &a->opt.spp);
@@ -415,7 +422,8 @@ int args_parse_render(int argc, char **argv, RenderArgs *a)
 			    {"--max-depth", GIVEN_MAX_DEPTH}, {"--min-depth", GIVEN_MIN_DEPTH},
 			    {"--seed", GIVEN_SEED},	    {"--mis", GIVEN_MIS},
 			    {"--strategy-len", GIVEN_STRATEGY_LEN}, {"--spp", GIVEN_SPP},
-			    {"--time", GIVEN_TIME}, {"--aov", GIVEN_AOV}, {"--portals", GIVEN_PORTALS}};
+			    {"--time", GIVEN_TIME}, {"--aov", GIVEN_AOV}, {"--portals", GIVEN_PORTALS},
+			    {"--noise", GIVEN_NOISE}};
 		for (size_t b = 0; b < sizeof bits / sizeof bits[0]; b++)
 			if (!strcmp(name, bits[b].name))
 				a->given |= bits[b].bit;
@@ -445,9 +453,9 @@ int args_parse_render(int argc, char **argv, RenderArgs *a)
 		return args_usage_error("%s needs --strategies OUT.exr",
 					strategy_len ? "--strategy-len" : "--unweighted");
 	}
-	/* 64 samples unless only a time limit was asked for. */
+	/* 64 samples unless only a time limit or a noise target was asked for. */
 	if (!spp_given)
-		a->opt.spp = time_given ? 0 : 64;
+		a->opt.spp = time_given || noise_given ? 0 : 64;
 	if (!time_given)
 		a->opt.time_limit = 0;
 	return EXIT_OK;

@@ -74,7 +74,8 @@ enum {
 	GIVEN_SPP = 1 << 8,
 	GIVEN_TIME = 1 << 9,
 	GIVEN_AOV = 1 << 10,
-	GIVEN_PORTALS = 1 << 11
+	GIVEN_PORTALS = 1 << 11,
+	GIVEN_NOISE = 1 << 12
 };
 
 /* Parses the arguments after `render`. Returns EXIT_OK or EXIT_USAGE

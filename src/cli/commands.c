@@ -61,9 +61,13 @@ static const char usage_render[] =
 	"\n"
 	"  -o, --output OUT.exr   linear HDR result (float RGBA, ZIP); the header records\n"
 	"                         the samples per pixel done as \"ajar:spp\"\n"
-	"  --spp N                samples per pixel (default 64 unless --time is given)\n"
+	"  --spp N                samples per pixel (default 64 unless --time or --noise\n"
+	"                         is given)\n"
 	"  --time SECONDS         render until this time has passed (with --spp: whichever\n"
 	"                         comes first)\n"
+	"  --noise PCT            render until the image's estimated relative error is\n"
+	"                         below PCT percent (--spp and --time bound it); the\n"
+	"                         estimate, from two halves of the samples, is shown\n"
 	"  --size WxH             image size (default: the scene's suggestion, else 512 wide)\n"
 	"  --integrator NAME      pt (default): path tracing; bdpt: bidirectional path\n"
 	"                         tracing; portal: bdpt plus intermediate subpaths\n"
@@ -91,7 +95,7 @@ static const char usage_render[] =
 	"                         --checkpoint-every SECONDS (default 60), when a device\n"
 	"                         fails and when the render stops (also on Ctrl-C)\n"
 	"  --resume FILE          continue the render FILE holds (with its options; only\n"
-	"                         --spp, --time and --device may change, to extend it); the\n"
+	"                         --spp, --time, --noise and --device may change); the\n"
 	"                         result equals an uninterrupted render bit for bit. FILE\n"
 	"                         is updated as the render goes on unless --checkpoint\n"
 	"                         names another\n"
@@ -430,9 +434,11 @@ static int resume_options(RenderArgs *a)
 		return args_usage_error("--strategies: the checkpoint %s keeps no strategy layers", a->resume);
 	const char *device = o->device;
 	uint32_t spp = o->spp;
-	double time_limit = o->time_limit;
+	double time_limit = o->time_limit, noise = o->noise;
 	a->opt = ck;
 	a->opt.device = device;
+	if (a->given & GIVEN_NOISE)
+		a->opt.noise = noise;
 	if (a->given & GIVEN_SPP)
 		a->opt.spp = spp;
 	if (a->given & GIVEN_TIME)
@@ -540,7 +546,7 @@ static int cmd_render(int argc, char **argv)
 		return rc;
 
 	Progress progress;
-	progress_init(&progress, stderr, a.quiet);
+	progress_init(&progress, stderr, a.quiet, a.opt.noise > 0.0);
 	ajar_set_log_callback(on_log, &progress);
 	install_signals();
 
@@ -587,6 +593,9 @@ static int cmd_render(int argc, char **argv)
 		if (a.opt.time_limit > 0)
 			snprintf(budget + strlen(budget), sizeof budget - strlen(budget), "%s%g s",
 				 a.opt.spp ? ", at most " : "", a.opt.time_limit);
+		if (a.opt.noise > 0)
+			snprintf(budget + strlen(budget), sizeof budget - strlen(budget), "%suntil noise %g%%",
+				 budget[0] ? ", " : "", 100.0 * a.opt.noise);
 		const char *device = ajar_renderer_device_name(r);
 		char from[64] = "";
 		if (a.resume)
@@ -639,8 +648,11 @@ static int cmd_render(int argc, char **argv)
 			ckpt ? ckpt : "");
 		rc = EXIT_INTERRUPTED;
 	} else if (!a.quiet) {
-		fprintf(stderr, "ajar: done: %u spp in %s (%.3g Msamples/s); wrote %s%s%s\n", spp, elapsed,
-			last->samples_per_second * 1e-6, a.exr, a.png ? " and " : "", a.png ? a.png : "");
+		char noise[64] = "";
+		if (a.opt.noise > 0 && ajar_renderer_noise(r) >= 0)
+			snprintf(noise, sizeof noise, ", estimated error %.2g%%", 100.0 * ajar_renderer_noise(r));
+		fprintf(stderr, "ajar: done: %u spp in %s (%.3g Msamples/s%s); wrote %s%s%s\n", spp, elapsed,
+			last->samples_per_second * 1e-6, noise, a.exr, a.png ? " and " : "", a.png ? a.png : "");
 		print_device_shares(r);
 	}
 done:

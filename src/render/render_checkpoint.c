@@ -53,6 +53,7 @@ static ajar_status checkpoint_gather(ajar_renderer *r, Checkpoint *c)
 	c->aov = o->aov;
 	c->portals = (uint32_t)o->portals;
 	c->time_limit = r->time_limit;
+	c->noise = r->opt.noise;
 	c->elapsed = r->elapsed;
 	size_t n = r->base.n;
 	for (uint32_t i = 0; i < r->ndev; i++)
@@ -162,6 +163,7 @@ static void options_from_checkpoint(const Checkpoint *c, ajar_options *o)
 	o->height = c->height;
 	o->spp = c->spp;
 	o->time_limit = c->time_limit;
+	o->noise = c->noise;
 	o->integrator = (ajar_integrator)c->integrator;
 	o->max_depth = c->max_depth;
 	o->min_depth = c->min_depth;
@@ -263,11 +265,12 @@ static ajar_status resume_options(ajar_options *want, const ajar_options *o, con
 											   : NULL;
 		if (differs)
 			return err_set(AJAR_ERROR_INVALID_ARGUMENT,
-				       "%s: options.%s differs from the checkpoint's (only spp, time_limit and device "
+				       "%s: options.%s differs from the checkpoint's (only spp, time_limit, noise and device "
 				       "may change when resuming)",
 				       path, differs);
 		want->spp = o->spp;
 		want->time_limit = o->time_limit;
+		want->noise = o->noise;
 		want->device = o->device;
 	}
 	return AJAR_OK;
