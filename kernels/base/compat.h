@@ -38,7 +38,7 @@ static inline long atom_add(long *p, long v) { long old = *p; *p += v; return ol
 /* The large functions: traversal, subpaths, connections, MIS. With
  * -DAJAR_CALLS they stay calls on the device. NVIDIA's OpenCL compiler did
  * not finish bdpt's or portal's program in 5 minutes with everything
- * inlined, and builds them in under half a minute this way (kernels/gpu.md, "On GPUs").
+ * inlined, and builds them in under half a minute this way (src/device/README.md, "Build options").
  * The host adds it for bdpt and portal on devices that are not CPUs; on
  * PoCL it costs 0-3%, so CPUs inline. */
 #if defined(AJAR_DEVICE) && defined(AJAR_CALLS)

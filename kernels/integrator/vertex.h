@@ -54,7 +54,7 @@ typedef struct {
 		       * vertex (rebuilding it was 17% of door-ajar's portal time) */
 } PathVertex;
 
-/* ---- Where subpaths live (kernels/gpu.md, "On GPUs: subpaths in global memory") ----
+/* ---- Where subpaths live (kernels/integrator/README.md, "Where subpaths live") ----
  *
  * By default the subpath arrays are private arrays of PathVertex (CPUs:
  * they stay in the core's caches). Built with -DAJAR_SUBPATH_SOA=C, they live

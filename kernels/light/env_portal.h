@@ -33,8 +33,7 @@
 /* The same share where the planes' sky tables sample an image
  * (sky_nee_sample): 0.9 lowered pt's variance per sample by 7% and 10% on
  * window-room-forest and -sunset and left living-room-forest's within 1%
- * (0.95: 11%, 13%, and 3% worse; kernels/sky_measurements.md,
- * "Measurements"). The rest still finds a sun through an opening without
+ * (0.95: 11%, 13%, and 3% worse; kernels/light/README.md, "The portals' share of next-event samples"). The rest still finds a sun through an opening without
  * a portal. */
 #ifndef PORTAL_SKY_NEE_MIX
 #define PORTAL_SKY_NEE_MIX 0.9f

@@ -228,16 +228,14 @@ INLINE V3 punctual_dir_sample(GLOBAL const PunctualLight *l, float u1, float u2)
  * |n_k.w| (each crossed triangle j contributes A_j |n_j.w| / S for its
  * choice times 1 / (A_j |n_j.w|) per perpendicular area). The same
  * function at sampling and in every MIS record (vertex_density.h,
- * bdpt_emission_pdf; kernels/sky_measurements.md, "Sky light subpaths through the
- * portals"). */
+ * bdpt_emission_pdf; kernels/light/README.md, "Punctual lights" (why 10% on the disk)). */
 #define SUN_DISK_SHARE 0.1f
 
 /* Whether an environment's light subpaths take these lines through the
  * portals: a sky image's (its sun finds the way in); a constant sky keeps
  * the disk, where its next-event estimation through the portals already
  * takes the direct light and the light subpaths that come in only added
- * variance and time (kernels/sky_measurements.md, "Sky light subpaths through the
- * portals"). */
+ * variance and time (kernels/light/README.md, "Punctual lights" (why 10% on the disk)). */
 INLINE int env_lines_through_portals(const SceneView *sc)
 {
 	return sc->params->env_type == ENV_IMAGE && sc->params->num_portals > 0;

@@ -75,7 +75,7 @@ INLINE Rgba rgba_lerp(Rgba a, Rgba b, float t)
  * blends the stored (sRGB-encoded) values and decodes the blend, as
  * Cycles does with 8-bit sRGB images (NODE_IMAGE_COMPRESS_AS_SRGB:
  * interpolate, then color_srgb_to_linear): Blender's importer is what
- * users compare with (kernels/materials.md, "Texture coordinates and
+ * users compare with (kernels/material/README.md, "Feature-specialised programs", "Texture coordinates and
  * samplers"). */
 INLINE Rgba texture_rgba(const SceneView *sc, int tex, float u0, float v0, int srgb)
 {
@@ -185,7 +185,7 @@ INLINE float alpha_hash(V3 o, V3 d, int tri)
  * its coverage is 1, always; BLEND with probability alpha. Never inlined:
  * the traversal's leaf loop (bvh.h) keeps only a flag test and a call
  * taken for alpha-tested triangles, not the texture lookup's code and
- * registers (untextured scenes: kernels/materials.md, "Alpha"). */
+ * registers (untextured scenes: kernels/material/README.md, "Feature-specialised programs"). */
 static __attribute__((noinline, unused)) int alpha_hit(const SceneView *sc, int tri, float b1, float b2, V3 o, V3 d)
 {
 	float c = tri_coverage(sc, tri, b1, b2);

@@ -56,8 +56,7 @@ INLINE float mis_term(float r, int heuristic) { return heuristic == MIS_BALANCE 
  * (t = 1, s = k - 1) with every light vertex and the other strategies with
  * at most conn light vertices (s <= conn; conn is 1 or 2, which the tails
  * below need): the portal integrator's set where light subpaths bring the
- * light in (src/prepare/prepare.c, kernels/sky_measurements.md, "Connections to
- * the first light vertices"). */
+ * light in (src/prepare/prepare.c, kernels/integrator/README.md, "Connections to the first two light vertices"). */
 INLINE int mis_conn_in_set(int conn, int k, int s) { return conn == 0 || s <= conn || s == k - 1; }
 
 /* The sum behind mis_path_weight and mis_path_weight_tails: the eye

@@ -15,7 +15,7 @@
  * samples of one pixel fill each pair's square far more evenly than
  * independent ones, which is where most of a pixel's variance at hundreds of
  * samples comes from: pixel position, the first scattering and next-event
- * directions (kernels/README.md, "Sampling"). */
+ * directions (kernels/sample/README.md, "Low-discrepancy numbers"). */
 #ifndef AJAR_QMC_H
 #define AJAR_QMC_H
 #include "base/compat.h"

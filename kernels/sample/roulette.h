@@ -22,7 +22,7 @@
  * Where every eye vertex also connects to each vertex of a light subpath
  * (bdpt; portal in scenes with emitters), 2 cost door-ajar's portal
  * integrator 10% in efficiency, and 1.5 leaves it and bathroom even
- * against the old absolute rule (kernels/README.md, "pt and Russian roulette"). */
+ * against the old absolute rule (kernels/sample/README.md, "Russian roulette"). */
 #ifndef AJAR_ROULETTE_H
 #define AJAR_ROULETTE_H
 #include "sample/rng.h"

@@ -1,7 +1,7 @@
 /* device_plan.c — how a pass spreads over a device (DevicePlan): where
  * bdpt's and portal's subpaths live, how many work-items a pixel gets, and
  * the options render_pass is built with for that plan and the scene's
- * features (kernels/gpu.md, "On GPUs: subpaths in global memory"). */
+ * features (kernels/integrator/README.md, "Where subpaths live"). */
 #include "device/device_plan.h"
 
 #include <errno.h>

@@ -1,7 +1,7 @@
 /* device_plan.h — how a pass spreads over a device (device_plan.c): where
  * bdpt's and portal's subpaths live, work-items per pixel, and the options
  * render_pass is built with for that plan and the scene's features
- * (kernels/gpu.md, "On GPUs: subpaths in global memory"). */
+ * (kernels/integrator/README.md, "Where subpaths live"). */
 #ifndef AJAR_DEVICE_PLAN_H
 #define AJAR_DEVICE_PLAN_H
 #include <stddef.h>

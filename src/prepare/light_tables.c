@@ -281,7 +281,7 @@ static ajar_status build_portals(PortalTri *portals, uint32_t n, LightTables *ou
  * from (design.md). Counted over the whole disk, a sky under a sun lamp
  * took 99.1% of the choice on window-room-sun (pi R^2 = 25 m^2 against a
  * 0.64 m^2 window) and the sun 0.9% (now 74% and 26%), where the two bring
- * comparable light into the room (kernels/punctual.md, "Punctual lights"). */
+ * comparable light into the room (kernels/light/README.md, "The light choice"). */
 static double env_cross_section(const PortalTri *portals, uint32_t nportal_tris, float scene_radius)
 {
 	double a = 0.0;

@@ -1,8 +1,13 @@
 /* policy.c — the rendering choices (policy.h), each beside the
- * measurement that decided it. The records are in kernels/integrator/README.md
- * ("Choices by measurement") and kernels/light/README.md; the commands that
- * measure them are tests/peers/sky_eff.py (variance and time per sample of
- * one integrator on one scene) and `make bench-peers`. */
+ * measurement that decided it. The records: kernels/integrator/README.md
+ * ("Strategy sets and the rate", "Where light subpaths come in, portal is
+ * bdpt", "Connections to the first two light vertices", "A lamp behind a
+ * portal counts as an emitter"), kernels/mis/README.md ("The heuristic:
+ * power, balance, auto"), kernels/light/README.md ("Table resolution",
+ * "Sky light subpaths through the portals", "A sun's share through the
+ * openings"). The commands that measure them: tests/peers/sky_eff.py
+ * (variance and time per sample of one integrator on one scene, after
+ * changing a choice here) and `make bench-peers`. */
 #include "prepare/policy.h"
 
 #include "ajar.h"

@@ -107,8 +107,7 @@ static ajar_status setup_camera(const Scene *s, uint32_t width, uint32_t height,
  * it: on the other side of some portal triangle's plane, within its range
  * of the triangle. Its light then reaches the camera's side through the
  * opening, as an emitter's in door-ajar does, and the intermediate
- * subpaths carry it (kernels/sky_measurements.md, "Where light subpaths
- * come in, portal is bdpt"). A plane test, not a visibility test: it
+ * subpaths carry it (kernels/integrator/README.md, "A lamp behind a portal counts as an emitter"). A plane test, not a visibility test: it
  * only chooses the strategies, never the image's expectation. */
 static int lamp_behind_portal(const SceneData *d, V3 camera)
 {

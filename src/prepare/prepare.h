@@ -9,7 +9,7 @@
 #include "scene/scene.h"
 
 /* Scene features render_pass can be built without (kernel specialisation,
- * kernels/materials.md "Feature-specialised programs"): prepare_scene says
+ * kernels/material/README.md, "Feature-specialised programs"): prepare_scene says
  * which a scene lacks (kernel_omit); device_render_options makes each a -D
  * option, and the cache keys on it. */
 #define KERNEL_OMIT_ALPHA 1u        /* -DAJAR_NO_ALPHA: no TRI_ALPHA triangle */

@@ -51,7 +51,7 @@ static ajar_status device_setup(ajar_renderer *r, RenderDevice *rd, cl_platform_
 	cl_long zero = 0;
 	size_t bytes = film_bytes(r), sbytes = film_splat_bytes(r);
 	/* One program per integrator (see PARAMS_INTEGRATOR), built with
-	 * device_build_options and what AJAR_CL_OPTIONS adds (kernels/gpu.md, "On GPUs"). */
+	 * device_build_options and what AJAR_CL_OPTIONS adds (src/device/README.md, "Build options"). */
 	const char *extra = env_var(ENV_VAR_CL_OPTIONS);
 	char options[768]; /* KERNEL_OPTIONS, the plan's, the -DAJAR_NO_* and 400 of AJAR_CL_OPTIONS */
 	if (extra && strlen(extra) > 400)

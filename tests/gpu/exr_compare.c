@@ -2,7 +2,7 @@
  * of the same scene, seed and options (tests/gpu/run.sh): the mean of each
  * image, their relative difference, the share of pixels equal bit for bit
  * and the largest pixel difference. Exits 1 when the means differ by more
- * than TOL relative (default 3e-5, what kernels/gpu.md "On GPUs" states
+ * than TOL relative (default 3e-5, what kernels/README.md, "On GPUs" states
  * for the H100 against PoCL), 2 on bad input. */
 #include <math.h>
 #include <stdio.h>

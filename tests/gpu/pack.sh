@@ -10,7 +10,7 @@
 #          seed and options on the GPU), and PoCL's speed on this machine:
 #          speed.tsv, Msamples/s of one thread from its CPU time (user time),
 #          times two for "two cores" (the machine is shared: wall-clock time
-#          here is not the renderer's; kernels/README.md says how loaded)
+#          here is not the renderer's; kernels/README.md, "How the figures were measured")
 # Then, with the device tool: command "bash tests/gpu/run.sh", carry
 # ["build/gpu-carry"], timeout_s 590.
 set -eu

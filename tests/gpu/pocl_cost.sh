@@ -1,7 +1,7 @@
 #!/bin/sh
 # tests/gpu/pocl_cost.sh OUT.tsv AJAR [AJAR ...] — PoCL's cost per scene
 # and integrator on one thread, for before/after comparisons of kernel
-# changes (kernels/gpu.md, "On GPUs: subpaths in global memory"): the
+# changes (kernels/integrator/README.md, "Where subpaths live"): the
 # instructions of the render_pass kernel's code (callgrind, $AJAR_COST_CG,
 # default "32x32 2": size and spp) and the user CPU time of a render
 # ($AJAR_COST_TIME, default "64x64 8"). The binaries take turns at each

@@ -9,7 +9,7 @@
 #      private memory a work-item, for both subpath layouts (kernel_info);
 #   2. images: pt, bdpt and portal on living-room and door-ajar, 128x128 at
 #      16 spp, seed 7, on the GPU, against PoCL's (ref/, made by pack.sh):
-#      the means within 3e-5 relative (kernels/gpu.md, "On GPUs"), for
+#      the means within 3e-5 relative (src/device/README.md, "Build options"), for
 #      both subpath layouts (AJAR_SUBPATHS=private / global);
 #   3. speed: Msamples/s of each integrator and layout on living-room
 #      640x360 and door-ajar 512x512 (kernels/README.md's GPU table), against

@@ -58,7 +58,7 @@ SKY_SCENES = ("window-room-sunset window-room-forest living-room-forest window-r
 # 1,437, the sun 5% of the sky's power), so their rooms are lit mostly by the
 # sky; here the sky's sun pixels (luminance above 0.3 of the peak) are
 # multiplied, so the sun carries most of the light (forest x 60: 75%, peak
-# 81,000; kernels/sky_measurements.md, "A sun as bright as the sky's own").
+# 81,000; tests/peers/README.md, "An unclipped sun: window-room-fullsun").
 # Made from the shipped scene into build/peers/ by sun_variant; not shipped.
 SUN_VARIANTS = {"window-room-fullsun": ("window-room-forest", 60.0)}
 

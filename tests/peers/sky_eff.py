@@ -1,6 +1,5 @@
 """sky_eff.py — variance per sample and CPU time per sample of Ajar's
-integrators, for choosing strategies on the sky scenes (kernels/README.md,
-"Sky images through portals", Measurements). Not part of make test or
+integrators, for choosing strategies on the sky scenes (kernels/README.md, "How the figures were measured"). Not part of make test or
 bench-peers; run with the peers' venv:
 
   build/peers/venv/bin/python tests/peers/sky_eff.py AJAR SCENE INTEGRATOR SPP [VAR=VALUE ...]

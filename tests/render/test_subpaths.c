@@ -1,6 +1,5 @@
 /* test_subpaths.c — where bdpt's and portal's subpaths live (kernels/integrator/vertex.h,
- * src/device/device_plan.c; kernels/gpu.md, "On GPUs: subpaths in global
- * memory"): private arrays or the global scratch laid out by work-item, and
+ * src/device/device_plan.c; kernels/integrator/README.md, "Where subpaths live"): private arrays or the global scratch laid out by work-item, and
  * a pass spread over several work-items a pixel, must render the same image
  * bit for bit on the same device. On PoCL the GPU's layout is forced with
  * AJAR_SUBPATHS=global; a small AJAR_SUBPATH_CAPACITY makes every pass take

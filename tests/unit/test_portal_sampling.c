@@ -301,7 +301,7 @@ static void test_wasted_fewer(void **state)
 	/* Skies with a sun: guided <- halves aim at the sky's importance. */
 	check_wasted(NULL, sun_room(0, 3000.0f), "window-room, high sun");
 	check_wasted(NULL, sun_room(1, 3000.0f), "window-room, low sun");
-	/* The shipped sky scenes (kernels/lights.md, "Sky images through portals"). */
+	/* The shipped sky scenes (kernels/light/README.md, "Sky images through portals"). */
 	check_wasted(SCENE("window-room-forest/window-room-forest.gltf"), NULL, "window-room-forest");
 	check_wasted(SCENE("window-room-sunset/window-room-sunset.gltf"), NULL, "window-room-sunset");
 	check_wasted(SCENE("living-room-forest/living-room-forest.gltf"), NULL, "living-room-forest");
