@@ -4,39 +4,38 @@
  * (the kernels' defensive shares cover directions outside all portals), so
  * this search risks noise, never the image's expectation. It runs on the
  * host with the kernels' own traversal, from fixed seeds, single-threaded:
- * the same scene always gets the same portals. The method, in steps:
+ * the same scene always gets the same portals. The method, in steps (the
+ * record, with why and the figures: src/prepare/README.md, "Found portals"):
  *
  *  1. The camera's space. Rays from the camera in every direction; the room
- *     scale R is twice their median hit distance. Points just in front of
- *     their hits, halfway along some of them, and one diffuse bounce further
- *     are the room's points.
- *  2. Rays through openings. Rays from the room's points (cosine about a
- *     surface point's normal) that escape the scene, hit an emitter's front,
- *     or hit a point lit by a light sample the room point does not see
- *     (light from behind a door ajar). Glass (transmission > 0) counts as
- *     open: rays pass through it.
- *  3. The ring test. Such a ray went through an opening if rays around it
- *     (8 at 2, 5, 12 or 30 degrees) mostly stop well short of it: the wall
- *     the hole is in. Their hits give the wall's plane and the ray's
- *     crossing of it; a ceiling lamp or a lit wall fails the test.
- *  4. Openings. Crossings whose walls agree (25 degrees) and that lie
- *     within 0.1 R of each other join one opening.
- *  5. The waist. Over an opening's rays, the plane (among the walls and the
- *     surfaces around the hole that the rings saw, at every offset near the
- *     crossings) where the bundle of rays is narrowest is where the portal
- *     goes: a window's wall, a door's gap between the leaf and the jamb.
- *  6. Open cells. A grid over the bundle's footprint in that plane, each
- *     cell open if a ray from a room point whose ray passed near it goes
- *     through the cell and on at least a third of the opening's width
- *     (or escapes, or meets an emitter).
- *  7. Rectangles. The open cells' connected parts, each bounded by a
- *     rectangle aligned with the footprint's narrowest frame and grown by a
- *     cell; rectangles of one plane merge where one rectangle covers them
- *     with at most 25% more area (a row of panes). Rays of an opening that
- *     no rectangle catches (over a door leaf's top) are searched once more.
- *  8. Light. A rectangle behind which no light is seen (a closed room's
- *     door to a dark hall) or that takes under 0.5% of the rays is dropped;
- *     portals face into the camera's space.
+ *     scale R is twice the RMS distance of their hits from their centroid.
+ *     Points just in front of the hits, halfway along some of them, and one
+ *     diffuse bounce further are the room's points; one that sees too few of
+ *     the first hits lies behind an opening and goes.
+ *  2. Rays through openings. Cosine rays from the room's points that escape,
+ *     hit an emitter's front, or hit a point lit by a light sample the room
+ *     point does not see (lamps, emitters, and the points they light one
+ *     bounce on, behind the openings). Glass (transmission > 0) is open.
+ *  3. The ring test. Such a ray went through a hole if rays around it (8 at
+ *     2, 5, 12 or 30 degrees) mostly stop well short of it: the wall. Their
+ *     hits give the wall's plane, the ray's crossing and the surfaces near
+ *     the hole. Where few crossings pass near a place and direction, more
+ *     rays are aimed there, two rounds.
+ *  4. Where the lines crowd. On each candidate plane (the surfaces the rings
+ *     met) the open lines' crossings are rastered into patches, scored by
+ *     sqrt(lines x origins) / area^0.75; the best patch, and the runner-up
+ *     on another plane, go to step 5, the tighter result wins.
+ *  5. Open cells. A grid over the patch in its plane (moved a little beyond
+ *     the surface), a cell open if a ray from a nearby line's origin through
+ *     it escapes, meets an emitter, a point lit from outside or a point under
+ *     the sky; grown where open cells touch its border, turned to the open
+ *     cells' own frame where that is much narrower; parts touching the border
+ *     still are no openings. Each part's rectangle, its edges bisected onto
+ *     the opening's.
+ *  6. Portals. Rectangles with light behind them close the lines they catch;
+ *     again until under MIN_SHARE of the lines remain. Rectangles of nearly
+ *     one plane merge where one covers them with little more area (a row of
+ *     panes). Portals face the side their lines come from.
  *
  * A scene without openings (a closed box, a room lit only by a lamp in it)
  * gets none: nothing escapes, and lit points inside fail the ring test. */
@@ -44,8 +43,8 @@
 
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <stdio.h>
+#include <time.h>
 
 #include "core/error.h"
 #include "geom/bvh.h"
@@ -75,7 +74,7 @@
 #define RING_NEAR 0.85f
 #define RING_NORMALS 16    /* hit normals kept per crossing */
 #define NEAR_START 0.1f    /* x R: crossings nearer their start are left out */
-#define MAX_PLANES 32      /* step 5: surfaces around the holes tried */
+#define MAX_PLANES 32      /* step 4: surfaces around the holes tried */
 #define PATCH_CELL 0.01f   /* x R: cells of the crossings' raster on a plane */
 #define PATCH_JOIN 3       /* crossings this many cells apart join one patch */
 #define PATCH_FLOOR 0.05f  /* x R: a patch counts as at least this square */
@@ -85,7 +84,7 @@
 #define RUNNER_UP 0.5      /* a patch on another plane this close to the best is tried too */
 #define MEET_DN 0.05f      /* a line crossing a portal at a shallower cosine does not count */
 #define PLANE_OFFSET 1e-3f /* x R: a portal lies this far beyond the surface it was found in */
-#define GRID 64            /* step 6: cells a side */
+#define GRID 64            /* step 5: cells a side */
 #define CELL_ORIGINS 3
 #define SKY_RAYS 4         /* a point under the sky: SKY_SEEN of SKY_RAYS rays escape */
 #define SKY_SEEN 2
@@ -94,10 +93,14 @@
 #define EDGE_STEPS 4       /* bisections of each edge of a rectangle (to 1/16 cell) */
 #define EDGE_PROBES 16     /* points along it each */
 #define EDGE_MARGIN 0.25f  /* x a cell: a rectangle's margin beyond its opening */
+#define SLIDE_STEP 0.005f  /* x R: a rectangle slides out through a tunnel by these steps */
+#define SLIDE_STEPS 24
+#define RIM_GAP 0.03f      /* x its size: its rim lies this far outside it */
+#define SLIDE_SOLID 0.1f   /* x R */
 #define CONNECT 2          /* open cells this many cells apart join */
-#define MERGE_AREA 1.25    /* step 7 */
+#define MERGE_AREA 1.25    /* step 6 */
 #define MERGE_GAP 0.03f    /* x R: rectangles of planes this close may merge */
-#define MIN_SHARE 0.02f    /* step 8 */
+#define MIN_SHARE 0.02f    /* lines a portal must catch */
 #define MAX_PORTALS 16
 
 typedef struct {
@@ -996,6 +999,45 @@ static float refine_edge(Ctx *c, const CellPlane *cp, int axis, float closed, fl
 	return closed;
 }
 
+/* Slides rectangle r outward (along -n) through a tunnel: a roof slab's
+ * opening, a window in a thick wall, found at the face the room sees. It
+ * moves by SLIDE_STEP R while, in the moved plane, its inside stays open
+ * (9 in 10 points) and its rim (points just outside its edges) lies inside
+ * solid matter (9 in 10 of them meet a surface within SLIDE_SOLID R both
+ * ways along n): still in the tunnel, not yet out in the open.
+ * A sun's light enters at the tunnel's far end, where no light path that
+ * grazes in past its edge is lost. */
+static void slide_out(Ctx *c, const CellPlane *cp, Rect *r)
+{
+	float w1 = r->hi1 - r->lo1, w2 = r->hi2 - r->lo2, rim = RIM_GAP * fmax(w1, w2);
+	int good = 0;
+	for (int k = 1; k <= SLIDE_STEPS; k++) {
+		CellPlane moved = *cp;
+		moved.o = v3_madd(cp->o, cp->n, -(float)k * SLIDE_STEP * c->R);
+		int in = 0, solid = 0;
+		for (int q = 0; q < 36; q++) {
+			float f1 = ((float)(q % 6) + 0.5f) / 6.0f, f2 = ((float)(q / 6) + 0.5f) / 6.0f;
+			in += point_open(c, &moved, r->lo1 + (0.1f + 0.8f * f1) * w1, r->lo2 + (0.1f + 0.8f * f2) * w2,
+					 (uint32_t)q);
+			/* Rim points, around the four edges in turn. */
+			float t = ((float)(q / 4) + 0.5f) / 9.0f, p1, p2;
+			switch (q % 4) {
+			case 0: p1 = r->lo1 - rim, p2 = r->lo2 + t * w2; break;
+			case 1: p1 = r->hi1 + rim, p2 = r->lo2 + t * w2; break;
+			case 2: p1 = r->lo1 + t * w1, p2 = r->lo2 - rim; break;
+			default: p1 = r->lo1 + t * w1, p2 = r->hi2 + rim; break;
+			}
+			V3 X = v3_add(moved.o, v3_add(v3_scale(cp->a1, p1), v3_scale(cp->a2, p2)));
+			Solid sa, sb;
+			solid += trace(c, X, cp->n, SLIDE_SOLID * c->R, &sa) && trace(c, X, v3_neg(cp->n), SLIDE_SOLID * c->R, &sb);
+		}
+		if (in < 32 || solid < 32)
+			break;
+		good = k;
+	}
+	r->o = v3_madd(r->o, r->n, -(float)good * SLIDE_STEP * c->R);
+}
+
 /* Open cells of plane (n, s) over the footprint, their connected parts as
  * rectangles into rs; the lines each rectangle catches are marked in
  * caught (steps 6 and 7). */
@@ -1188,6 +1230,7 @@ static ajar_status open_rects(Ctx *c, const Crossing *xs, const uint32_t *idx, u
 				hits++;
 				caught[yl[q]] = 1;
 			}
+		slide_out(c, &cp, &r);
 		r.share = (float)hits / (float)total;
 		if (!rect_add(rs, &r)) {
 			st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "portal search: out of memory");

@@ -107,17 +107,24 @@ static ajar_status setup_camera(const Scene *s, uint32_t width, uint32_t height,
  * it: on the other side of some portal triangle's plane, within its range
  * of the triangle. Its light then reaches the camera's side through the
  * opening, as an emitter's in door-ajar does, and the intermediate
- * subpaths carry it (kernels/integrator/README.md, "A lamp behind a portal counts as an emitter"). A plane test, not a visibility test: it
- * only chooses the strategies, never the image's expectation. */
+ * subpaths carry it (kernels/integrator/README.md, "Where light subpaths
+ * come in, portal is bdpt"). The camera's side is the side the camera is
+ * on for marked portals, and the side a found portal faces (it faces where
+ * the room's rays through it came from: a door's gap found in the jamb's
+ * plane has the camera and the lamp on one geometric side). A plane test,
+ * not a visibility test: it only chooses the strategies, never the
+ * image's expectation. */
 static int lamp_behind_portal(const SceneData *d, V3 camera)
 {
+	int found = d->portal_source == POLICY_PORTALS_FOUND;
 	for (uint32_t i = 0; i < d->lights.nlights; i++) {
 		const PunctualLight *l = &d->lights.lights[i];
 		if (l->type == LIGHT_DIRECTIONAL)
 			continue;
 		for (size_t k = 0; k < d->n_portals; k++) {
 			const PortalTri *t = &d->portals[k];
-			float side_cam = v3_dot(t->n, v3_sub(camera, t->p0)), side_l = v3_dot(t->n, v3_sub(l->pos, t->p0));
+			float side_cam = found ? 1.0f : v3_dot(t->n, v3_sub(camera, t->p0)),
+			      side_l = v3_dot(t->n, v3_sub(l->pos, t->p0));
 			if (!(side_cam * side_l < 0.0f))
 				continue;
 			float near = fminf(v3_len(v3_sub(l->pos, t->p0)),
