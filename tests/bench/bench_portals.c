@@ -12,9 +12,13 @@
  * Error measure (no reference needed; every render is unbiased): the
  * relative variance of one render, mean over pixels and channels of
  * (a - b)^2 / 2 / (r^2 + (0.1 mean r)^2), a and b the two seeds' images and
- * r the mean of all six renders: relMSE at equal time. Printed: spp, the
- * error, found/marked (the issue's target: at most 1.25) and none/found (at
- * least 5), and the search's time beside the render time.
+ * r the mean of all six renders: relMSE at equal time. The machine may be
+ * shared, and a render's samples then follow the others' load: the ratios
+ * are taken at equal CPU time, relvar x CPU seconds of the render (user and
+ * system, every thread; relMSE at equal CPU time is proportional to it),
+ * and at equal wall time as rendered. Printed: spp, the error, CPU
+ * seconds, found/marked (the target: at most 1.25) and none/found (at least
+ * 5), and the search's time beside the render time.
  *
  * AJAR_BENCH_SECONDS (default 10) per render, AJAR_BENCH_SIZE (default 64),
  * AJAR_BENCH_SCENES (comma-separated names) picks scenes; each scene's
@@ -23,6 +27,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 
 #include "ajar.h"
 #include "scene/scene.h"
@@ -54,8 +59,15 @@ static void check(ajar_status st)
 }
 
 /* Renders two seeds of s for `secs` each into img[0], img[1]. */
+static double cpu_seconds(void)
+{
+	struct rusage u;
+	getrusage(RUSAGE_SELF, &u);
+	return u.ru_utime.tv_sec + u.ru_utime.tv_usec * 1e-6 + u.ru_stime.tv_sec + u.ru_stime.tv_usec * 1e-6;
+}
+
 static void render2(ajar_scene *s, ajar_integrator integ, ajar_portals portals, uint32_t size, double secs, float *img[2],
-		    uint32_t spp[2], double *search)
+		    uint32_t spp[2], double *search, double *cpu)
 {
 	ajar_options o;
 	ajar_options_default(&o);
@@ -69,9 +81,12 @@ static void render2(ajar_scene *s, ajar_integrator integ, ajar_portals portals, 
 	uint32_t n = 0;
 	*search = 0.0;
 	check(ajar_renderer_found_portals(r, NULL, 0, &n, search));
+	*cpu = 0.0;
 	for (int k = 0; k < 2; k++) {
 		check(ajar_renderer_restart(r, 1000u + 17u * (uint32_t)k));
+		double c0 = cpu_seconds();
 		check(ajar_renderer_render(r, NULL, NULL));
+		*cpu += 0.5 * (cpu_seconds() - c0);
 		check(ajar_renderer_image(r, img[k], NULL, NULL));
 		spp[k] = ajar_renderer_spp(r);
 	}
@@ -101,8 +116,9 @@ int main(void)
 	size_t npix = (size_t)size * size;
 	printf("found portals against marked ones: %ux%u, %.0f s a render, two seeds; relative variance of one render\n",
 	       size, size, secs);
-	printf("%-20s %-7s %-22s %-22s %-22s %8s %8s %9s\n", "scene", "integ", "marked (spp, relvar)",
-	       "found (spp, relvar)", "none, pt (spp, relvar)", "fnd/mrk", "none/fnd", "search s");
+	printf("%-19s %-6s %-24s %-24s %-24s %7s %8s %7s %8s %8s\n", "scene", "integ", "marked (spp relvar cpu)",
+	       "found (spp relvar cpu)", "none, pt (spp relvar cpu)", "fnd/mrk", "none/fnd", "(wall:", "f/m", "n/f)");
+	printf("%-19s %-6s %-24s %-24s %-24s %7s %8s %7s %8s %8s\n", "", "", "", "", "", "cpu", "cpu", "", "", "");
 	for (size_t i = 0; i < sizeof scenes / sizeof scenes[0]; i++) {
 		const BenchScene *b = &scenes[i];
 		if (only) {
@@ -126,13 +142,13 @@ int main(void)
 		stripped->nportal_tris = stripped->nportals = 0; /* the portal nodes taken out */
 		float *img[3][2];
 		uint32_t spp[3][2];
-		double search[3];
+		double search[3], cpu[3];
 		for (int v = 0; v < 3; v++)
 			for (int k = 0; k < 2; k++)
 				img[v][k] = malloc(sizeof(float) * 4 * npix);
-		render2(marked, integ, AJAR_PORTALS_DEFAULT, size, secs, img[0], spp[0], &search[0]);
-		render2(stripped, integ, AJAR_PORTALS_DEFAULT, size, secs, img[1], spp[1], &search[1]);
-		render2(stripped, AJAR_INTEGRATOR_PT, AJAR_PORTALS_NONE, size, secs, img[2], spp[2], &search[2]);
+		render2(marked, integ, AJAR_PORTALS_DEFAULT, size, secs, img[0], spp[0], &search[0], &cpu[0]);
+		render2(stripped, integ, AJAR_PORTALS_DEFAULT, size, secs, img[1], spp[1], &search[1], &cpu[1]);
+		render2(stripped, AJAR_INTEGRATOR_PT, AJAR_PORTALS_NONE, size, secs, img[2], spp[2], &search[2], &cpu[2]);
 		double *ref = calloc(3 * npix, sizeof *ref);
 		for (int v = 0; v < 3; v++)
 			for (int k = 0; k < 2; k++)
@@ -142,11 +158,12 @@ int main(void)
 		double e[3];
 		for (int v = 0; v < 3; v++)
 			e[v] = rel_var(img[v], ref, npix);
-		char cell[3][32];
+		char cell[3][40];
 		for (int v = 0; v < 3; v++)
-			snprintf(cell[v], sizeof cell[v], "%u, %.3g", (spp[v][0] + spp[v][1]) / 2, e[v]);
-		printf("%-20s %-7s %-22s %-22s %-22s %8.2f %8.1f %9.3f\n", b->name, integ_name(integ), cell[0], cell[1],
-		       cell[2], e[1] / e[0], e[2] / e[1], search[1]);
+			snprintf(cell[v], sizeof cell[v], "%u %.3g %.1f", (spp[v][0] + spp[v][1]) / 2, e[v], cpu[v]);
+		printf("%-19s %-6s %-24s %-24s %-24s %7.2f %8.1f %7s %8.2f %8.1f   search %.3f s\n", b->name,
+		       integ_name(integ), cell[0], cell[1], cell[2], e[1] * cpu[1] / (e[0] * cpu[0]),
+		       e[2] * cpu[2] / (e[1] * cpu[1]), "", e[1] / e[0], e[2] / e[1], search[1]);
 		fflush(stdout);
 		for (int v = 0; v < 3; v++)
 			for (int k = 0; k < 2; k++)
