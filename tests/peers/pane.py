@@ -1,5 +1,5 @@
 """pane.py — each renderer's smooth thin pane against glTF's thin-walled model,
-analytically (`sh tests/peers/run.sh pane`, about a minute).
+analytically (`sh tests/peers/run.sh pane`, seconds).
 
 A camera with a narrow view (yfov 0.02) looks at a pane of KHR_materials_transmission
 1 (ior 1.5, a tinted base colour, no volume: thin-walled) at PANE_ANGLE degrees (70)
