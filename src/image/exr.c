@@ -346,9 +346,10 @@ static void exr_close(ExrReader *r)
 /* Limits on what a header may declare, checked before anything is
  * allocated for it: a file of a few hundred bytes can declare any size, and
  * its allocation failing would report "out of memory" for a bad file.
- * 2^29 pixels is 8 GiB of float RGBA, a 32768 x 16384 sky. */
+ * 2^28 pixels is 4 GiB of float RGBA, a 16384 x 16384 image: the largest
+ * Ajar renders (skies are held to less, src/scene/scene.c). */
 #define EXR_MAX_SIDE 65536
-#define EXR_MAX_PIXELS ((int64_t)1 << 29)
+#define EXR_MAX_PIXELS ((int64_t)1 << 28)
 /* A tile may exceed the image (a 7 x 5 image in 64 x 64 tiles), not both
  * this and the image's side: the C++ library allocates whole tiles. */
 #define EXR_MAX_TILE_SIDE 1024
@@ -429,6 +430,29 @@ static ajar_status exr_check_size(const char *path, const ExrReader *r, exr_stor
 			       "%s: truncated: %lld bytes cannot hold the offsets of its %d chunks", path,
 			       (long long)sb.st_size, chunks);
 	return AJAR_OK;
+}
+
+ajar_status exr_read_size(const char *path, uint32_t *width, uint32_t *height)
+{
+	ExrReader r;
+	ajar_status st = exr_open(path, &r);
+	if (st != AJAR_OK)
+		return st;
+	exr_storage_t storage;
+	exr_attr_box2i_t dw;
+	exr_result_t rv = exr_get_storage(r.ctxt, 0, &storage);
+	if (rv == EXR_ERR_SUCCESS)
+		rv = exr_get_data_window(r.ctxt, 0, &dw);
+	if (rv != EXR_ERR_SUCCESS)
+		st = err_set(AJAR_ERROR_BAD_INPUT, "%s: OpenEXR header: %s", path, exr_why(rv));
+	else
+		st = exr_check_size(path, &r, storage, &dw);
+	if (st == AJAR_OK) {
+		*width = (uint32_t)((int64_t)dw.max.x - dw.min.x + 1);
+		*height = (uint32_t)((int64_t)dw.max.y - dw.min.y + 1);
+	}
+	exr_close(&r);
+	return st;
 }
 
 ajar_status ajar_read_exr(const char *path, float **rgba, uint32_t *width, uint32_t *height)

@@ -16,6 +16,9 @@ extern "C" {
  * one of another type is AJAR_ERROR_BAD_INPUT; a value longer than the
  * buffer is AJAR_ERROR_INVALID_ARGUMENT. */
 ajar_status exr_read_attr(const char *path, const char *name, char *value, size_t cap);
+/* The size of part 0 from the header alone, after the checks
+ * ajar_read_exr makes before it allocates: errors as it gives them. */
+ajar_status exr_read_size(const char *path, uint32_t *width, uint32_t *height);
 
 /* Writes nch float channels named names[0..nch-1], interleaved per pixel
  * in `px` (top row first), with string attributes as in ajar_write_exr. */

@@ -552,7 +552,16 @@ ajar_status scene_load_env_image(Scene *s, const char *path, float strength)
 		ajar_status st = hdr_read(path, &rgba, &w, &h);
 		return st ? st : set_env_image(s, path, w, h, rgba, strength);
 	}
-	ajar_status st = ajar_read_exr(path, &rgba, &w, &h);
+	/* The size from the header first: an environment image is held to
+	 * SCENE_SKY_MAX_PIXELS before its pixels are allocated. */
+	ajar_status st = exr_read_size(path, &w, &h);
+	if (st)
+		return st;
+	if ((uint64_t)w * h > SCENE_SKY_MAX_PIXELS)
+		return err_set(AJAR_ERROR_BAD_INPUT,
+			       "%s: environment: %ux%u pixels; a sky has at most %llu (16384 x 8192, 2 GiB as it is read)",
+			       path, w, h, (unsigned long long)SCENE_SKY_MAX_PIXELS);
+	st = ajar_read_exr(path, &rgba, &w, &h);
 	if (st)
 		return st;
 	/* Reuse the RGBA allocation for the packed RGB the scene keeps. */

@@ -16,6 +16,11 @@
 extern "C" {
 #endif
 
+/* The largest environment image: 2^27 pixels (a 16384 x 8192 sky, 2 GiB
+ * of float RGBA as it is read), from the header before the pixels are
+ * allocated; image/hdr.c holds .hdr files to the same. */
+#define SCENE_SKY_MAX_PIXELS ((uint64_t)1 << 27)
+
 /* The public ajar_scene handle is this struct. */
 typedef struct ajar_scene {
 	char *source;            /* file name for messages, or "<api>" */

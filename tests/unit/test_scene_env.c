@@ -255,6 +255,29 @@ static void test_environment_hdr_hostile(void **state)
 	ajar_scene_destroy(&s);
 }
 
+/* An EXR sky whose header declares 16384 x 16384 pixels (as many as the EXR
+ * reader takes, twice what a sky may have): refused from its header, before
+ * 4 GiB are allocated for pixels it does not have. */
+static void test_environment_exr_too_large(void **state)
+{
+	char *p = test_tmp("huge.exr");
+	const float px[4] = {1, 1, 1, 1};
+	assert_int_equal(ajar_write_exr(p, px, 1, 1, NULL, 0), AJAR_OK);
+	FILE *f = fopen(p, "rb");
+	unsigned char buf[16384] = {0};
+	size_t n = fread(buf, 1, sizeof buf, f);
+	fclose(f);
+	static const char key[] = "dataWindow\0box2i";
+	unsigned char *at = memmem(buf, n, key, sizeof key);
+	assert_non_null(at);
+	const int32_t box[4] = {0, 0, 16383, 16383};
+	memcpy(at + sizeof key + 4, box, sizeof box);
+	write_bytes("huge.exr", buf, sizeof buf); /* long enough for its 1024 chunk offsets */
+	write_tri_gltf("huge.gltf", "0", "{\"mesh\":0}", ",\"extras\":{\"environment\":{\"image\":\"huge.exr\"}}");
+	load_fails("huge.gltf", AJAR_ERROR_BAD_INPUT, "huge.exr: environment: 16384x16384 pixels; a sky has at most 134217728");
+	free(p);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -263,6 +286,7 @@ int main(void)
 		cmocka_unit_test(test_environment_rotation),
 		cmocka_unit_test(test_environment_hdr),
 		cmocka_unit_test(test_environment_hdr_hostile),
+		cmocka_unit_test(test_environment_exr_too_large),
 	};
 	return cmocka_run_group_tests(tests, test_group_setup, test_group_teardown);
 }
