@@ -101,10 +101,12 @@ static float box_area(const Box *b)
 /* Centroid times two: only compared, never used as a position. */
 static float ref_key(const Ref *r, int axis) { return r->b.lo[axis] + r->b.hi[axis]; }
 
+/* Clamped before the cast: a NaN or huge position (e.g. the builder API's
+ * sums near FLT_MAX) is a bad bin, never undefined behaviour. */
 static int bin_of(float key, float cmin, float scale, int nbins)
 {
-	int k = (int)((key - cmin) * scale);
-	return k < 0 ? 0 : (k >= nbins ? nbins - 1 : k);
+	float f = (key - cmin) * scale;
+	return !(f > 0.0f) ? 0 : (f >= (float)nbins ? nbins - 1 : (int)f);
 }
 
 /* Reorders r[0, n) so that r[k] has the k-th smallest key on `axis` and

@@ -165,10 +165,16 @@ ajar_status scene_add_texture_use(Scene *s, uint32_t image, int flags, const flo
 	return AJAR_OK;
 }
 
+/* Coordinates and directions are finite and at most SCENE_MAX_COORD in
+ * size, so their squares (lengths, areas, the BVH's centroid sums) stay
+ * finite in float: a vertex at 3e38, finite, gave NaN bins in the BVH
+ * (fuzz_gltf, UBSan: NaN cast to int). */
+#define SCENE_MAX_COORD 1e18f
+
 static int all_finite(const float *v, size_t n)
 {
 	for (size_t i = 0; i < n; i++)
-		if (!isfinite(v[i]))
+		if (!(fabsf(v[i]) <= SCENE_MAX_COORD))
 			return 0;
 	return 1;
 }
@@ -185,7 +191,8 @@ static ajar_status check_geometry(const Scene *s, const char *what, const float 
 			       s->source, what, ntris, SCENE_MAX_ITEMS);
 	for (uint32_t v = 0; v < nverts; v++)
 		if (!all_finite(pos + 3 * (size_t)v, 3))
-			return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: vertex %u: position (%g, %g, %g) is not finite",
+			return err_set(AJAR_ERROR_BAD_INPUT,
+				       "%s: %s: vertex %u: position (%g, %g, %g) is not finite or beyond 1e18",
 				       s->source, what, v, pos[3 * (size_t)v], pos[3 * (size_t)v + 1],
 				       pos[3 * (size_t)v + 2]);
 	if (!idx) {
@@ -399,15 +406,14 @@ ajar_status scene_add_portal(Scene *s, const char *what, const float *pos, uint3
 	return AJAR_OK;
 }
 
-static int v3_finite(V3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
-
 ajar_status scene_add_light(Scene *s, const char *what, const ajar_light *l)
 {
 	const float *num[] = {l->position, l->direction, l->color};
 	for (int k = 0; k < 3; k++)
 		for (int j = 0; j < 3; j++)
-			if (!isfinite(num[k][j]))
-				return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: position, direction or colour is not finite",
+			if (!(k == 2 ? isfinite(num[k][j]) : fabsf(num[k][j]) <= SCENE_MAX_COORD))
+				return err_set(AJAR_ERROR_BAD_INPUT,
+					       "%s: %s: position, direction or colour is not finite (or beyond 1e18)",
 					       s->source, what);
 	if (l->type != AJAR_LIGHT_DIRECTIONAL && l->type != AJAR_LIGHT_POINT && l->type != AJAR_LIGHT_SPOT)
 		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: unknown light type %d", s->source, what, (int)l->type);
@@ -448,9 +454,10 @@ ajar_status scene_add_light(Scene *s, const char *what, const ajar_light *l)
 
 ajar_status scene_set_camera(Scene *s, V3 pos, V3 forward, V3 up, float yfov, float aspect)
 {
-	if (!v3_finite(pos) || !v3_finite(forward) || !v3_finite(up))
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: camera: position or orientation is not finite",
-			       s->source);
+	const float c[9] = {pos.x, pos.y, pos.z, forward.x, forward.y, forward.z, up.x, up.y, up.z};
+	if (!all_finite(c, 9))
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT,
+			       "%s: camera: position or orientation is not finite (or beyond 1e18)", s->source);
 	if (!(yfov > 0.0f && yfov < AJAR_PI))
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: camera: yfov %g is not in (0, pi)", s->source,
 			       yfov);
