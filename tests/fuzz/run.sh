@@ -6,13 +6,15 @@
 # report, leak, input slower than 10 s or allocation past the limits is a
 # finding: its input is kept in build/fuzz/findings/ and the script exits
 # 1. Prints each harness's executions, executions per second and coverage.
+# FUZZ_BIN_DIR runs harnesses from elsewhere (a long campaign's copies, so
+# a rebuild meanwhile does not change what runs).
 set -u
 seconds=$1
 shift
 status=0
 mkdir -p build/fuzz/findings
 for t in "$@"; do
-	bin=build/fuzz/fuzzers/fuzz_$t
+	bin=${FUZZ_BIN_DIR:-build/fuzz/fuzzers}/fuzz_$t
 	mkdir -p build/fuzz/corpus/$t
 	log=build/fuzz/fuzz_$t.log
 	# 4200 MB: above the largest allocation the limits allow (an EXR of
