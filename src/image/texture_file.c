@@ -55,7 +55,11 @@ static const stbi_io_callbacks callbacks = {cb_read, cb_skip, cb_eof};
  * Huffman table's code counts: counts summing past 256 write past its
  * tables (fuzz_texture found it: UBSan, index 257 of size[257]), so every
  * table (DHT, also between the scans of a progressive file) must hold at
- * most 256 codes and fit its segment. Every scan codes each 8 x 8 block of
+ * most 256 codes and fit its segment. stb also decodes with tables never
+ * defined, whose memory it never set (its index of the symbol came out
+ * 1,062,821,993: an out-of-bounds read, fuzz_texture after 3.4M runs), so
+ * every scan's tables must be defined before it: DC and AC for sequential
+ * files; for progressive ones DC on a first DC scan, AC on an AC scan. Every scan codes each 8 x 8 block of
  * a component with at least one bit (its DC coefficient, or an end-of-band
  * run covering it), so the first component's blocks at its sampling need
  * that many bits: *min_bytes. Returns a reason to refuse, or NULL (also for
@@ -70,6 +74,8 @@ static const char *jpeg_check(const unsigned char *p, size_t n, size_t *min_byte
 	if (n < 4 || p[0] != 0xff || i >= n || p[i] != 0xd8)
 		return NULL;
 	i++;
+	unsigned defined = 0; /* Huffman tables defined: bit id for DC, 4 + id for AC */
+	int progressive = 0;
 	while (i + 4 <= n) {
 		if (p[i] != 0xff) { /* entropy-coded data up to the next marker */
 			i++;
@@ -91,6 +97,7 @@ static const char *jpeg_check(const unsigned char *p, size_t n, size_t *min_byte
 			return "a marker segment shorter than its length field";
 		if (m == 0xc4) { /* DHT: tables of class/id, 16 counts, their values */
 			for (size_t t = i + 4; t < end && t < n;) {
+				defined |= 1u << ((p[t] >> 4 & 1) * 4 + (p[t] & 3));
 				size_t codes = 0;
 				for (size_t k = 0; k < 16 && t + 1 + k < n; k++)
 					codes += p[t + 1 + k];
@@ -101,7 +108,23 @@ static const char *jpeg_check(const unsigned char *p, size_t n, size_t *min_byte
 					return "a Huffman table longer than its segment";
 			}
 		}
+		if (m == 0xda && i + 5 <= n) { /* SOS: components' table ids, then Ss, Se, Ah/Al */
+			unsigned ns = p[i + 4], need = 0;
+			size_t after = i + 5 + 2 * (size_t)ns;
+			int dc_first = after + 2 < n && p[after] == 0 && p[after + 2] >> 4 == 0, ac = after < n && p[after] > 0;
+			for (unsigned c = 0; c < ns && i + 6 + 2 * (size_t)c < n; c++) {
+				unsigned td = p[i + 6 + 2 * c] >> 4 & 3, ta = p[i + 6 + 2 * c] & 3;
+				if (!progressive || dc_first)
+					need |= 1u << td;
+				if (!progressive || ac)
+					need |= 1u << (4 + ta);
+			}
+			if (need & ~defined)
+				return "a scan uses a Huffman table never defined";
+		}
 		int sof = m >= 0xc0 && m <= 0xcf && m != 0xc4 && m != 0xc8 && m != 0xcc;
+		if (sof)
+			progressive = m == 0xc2 || m == 0xc6 || m == 0xca || m == 0xce;
 		if (sof && !*min_bytes && i + 4 + 6 + 3 <= n && len >= 8) {
 			const unsigned char *f = p + i + 4; /* precision, height, width, components */
 			size_t h = (size_t)f[1] << 8 | f[2], w = (size_t)f[3] << 8 | f[4];

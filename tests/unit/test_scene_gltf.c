@@ -373,8 +373,9 @@ static void spill_image(void *ctx, void *data, int n)
 }
 
 /* test_dir/name: an 8 x 8 JPEG (or PNG) whose header declares w x h, cut
- * to `keep` bytes (0: whole); w < 0: a JPEG whose first Huffman table
- * counts 512 codes. */
+ * to `keep` bytes (0: whole); w = -1: a JPEG whose first Huffman table
+ * counts 512 codes; w = -2: one whose scan uses an AC table never defined
+ * (stb read tables it never set: an out-of-bounds read, fuzz_texture). */
 static void write_lying_image(const char *name, int jpeg, int w, int h, size_t keep)
 {
 	unsigned char rgb[8 * 8 * 3];
@@ -399,7 +400,14 @@ static void write_lying_image(const char *name, int jpeg, int w, int h, size_t k
 	fclose(f);
 	for (size_t i = 0; jpeg && w < 0 && i + 21 < n; i++)
 		if (buf[i] == 0xff && buf[i + 1] == 0xc4) { /* DHT: length, class/id, 16 counts */
-			memset(buf + i + 5, 0x20, 16);   /* 512 codes: stb wrote past its tables */
+			if (w == -1) {
+				memset(buf + i + 5, 0x20, 16); /* 512 codes: stb wrote past its tables */
+			} else { /* the second table, AC 0, becomes DC 0 again: AC 0 is never defined */
+				size_t codes = 0;
+				for (int k = 0; k < 16; k++)
+					codes += buf[i + 5 + k];
+				buf[i + 4 + 17 + codes] = 0x00;
+			}
 			w = h = 8;
 			break;
 		}
@@ -435,6 +443,7 @@ static void test_lying_images(void **state)
 		{"junk.png", 0, 8, 8, 20, "'junk.png'): "},
 		{"dht.jpg", 1, -1, -1, 0, "'dht.jpg'): corrupt JPEG: a Huffman table of more than 256 codes"},
 		{"tga.png", 2, 0, 0, 0, "'tga.png'): not a PNG or JPEG image"},
+		{"noac.jpg", 1, -2, -2, 0, "'noac.jpg'): corrupt JPEG: a scan uses a Huffman table never defined"},
 	};
 	for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
 		write_lying_image(cases[k].name, cases[k].jpeg, cases[k].w, cases[k].h, cases[k].keep);
