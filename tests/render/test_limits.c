@@ -169,9 +169,10 @@ static void test_checkpoint_films(void **state)
 /* A checkpoint whose options no render can have (each field of the
  * header in turn, the CRC made valid): bad input naming the file, from
  * ajar_checkpoint_options and ajar_renderer_resume (a crafted file gave
- * exit 1, and 22 of 41 such messages did not name it). The header: magic,
- * format, version[16], two hashes, scene[256] (300 bytes), then 11 u32
- * options from width to aov, time_limit and elapsed. */
+ * exit 1, and 22 of 41 such messages did not name it). The header
+ * (src/render/checkpoint_file.c): magic, format, version[16], two hashes,
+ * scene[256] (300 bytes), then 12 u32 options from width to aov and
+ * portals, and the f64 time_limit, noise and elapsed. */
 static void test_checkpoint_options(void **state)
 {
 	char *ck = test_tmp("options.ckpt");
@@ -181,12 +182,12 @@ static void test_checkpoint_options(void **state)
 	static const struct {
 		size_t at;
 		uint32_t v;
-	} u32s[] = {{308, 7},  {312, 5000},	  {316, 100}, {324, 9},	   {328, 9},
-		    {332, 2},  {336, 3000000}, {340, 0x40}, {312, 0}};
+	} u32s[] = {{308, 7}, {312, 5000}, {316, 100}, {324, 9}, {328, 9},
+		    {332, 2}, {336, 3000000}, {340, 0x40}, {344, 9}, {312, 0}};
 	static const struct {
 		size_t at;
 		double v;
-	} f64s[] = {{344, -1.0}, {344, NAN}, {352, NAN}, {352, -5.0}};
+	} f64s[] = {{348, -1.0}, {348, NAN}, {356, -0.5}, {356, 2.0}, {364, NAN}, {364, -5.0}};
 	size_t cases = sizeof u32s / sizeof u32s[0] + sizeof f64s / sizeof f64s[0];
 	unsigned char *bad = malloc(n);
 	for (size_t k = 0; k < cases; k++) {
