@@ -9,7 +9,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "ajar.h"
 #include "device/device_build.h"
@@ -201,6 +204,104 @@ static double startup(const char *cache, int cold)
 	return now() - t0;
 }
 
+/* ---- Scale: the big scenes of issue 42 ---------------------------------- */
+
+/* One `ajar render SCENE --spp 1` in a child process: its wall time (start
+ * to the end of the first pass, the EXR of 64x48 pixels written), peak RSS
+ * (getrusage of the child: every page it ever held) and the load and BVH
+ * times its log names. Kernel caches warm (the caller runs it once before). */
+static void scale_row(const char *dir, const char *name, int quiet)
+{
+	char scene[512], log[512], cmd[2048];
+	snprintf(scene, sizeof scene, "build/scale/%s.gltf", name);
+	snprintf(log, sizeof log, "%s/scale.log", dir);
+	snprintf(cmd, sizeof cmd, "exec build/ajar render %s -o %s/scale.exr --spp 1 --size 64x48 2> %s", scene, dir,
+		 log);
+	double t0 = now();
+	pid_t pid = fork();
+	if (pid == 0) {
+		execl("/bin/sh", "sh", "-c", cmd, (char *)NULL);
+		_exit(127);
+	}
+	int status = 0;
+	struct rusage ru;
+	if (pid < 0 || wait4(pid, &status, 0, &ru) < 0) {
+		fprintf(stderr, "bench: cannot run %s\n", cmd);
+		exit(1);
+	}
+	double wall = now() - t0;
+	if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+		printf("%-14s exit %d (%s)\n", name, WIFEXITED(status) ? WEXITSTATUS(status) : -1,
+		       WEXITSTATUS(status) == 6 ? "out of memory" : "failed");
+		return;
+	}
+	/* The render log's counts and times (src/cli/commands.c). */
+	double load = -1, bvh = -1;
+	unsigned long long tris = 0, unique = 0, inst = 0;
+	FILE *f = fopen(log, "r");
+	char line[1024];
+	while (f && fgets(line, sizeof line, f)) {
+		const char *p;
+		if ((p = strstr(line, "loaded in ")))
+			load = atof(p + 10);
+		if ((p = strstr(line, "BVH built in ")))
+			bvh = atof(p + 13);
+		if ((p = strstr(line, " triangles (")))
+			sscanf(p - 20 > line ? p - 20 : line, "%*[^0-9]%llu triangles (%llu unique, %llu instances",
+			       &tris, &unique, &inst);
+	}
+	if (f)
+		fclose(f);
+	if (quiet)
+		return;
+	double peak = (double)ru.ru_maxrss * 1024.0; /* kilobytes on Linux */
+	printf("%-14s %11llu tris %10llu unique %5llu inst  peak %7.0f MiB  %6.1f B/tri (unique)  "
+	       "to first pass %6.2f s (cpu %6.2f s)  load %6.2f s  BVH %6.2f s\n",
+	       name, tris, unique, inst, peak / 1048576.0, unique ? peak / (double)unique : 0.0, wall,
+	       (double)ru.ru_utime.tv_sec + ru.ru_utime.tv_usec * 1e-6 + ru.ru_stime.tv_sec +
+		       ru.ru_stime.tv_usec * 1e-6,
+	       load, bvh);
+}
+
+/* Whether the comma-separated `list` names `name` exactly (NULL: all). */
+static int in_list(const char *list, const char *name)
+{
+	size_t n = strlen(name);
+	for (const char *p = list; p; p = strchr(p, ',') ? strchr(p, ',') + 1 : NULL)
+		if (!strncmp(p, name, n) && (p[n] == ',' || p[n] == '\0'))
+			return 1;
+	return list == NULL;
+}
+
+/* The scale rows: scenes written by tests/bench/make_scale_scenes.py into
+ * build/scale (once; 30 s and 0.6 GB of files for all). AJAR_BENCH_SCALE: a
+ * comma-separated list of the scenes (default all of them), or 0 for none.
+ * One at a time: the largest holds gigabytes. */
+static void bench_scale(const char *dir)
+{
+	const char *want = getenv("AJAR_BENCH_SCALE");
+	static const char *const names[] = {"unique-1m", "unique-10m", "inst-100", "inst-1000", "inst-1000-gpu"};
+	if (want && !strcmp(want, "0"))
+		return;
+	char cmd[1024] = "python3 tests/bench/make_scale_scenes.py build/scale";
+	for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
+		if (in_list(want, names[i]))
+			snprintf(cmd + strlen(cmd), sizeof cmd - strlen(cmd), " %s", names[i]);
+	if (system(cmd) != 0) {
+		fprintf(stderr, "bench: %s failed\n", cmd);
+		exit(1);
+	}
+	int first = 1;
+	for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+		if (!in_list(want, names[i]))
+			continue;
+		if (first) /* warms the kernel caches */
+			scale_row(dir, names[i], 1);
+		first = 0;
+		scale_row(dir, names[i], 0);
+	}
+}
+
 /* ---- Efficiency at equal time ------------------------------------------- */
 
 /* Renders for `seconds` (or spp samples if seconds is 0); returns the
@@ -305,6 +406,10 @@ int main(int argc, char **argv)
 		return 1;
 	if (getenv("AJAR_BENCH_SCENES"))
 		goto equal_time;
+	if (getenv("AJAR_BENCH_SCALE") && strcmp(getenv("AJAR_BENCH_SCALE"), "0")) {
+		bench_scale(dir); /* AJAR_BENCH_SCALE=list: those rows alone */
+		goto done;
+	}
 	bench_devices();
 	double cold = startup(dir, 1);
 	startup(dir, 0); /* fills PoCL's cache */
@@ -313,6 +418,7 @@ int main(int argc, char **argv)
 	       cold / warm);
 	bench_scene("scenes/cornell/cornell.gltf", 16);
 	bench_scene("scenes/bathroom/bathroom.gltf", 4);
+	bench_scale(dir);
 equal_time:;
 	/* Equal time: AJAR_BENCH_SECONDS per integrator (default 10), the
 	 * reference 2 x 4 times as long; AJAR_BENCH_SCENES picks scenes and
@@ -329,6 +435,7 @@ equal_time:;
 		if (!only || strstr(only, stem))
 			bench_equal_time(scenes[i], 128, secs, 4 * secs);
 	}
+done:
 	test_remove_tree(dir);
 	free(dir);
 	return 0;
