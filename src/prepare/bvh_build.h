@@ -32,8 +32,13 @@ typedef struct {
 	uint32_t wide_depth; /* the wide tree: the same */
 } Bvh;
 
-/* ntris >= 1. On failure *out is left empty (safe to bvh_free). */
+/* ntris >= 1, on bvh_threads() threads. On failure *out is left empty
+ * (safe to bvh_free). */
 ajar_status bvh_build(const Tri *tris, uint32_t ntris, Bvh *out);
+/* The same tree, bit for bit, on `threads` threads (1: the caller's alone). */
+ajar_status bvh_build_threads(const Tri *tris, uint32_t ntris, int threads, Bvh *out);
+/* The threads a build uses: the processors the process may run on. */
+int bvh_threads(void);
 void bvh_free(Bvh *b);
 /* Bytes of nodes + order. */
 size_t bvh_memory(const Bvh *b);
