@@ -56,16 +56,16 @@ DEPS_test_bsdf := $(call obj,core/error)
 DEPS_test_sampling := $(call obj,core/error)
 # The BVH build: its driver and threads, the node split, the wide collapse.
 BVH_OBJS := prepare/bvh_build prepare/bvh_split prepare/bvh_collapse core/workers
-DEPS_test_bvh := $(call obj,core/error scene/scene $(BVH_OBJS) scene/gltf scene/tangents image/exr image/exr_read image/hdr)
+DEPS_test_bvh := $(call obj,core/error scene/scene scene/scene_share core/big_array $(BVH_OBJS) scene/gltf scene/tangents image/exr image/exr_read image/hdr)
 # The light tests share tests/support/lit.c (the kernels' light code inside).
-LIGHT_DEPS := $(BUILD)/tests/lit.o $(call obj,core/error scene/scene prepare/light_tables image/exr image/exr_read image/hdr)
+LIGHT_DEPS := $(BUILD)/tests/lit.o $(call obj,core/error scene/scene scene/scene_share core/big_array prepare/light_tables image/exr image/exr_read image/hdr)
 DEPS_test_lights_env := $(LIGHT_DEPS) $(call obj,prepare/portal_flux)
 DEPS_test_lights_emitters := $(LIGHT_DEPS)
 DEPS_test_lights_sample := $(LIGHT_DEPS)
 DEPS_test_lights_sky_planes := $(LIGHT_DEPS) $(call obj,prepare/sky_tables)
 DEPS_test_lights_sky_planes_fine := $(patsubst %/lit.o,%/lit_fine.o,$(DEPS_test_lights_sky_planes))
 # The scene module: the loader, the API's scene calls, the images a scene reads.
-SCENE_DEPS := $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_read image/hdr)
+SCENE_DEPS := $(call obj,core/error scene/scene scene/scene_share core/big_array scene/scene_api scene/gltf scene/tangents image/exr image/exr_read image/hdr)
 DEPS_test_scene_shipped := $(BUILD)/tests/scene_files.o $(SCENE_DEPS)
 DEPS_test_scene_api := $(BUILD)/tests/scene_files.o $(SCENE_DEPS)
 DEPS_test_scene_gltf := $(BUILD)/tests/scene_files.o $(SCENE_DEPS)
@@ -75,9 +75,10 @@ DEPS_test_exr := $(call obj,core/error image/exr image/exr_read image/png)
 DEPS_test_confine := $(SCENE_DEPS) $(call obj,image/png)
 # The kernels' integrators run on the host (tests/support/kernel_host.c) on
 # scenes as prepare_scene makes them; the MIS tests add the oracle.
-HOST_DEPS := $(BUILD)/tests/kernel_host.o $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_read image/hdr $(BVH_OBJS) prepare/light_tables prepare/prepare prepare/policy prepare/portal_flux prepare/sky_tables render/render_options)
+HOST_DEPS := $(BUILD)/tests/kernel_host.o $(call obj,core/error scene/scene scene/scene_share core/big_array scene/scene_api scene/gltf scene/tangents image/exr image/exr_read image/hdr $(BVH_OBJS) prepare/light_tables prepare/prepare prepare/scene_bvh prepare/policy prepare/portal_flux prepare/sky_tables render/render_options)
 DEPS_test_bdpt := $(BUILD)/tests/mis_oracle.o $(HOST_DEPS)
 DEPS_test_punctual := $(HOST_DEPS)
+DEPS_test_scene_share := $(HOST_DEPS)
 PORTAL_DEPS := $(BUILD)/tests/portal_scenes.o $(HOST_DEPS)
 DEPS_test_portal_mis := $(BUILD)/tests/mis_oracle.o $(PORTAL_DEPS)
 DEPS_test_portal_groups := $(PORTAL_DEPS)

@@ -159,8 +159,18 @@ typedef struct {
 	uint64_t alpha_triangles; /* triangles whose alpha (MASK, BLEND) rays test */
 	uint32_t normal_textures; /* images used as normal maps */
 	uint32_t lights;         /* KHR_lights_punctual lights (ajar_scene_light_get) */
+	/* triangles counts every instance's; these hold each mesh once. */
+	uint64_t unique_triangles;
+	uint32_t instances;      /* copies of meshes kept as instances, not flattened */
+	uint64_t geometry_bytes; /* the triangles' memory (held once, shared with renderers) */
+	uint64_t bvh_bytes;      /* the BVH's memory; 0 until built */
+	double load_seconds;     /* ajar_scene_load's time (0 for a scene built in code) */
+	double bvh_seconds;      /* the BVH build's time; 0 until built */
 } ajar_scene_info;
 ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info);
+/* Builds the scene's BVH now (on every core), else the first renderer does;
+ * later renderers of the unchanged scene reuse it. */
+ajar_status ajar_scene_build_bvh(ajar_scene *s);
 
 /* ---- Render options ---------------------------------------------------- */
 

@@ -39,7 +39,8 @@ static const char usage_main[] =
 	"\n"
 	"commands:\n"
 	"  render SCENE -o OUT.exr [options]  render a .gltf/.glb scene to OpenEXR (see 'ajar render --help')\n"
-	"  info SCENE                         what the scene holds: triangles, lights, portals, camera\n"
+	"  info SCENE                         what the scene holds: triangles, instances, lights, portals,\n"
+	"                                     camera, memory of geometry, BVH and textures\n"
 	"  devices                            list OpenCL devices and how to select one\n"
 	"  help [render]                      this text, or the render options\n"
 	"  --version                          print the version\n"
@@ -473,6 +474,15 @@ static int cmd_render(int argc, char **argv)
 		goto done;
 	}
 	if (!a.quiet) {
+		/* The scene as loaded and prepared: its size and the time it took. */
+		ajar_scene_info si;
+		if (ajar_scene_info_get(scene, &si) == AJAR_OK)
+			fprintf(stderr,
+				"ajar: scene: %llu triangles (%llu unique, %u instances), geometry %.1f MiB, BVH %.1f MiB, "
+				"textures %.1f MiB; loaded in %.2f s, BVH built in %.2f s\n",
+				(unsigned long long)si.triangles, (unsigned long long)si.unique_triangles, si.instances,
+				si.geometry_bytes / 1048576.0, si.bvh_bytes / 1048576.0, si.texture_bytes / 1048576.0,
+				si.load_seconds, si.bvh_seconds);
 		char budget[64] = "";
 		if (a.opt.spp)
 			snprintf(budget, sizeof budget, "%u spp", a.opt.spp);
@@ -610,7 +620,9 @@ static int cmd_info(int argc, char **argv)
 	if (rc != EXIT_OK)
 		return rc;
 	ajar_scene_info in;
-	ajar_status st = ajar_scene_info_get(scene, &in);
+	ajar_status st = ajar_scene_build_bvh(scene);
+	if (st == AJAR_OK)
+		st = ajar_scene_info_get(scene, &in);
 	if (st != AJAR_OK) {
 		report(st, argv[0]);
 		ajar_scene_destroy(&scene);
@@ -618,7 +630,8 @@ static int cmd_info(int argc, char **argv)
 	}
 	static const char *const env[] = {"none", "colour", "image"};
 	printf("scene:        %s\n", argv[0]);
-	printf("triangles:    %llu\n", (unsigned long long)in.triangles);
+	printf("triangles:    %llu (%llu unique, %u instances)\n", (unsigned long long)in.triangles,
+	       (unsigned long long)in.unique_triangles, in.instances);
 	printf("materials:    %u\n", in.materials);
 	printf("emissive:     %u triangles\n", in.emissive_triangles);
 	printf("portals:      %u objects, %u triangles\n", in.portals, in.portal_triangles);
@@ -646,6 +659,9 @@ static int cmd_info(int argc, char **argv)
 	       in.normal_textures,
 	       (double)in.texture_bytes / (1024.0 * 1024.0));
 	printf("alpha-tested: %llu triangles\n", (unsigned long long)in.alpha_triangles);
+	printf("memory:       geometry %.1f MiB, BVH %.1f MiB, textures %.1f MiB\n", in.geometry_bytes / 1048576.0,
+	       in.bvh_bytes / 1048576.0, in.texture_bytes / 1048576.0);
+	printf("times:        loaded in %.2f s, BVH built in %.2f s\n", in.load_seconds, in.bvh_seconds);
 	printf("environment:  %s\n", in.environment >= 0 && in.environment <= 2 ? env[in.environment] : "?");
 	printf("bounds:       (%g, %g, %g) .. (%g, %g, %g)\n", in.bounds_min[0], in.bounds_min[1],
 	       in.bounds_min[2], in.bounds_max[0], in.bounds_max[1], in.bounds_max[2]);

@@ -28,6 +28,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/big_array.h"
 #include "core/error.h"
 #include "core/workers.h"
 #include "geom/bvh.h"
@@ -265,7 +266,8 @@ static void order_fill(void *ctx, int part, int nparts)
 
 int bvh_threads(void) { return workers_cores(); }
 
-ajar_status bvh_build_threads(const Tri *tris, uint32_t ntris, int threads, Bvh *out)
+ajar_status bvh_build_reorder(const Tri *tris, uint32_t ntris, int threads, BvhReorder reorder, void *ctx,
+			      Bvh *out)
 {
 	memset(out, 0, sizeof(*out));
 	if (ntris == 0)
@@ -305,12 +307,22 @@ ajar_status bvh_build_threads(const Tri *tris, uint32_t ntris, int threads, Bvh 
 	if (st == AJAR_OK) {
 		out->ntris = ntris;
 		out->depth = atomic_load(&b.max_depth);
+		if (reorder) {
+			reorder(out->order, ntris, ctx);
+			free(out->order);
+			out->order = NULL;
+		}
 		st = bvh_collapse(b.bn, atomic_load(&b.ninterior), out);
 	}
 	free(b.bn);
 	if (st != AJAR_OK)
 		bvh_free(out);
 	return st;
+}
+
+ajar_status bvh_build_threads(const Tri *tris, uint32_t ntris, int threads, Bvh *out)
+{
+	return bvh_build_reorder(tris, ntris, threads, NULL, NULL, out);
 }
 
 ajar_status bvh_build(const Tri *tris, uint32_t ntris, Bvh *out)
@@ -320,7 +332,7 @@ ajar_status bvh_build(const Tri *tris, uint32_t ntris, Bvh *out)
 
 void bvh_free(Bvh *b)
 {
-	free(b->nodes);
+	big_free(b->nodes, sizeof(BvhNode) * (size_t)b->nnodes);
 	free(b->order);
 	memset(b, 0, sizeof(*b));
 }

@@ -26,17 +26,25 @@
 typedef struct {
 	BvhNode *nodes;      /* BVH_WIDTH-wide */
 	uint32_t nnodes;
-	uint32_t *order;     /* order[i] = original index of reordered triangle i */
+	uint32_t *order;     /* order[i] = original index of reordered triangle i (NULL after a reorder) */
 	uint32_t ntris;
 	uint32_t depth;      /* binary tree: nodes on the longest root-to-leaf path */
 	uint32_t wide_depth; /* the wide tree: the same */
 } Bvh;
 
 /* ntris >= 1, on bvh_threads() threads. On failure *out is left empty
- * (safe to bvh_free). */
+ * (safe to bvh_free). out->nodes is a big array (core/big_array.h). */
 ajar_status bvh_build(const Tri *tris, uint32_t ntris, Bvh *out);
 /* The same tree, bit for bit, on `threads` threads (1: the caller's alone). */
 ajar_status bvh_build_threads(const Tri *tris, uint32_t ntris, int threads, Bvh *out);
+/* Puts the caller's triangle arrays in the leaf order: order[i] is the
+ * original index of triangle i, and order may be written (scratch). */
+typedef void (*BvhReorder)(uint32_t *order, uint32_t n, void *ctx);
+/* bvh_build_threads that hands the order to `reorder` between building
+ * the binary tree and collapsing it, when the build holds the least
+ * memory, and frees it (out->order NULL). */
+ajar_status bvh_build_reorder(const Tri *tris, uint32_t ntris, int threads, BvhReorder reorder, void *ctx,
+			      Bvh *out);
 /* The threads a build uses: the processors the process may run on. */
 int bvh_threads(void);
 void bvh_free(Bvh *b);

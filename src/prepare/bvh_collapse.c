@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/big_array.h"
 #include "core/error.h"
 #include "geom/bvh.h"
 #include "prepare/bvh_build.h"
@@ -79,7 +80,7 @@ ajar_status bvh_collapse(const BinNode *bn, uint32_t ninterior, Bvh *out)
 	 * is a leaf. Written node by node (no memset): only the pages the
 	 * tree fills are touched. */
 	uint32_t cap = ninterior + 1;
-	out->nodes = malloc(sizeof(BvhNode) * cap);
+	out->nodes = big_alloc(sizeof(BvhNode) * cap);
 	if (!out->nodes)
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for %u nodes", cap);
 	/* Pending (binary node, wide id) pairs: at most BVH_WIDTH - 1 per wide
@@ -123,9 +124,13 @@ ajar_status bvh_collapse(const BinNode *bn, uint32_t ninterior, Bvh *out)
 			}
 		}
 	}
-	BvhNode *shrunk = realloc(out->nodes, sizeof(BvhNode) * nwide);
-	if (shrunk)
-		out->nodes = shrunk;
+	BvhNode *shrunk = big_resize(out->nodes, sizeof(BvhNode) * cap, sizeof(BvhNode) * nwide);
+	if (!shrunk) {
+		big_free(out->nodes, sizeof(BvhNode) * cap);
+		out->nodes = NULL;
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for %u nodes", nwide);
+	}
+	out->nodes = shrunk;
 	out->nnodes = nwide;
 	return AJAR_OK;
 }

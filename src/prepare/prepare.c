@@ -1,7 +1,7 @@
-/* prepare.c — from Scene to device arrays. Triangles and their shading data
- * are reordered to the BVH's leaf order so a leaf's triangles are
- * contiguous; the light tables are built on the reordered triangles so
- * emitter indices and Tri.emitter agree. */
+/* prepare.c — from Scene to device arrays. The scene's triangles and their
+ * shading data, in the BVH's leaf order so a leaf's triangles are
+ * contiguous, are shared, not copied (scene_bvh.c); the light tables are
+ * built on them in that order so emitter indices and Tri.emitter agree. */
 #include "prepare/prepare.h"
 
 #include <math.h>
@@ -13,14 +13,8 @@
 #include "core/error.h"
 #include "prepare/policy.h"
 #include "prepare/portal_flux.h"
+#include "prepare/scene_bvh.h"
 #include "prepare/sky_tables.h"
-
-static double seconds(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-}
 
 /* Whether a hit on triangle t can get a shading normal that bsdf_setup_mr
  * counts as tilted (BSDF_TILTED: |n . ng| < BSDF_TILT_COS, kernels/material/bsdf.h).
@@ -128,7 +122,16 @@ static int lamp_behind_portal(const SceneData *d, V3 camera)
 	return 0;
 }
 
-ajar_status prepare_scene(const Scene *s, const ajar_options *o, uint32_t width, uint32_t height,
+/* A copy of n items of `size` (malloc), or NULL. */
+static void *dup_array(const void *p, size_t n, size_t size)
+{
+	void *q = malloc(n ? n * size : size);
+	if (q && n)
+		memcpy(q, p, n * size);
+	return q;
+}
+
+ajar_status prepare_scene(Scene *s, const ajar_options *o, uint32_t width, uint32_t height,
 			  const PolicyOverrides *over, SceneData *d)
 {
 	ajar_status st;
@@ -139,48 +142,48 @@ ajar_status prepare_scene(const Scene *s, const ajar_options *o, uint32_t width,
 	if (s->nmaterials == 0)
 		return err_set(AJAR_ERROR_BAD_INPUT, "%s: the scene has no materials", s->source);
 
-	double t0 = seconds();
-	if ((st = bvh_build(s->tris, n, &d->bvh)) != AJAR_OK)
+	if ((st = scene_bvh(s, &d->share)) != AJAR_OK)
 		return st;
-	d->bvh_seconds = seconds() - t0;
-	d->nodes = d->bvh.nodes;
-	d->n_nodes = d->bvh.nnodes;
-
-	d->tris = malloc(sizeof *d->tris * n);
-	d->shade = malloc(sizeof *d->shade * n);
+	SceneShare *sh = d->share;
+	d->nodes = sh->nodes;
+	d->n_nodes = sh->nnodes;
+	d->bvh_depth = sh->bvh_depth;
+	d->bvh_wide_depth = sh->bvh_wide_depth;
+	d->bvh_seconds = sh->bvh_seconds;
+	d->tris = sh->tris;
+	d->shade = sh->shade;
+	d->texels = sh->texels;
+	d->n_texels = sh->ntexels;
+	/* Materials and textures are small: copies, so a renderer needs
+	 * nothing of the scene but the share. */
+	d->materials = dup_array(s->materials, s->nmaterials, sizeof *s->materials);
+	d->n_materials = s->nmaterials;
+	d->textures = dup_array(s->textures, s->ntextures, sizeof *s->textures);
+	d->n_textures = s->ntextures;
 	d->n_extra = s->extra ? n : 1; /* one unused entry, so a device buffer exists */
-	d->extra = calloc(d->n_extra, sizeof *d->extra);
+	d->extra = s->extra ? sh->extra : calloc(1, sizeof *d->extra);
 	d->params = calloc(1, sizeof *d->params);
 	d->portals = malloc(sizeof *d->portals * (s->nportal_tris ? s->nportal_tris : 1));
-	if (!d->tris || !d->shade || !d->params || !d->portals || !d->extra) {
+	if (over && over->panes_opaque) { /* a test's brute force: smooth thin glass is a delta surface */
+		d->tris = dup_array(sh->tris, n, sizeof *d->tris);
+		d->own_tris = 1;
+		for (uint32_t i = 0; d->tris && i < n; i++)
+			d->tris[i].flags &= ~TRI_PANE;
+	}
+	if (!d->tris || !d->params || !d->portals || !d->extra || !d->materials || !d->textures) {
 		prepare_free(d);
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory preparing %u triangles", s->source, n);
 	}
-	for (uint32_t i = 0; i < n; i++) {
-		d->tris[i] = s->tris[d->bvh.order[i]];
-		d->shade[i] = s->shade[d->bvh.order[i]];
-		if (s->extra)
-			d->extra[i] = s->extra[d->bvh.order[i]];
-	}
 	d->n_tris = d->n_shade = n;
-	if (over && over->panes_opaque) /* a test's brute force: smooth thin glass is a delta surface */
-		for (uint32_t i = 0; i < n; i++)
-			d->tris[i].flags &= ~TRI_PANE;
 	if (s->nportal_tris)
 		memcpy(d->portals, s->portals, sizeof *d->portals * s->nportal_tris);
 	d->n_portals = s->nportal_tris;
-	d->materials = s->materials;
-	d->n_materials = s->nmaterials;
-	d->textures = s->textures;
-	d->n_textures = s->ntextures;
-	d->texels = s->texels;
-	d->n_texels = s->ntexels;
 	d->kernel_omit = kernel_omit(d);
 
 	scene_bounds(s, &d->bmin, &d->bmax);
 	V3 center = v3_scale(v3_add(d->bmin, d->bmax), 0.5f);
 	float radius = 0.5f * v3_len(v3_sub(d->bmax, d->bmin)) * 1.001f + 1e-4f;
-	if ((st = lights_build(s, d->tris, d->shade, d->extra, n, s->materials, d->portals, s->nportal_tris, center, radius,
+	if ((st = lights_build(s, d->tris, d->shade, d->extra, n, d->materials, d->portals, s->nportal_tris, center, radius,
 			       &d->lights)) != AJAR_OK) {
 		prepare_free(d);
 		return st;
@@ -301,15 +304,18 @@ ajar_status prepare_scene(const Scene *s, const ajar_options *o, uint32_t width,
 
 void prepare_free(SceneData *d)
 {
-	/* materials, textures and texels are borrowed from the Scene. */
-	free(d->tris);
-	free(d->shade);
-	free(d->extra);
+	/* nodes, shade, texels, tris and extra (unless copies) are the share's. */
+	if (d->own_tris)
+		free(d->tris);
+	if (!d->share || d->extra != d->share->extra)
+		free(d->extra);
+	free(d->materials);
+	free(d->textures);
 	free(d->params);
 	free(d->portals);
 	free(d->portal_planes);
 	free(d->portal_sky);
-	bvh_free(&d->bvh);
 	lights_free(&d->lights);
+	scene_share_release(d->share);
 	memset(d, 0, sizeof *d);
 }

@@ -11,11 +11,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/big_array.h"
 #include "core/error.h"
 #include "image/exr.h"
 #include "image/hdr.h"
 #include "material/bsdf.h"
 #include "material/texture.h"
+#include "scene/scene_share.h"
 
 /* Device code indexes with int, so no array may pass INT32_MAX entries. */
 #define SCENE_MAX_ITEMS ((size_t)INT32_MAX)
@@ -32,6 +34,25 @@ static ajar_status grow(void **arr, size_t *cap, size_t need, size_t size)
 	if (ncap > SIZE_MAX / size)
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "scene: array of %zu items is too large", need);
 	void *p = realloc(*arr, ncap * size);
+	if (!p)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "scene: out of memory for %zu items", need);
+	*arr = p;
+	*cap = ncap;
+	return AJAR_OK;
+}
+
+/* grow() for the big arrays (core/big_array.h): page-aligned, grown in
+ * place, written only where filled. */
+static ajar_status grow_big(void **arr, size_t *cap, size_t need, size_t size)
+{
+	if (need <= *cap)
+		return AJAR_OK;
+	size_t ncap = *cap ? *cap : 16;
+	while (ncap < need)
+		ncap *= 2;
+	if (ncap > SIZE_MAX / size)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "scene: array of %zu items is too large", need);
+	void *p = big_resize(*arr, *cap * size, ncap * size);
 	if (!p)
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "scene: out of memory for %zu items", need);
 	*arr = p;
@@ -70,14 +91,18 @@ void scene_free(Scene *s)
 	if (!s)
 		return;
 	free(s->source);
-	free(s->tris);
-	free(s->shade);
+	if (s->share) {
+		scene_share_release(s->share); /* the arrays go with the last holder */
+	} else {
+		big_free(s->tris, (size_t)s->cap_tris * sizeof *s->tris);
+		big_free(s->shade, (size_t)s->cap_tris * sizeof *s->shade);
+		big_free(s->texels, s->cap_texels * sizeof *s->texels);
+		big_free(s->extra, s->cap_extra * sizeof *s->extra);
+	}
 	free(s->materials);
 	free(s->textures);
-	free(s->texels);
 	free(s->portals);
 	free(s->env_rgb);
-	free(s->extra);
 	free(s->lights);
 	free(s);
 }
@@ -117,7 +142,9 @@ ajar_status scene_add_texture(Scene *s, uint32_t width, uint32_t height, const u
 	ajar_status st = grow32((void **)&s->textures, &s->cap_textures, (size_t)s->ntextures + 1,
 				sizeof *s->textures);
 	if (!st)
-		st = grow((void **)&s->texels, &s->cap_texels, s->ntexels + n, sizeof *s->texels);
+		st = scene_private(s);
+	if (!st)
+		st = grow_big((void **)&s->texels, &s->cap_texels, s->ntexels + n, sizeof *s->texels);
 	if (st)
 		return st;
 	uint32_t *dst = s->texels + s->ntexels;
@@ -222,7 +249,7 @@ static void extra_default(TriExtra *e)
 static ajar_status extra_reserve(Scene *s, const char *what, uint32_t ntris)
 {
 	size_t have = s->extra ? s->ntris : 0, need = (size_t)s->ntris + ntris;
-	ajar_status st = grow((void **)&s->extra, &s->cap_extra, need, sizeof *s->extra);
+	ajar_status st = grow_big((void **)&s->extra, &s->cap_extra, need, sizeof *s->extra);
 	if (st)
 		return err_set(st, "%s: %s: out of memory for vertex attributes", s->source, what);
 	for (size_t i = have; i < need; i++)
@@ -249,6 +276,8 @@ ajar_status scene_add_triangles_ex(Scene *s, const char *what, const float *pos,
 		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: a tangent is not finite", s->source, what);
 	if (material < s->nmaterials && !s->materials[material].normal_tex)
 		tangents = NULL; /* only normal maps read them */
+	if ((st = scene_private(s)) != AJAR_OK)
+		return st;
 	if ((uvs1 || colors || tangents || s->extra) && (st = extra_reserve(s, what, ntris)))
 		return st;
 	if (material >= s->nmaterials)
@@ -282,13 +311,20 @@ ajar_status scene_add_triangles_ex(Scene *s, const char *what, const float *pos,
 		size_t ncap = s->cap_tris ? s->cap_tris : 16;
 		while (ncap < need)
 			ncap *= 2;
-		Tri *t = realloc(s->tris, ncap * sizeof *t);
+		if (ncap > UINT32_MAX)
+			ncap = UINT32_MAX;
+		Tri *t = big_resize(s->tris, (size_t)s->cap_tris * sizeof *t, ncap * sizeof *t);
 		if (!t)
 			return err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: %s: out of memory", s->source, what);
 		s->tris = t;
-		TriShade *sh = realloc(s->shade, ncap * sizeof *sh);
-		if (!sh)
+		TriShade *sh = big_resize(s->shade, (size_t)s->cap_tris * sizeof *sh, ncap * sizeof *sh);
+		if (!sh) {
+			/* tris grew alone: shrink it back so both keep cap_tris */
+			Tri *back = big_resize(s->tris, ncap * sizeof *t, (size_t)s->cap_tris * sizeof *t);
+			if (back)
+				s->tris = back;
 			return err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: %s: out of memory", s->source, what);
+		}
 		s->shade = sh;
 		s->cap_tris = (uint32_t)ncap;
 	}
@@ -573,13 +609,21 @@ ajar_status scene_set_env_rotation(Scene *s, double degrees)
 	return AJAR_OK;
 }
 
+/* Min and max that take -0 below +0, so bounds do not depend on the order
+ * of the triangles (a renderer puts them in its BVH's), inline: a
+ * 10M-triangle scene's bounds in 40 ms, not 0.4 s of library calls. */
+static inline float min_signed(float a, float b) { return b < a || (b == a && signbit(b)) ? b : a; }
+static inline float max_signed(float a, float b) { return b > a || (b == a && !signbit(b)) ? b : a; }
+static inline V3 v3_min_signed(V3 a, V3 b) { return v3(min_signed(a.x, b.x), min_signed(a.y, b.y), min_signed(a.z, b.z)); }
+static inline V3 v3_max_signed(V3 a, V3 b) { return v3(max_signed(a.x, b.x), max_signed(a.y, b.y), max_signed(a.z, b.z)); }
+
 void scene_bounds(const Scene *s, V3 *bmin, V3 *bmax)
 {
 	V3 lo = v3(AJAR_INF, AJAR_INF, AJAR_INF), hi = v3(-AJAR_INF, -AJAR_INF, -AJAR_INF);
 	for (uint32_t i = 0; i < s->ntris; i++) {
 		const Tri *t = &s->tris[i];
-		lo = v3_min(lo, v3_min(t->p0, v3_min(t->p1, t->p2)));
-		hi = v3_max(hi, v3_max(t->p0, v3_max(t->p1, t->p2)));
+		lo = v3_min_signed(lo, v3_min_signed(t->p0, v3_min_signed(t->p1, t->p2)));
+		hi = v3_max_signed(hi, v3_max_signed(t->p0, v3_max_signed(t->p1, t->p2)));
 	}
 	for (uint32_t i = 0; i < s->nportal_tris; i++) {
 		const PortalTri *t = &s->portals[i];

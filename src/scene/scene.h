@@ -16,11 +16,17 @@
 extern "C" {
 #endif
 
+/* The arrays a scene shares with its renderers (scene_share.h). */
+typedef struct SceneShare SceneShare;
+
 /* The public ajar_scene handle is this struct. */
 typedef struct ajar_scene {
 	char *source;            /* file name for messages, or "<api>" */
 
-	Tri *tris;               /* world space, insertion order */
+	/* tris, shade, extra and texels are big arrays (core/big_array.h),
+	 * held with the renderers through `share` once one was prepared:
+	 * written only after scene_private(). */
+	Tri *tris;               /* world space, insertion order until a renderer puts them in its BVH's */
 	TriShade *shade;
 	uint32_t ntris, cap_tris;
 
@@ -54,10 +60,15 @@ typedef struct ajar_scene {
 	size_t cap_extra;
 	ajar_light *lights;      /* punctual lights, glTF units, direction unit */
 	uint32_t nlights, cap_lights;
+	SceneShare *share;       /* NULL until a renderer shares the arrays */
+	double load_seconds;     /* ajar_scene_load's */
 } Scene;
 
 ajar_status scene_new(const char *source, Scene **out);
 void scene_free(Scene *s);
+/* Makes tris, shade, extra and texels the scene's alone, to be written
+ * (scene_share.c): copied if a renderer shares them. */
+ajar_status scene_private(Scene *s);
 
 /* Returns the new material's index in *id. */
 ajar_status scene_add_material(Scene *s, const Material *m, uint32_t *id);

@@ -9,10 +9,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "core/error.h"
 #include "scene/gltf.h"
 #include "scene/scene.h"
+#include "scene/scene_share.h"
 
 ajar_status ajar_scene_load(const char *path, ajar_scene **out)
 {
@@ -37,7 +39,13 @@ ajar_status ajar_scene_load_with(const char *path, const ajar_load_options *o, a
 	*out = NULL;
 	if (!path || !*path)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_scene_load_with: no path");
-	return gltf_load_with(path, o ? o->allow_outside_files : 0, out);
+	struct timespec t0, t1;
+	clock_gettime(CLOCK_MONOTONIC, &t0);
+	ajar_status st = gltf_load_with(path, o ? o->allow_outside_files : 0, out);
+	clock_gettime(CLOCK_MONOTONIC, &t1);
+	if (st == AJAR_OK)
+		(*out)->load_seconds = (double)(t1.tv_sec - t0.tv_sec) + (t1.tv_nsec - t0.tv_nsec) * 1e-9;
+	return st;
 }
 
 ajar_status ajar_scene_create(ajar_scene **out)
@@ -380,5 +388,12 @@ ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info)
 	info->width = s->width;
 	info->height = s->height;
 	info->lights = s->nlights;
+	info->unique_triangles = s->ntris;
+	info->geometry_bytes = (uint64_t)s->ntris * (sizeof *s->tris + sizeof *s->shade + (s->extra ? sizeof *s->extra : 0));
+	if (s->share && s->share->nodes) {
+		info->bvh_bytes = (uint64_t)s->share->nnodes * sizeof(BvhNode);
+		info->bvh_seconds = s->share->bvh_seconds;
+	}
+	info->load_seconds = s->load_seconds;
 	return AJAR_OK;
 }

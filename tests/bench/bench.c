@@ -135,8 +135,8 @@ static void bench_scene(const char *path, uint32_t spp)
 	/* Textures as the device holds them: RGBA8 texels (4 bytes each). */
 	printf("%-34s %9u tris  load %6.2f s  BVH build %6.3f s  %7.1f MiB  %5u nodes/k-tri  "
 	       "traversal %6.2f Mrays/s  pt %6.3f Msamples/s  textures %u, %.1f MiB\n",
-	       path, s->ntris, load, sd.bvh_seconds, bvh_memory(&sd.bvh) / 1048576.0,
-	       (unsigned)(1000.0 * sd.bvh.nnodes / s->ntris), mrays, msps, s->nimages,
+	       path, s->ntris, load, sd.bvh_seconds, (double)sd.n_nodes * sizeof(BvhNode) / 1048576.0,
+	       (unsigned)(1000.0 * sd.n_nodes / s->ntris), mrays, msps, s->nimages,
 	       (double)(sd.n_texels * sizeof *sd.texels) / 1048576.0);
 	device_close(&d);
 	prepare_free(&sd);
@@ -246,9 +246,8 @@ static void scale_row(const char *dir, const char *name, int quiet)
 			load = atof(p + 10);
 		if ((p = strstr(line, "BVH built in ")))
 			bvh = atof(p + 13);
-		if ((p = strstr(line, " triangles (")))
-			sscanf(p - 20 > line ? p - 20 : line, "%*[^0-9]%llu triangles (%llu unique, %llu instances",
-			       &tris, &unique, &inst);
+		if ((p = strstr(line, "ajar: scene: ")))
+			sscanf(p, "ajar: scene: %llu triangles (%llu unique, %llu instances", &tris, &unique, &inst);
 	}
 	if (f)
 		fclose(f);

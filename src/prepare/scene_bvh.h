@@ -1,0 +1,10 @@
+/* scene_bvh.h — a scene's BVH, built once for the triangles it shares with
+ * its renderers, which it puts in the BVH's leaf order (scene_bvh.c). */
+#ifndef AJAR_SCENE_BVH_H
+#define AJAR_SCENE_BVH_H
+#include "scene/scene_share.h"
+
+/* s's share (with a reference for the caller, released with
+ * scene_share_release) with its BVH, built now if the share has none. */
+ajar_status scene_bvh(Scene *s, SceneShare **out);
+#endif
