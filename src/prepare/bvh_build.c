@@ -51,7 +51,8 @@ typedef struct {
 } Task;
 
 typedef struct {
-	const Tri *tris;
+	const BvhInput *in;
+	uint32_t inst_from;      /* in->ntris with instances, else UINT32_MAX */
 	Ref *refs;
 	BinNode *bn;
 	uint32_t *order;
@@ -77,24 +78,31 @@ static void slice(uint32_t start, uint32_t end, int part, int nparts, uint32_t *
 }
 
 /* A triangle's bounds: fmin/fmax of its corners, which keep the first
- * argument on ties (-0 and +0 as the scalar build had them). */
+ * argument on ties (-0 and +0 as the scalar build had them); an
+ * instance's as given. */
 static void refs_fill(void *ctx, int part, int nparts)
 {
 	Build *b = ctx;
+	const BvhInput *in = b->in;
 	uint32_t s, e;
 	slice(0, b->nrefs, part, nparts, &s, &e);
 	for (uint32_t i = s; i < e; i++) {
-		const Tri *t = &b->tris[i];
+		Ref *r = &b->refs[i];
+		r->idx = i;
+		if (i >= in->ntris) {
+			V3 lo = in->inst_lo[i - in->ntris], hi = in->inst_hi[i - in->ntris];
+			r->b = (Box){{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}};
+			continue;
+		}
+		const Tri *t = &in->tris[in->index ? in->index[i] : i];
 		F4 p0 = f4_load3(&t->p0.x), p1 = f4_load3(&t->p1.x), p2 = f4_load3(&t->p2.x);
 		float lo[4], hi[4];
 		f4_store(lo, f4_min(f4_min(p2, p1), p0));
 		f4_store(hi, f4_max(f4_max(p2, p1), p0));
-		Ref *r = &b->refs[i];
 		for (int a = 0; a < 3; a++) {
 			r->b.lo[a] = lo[a];
 			r->b.hi[a] = hi[a];
 		}
-		r->idx = i;
 	}
 }
 
@@ -153,7 +161,7 @@ static void build_subtree(Build *b, Task root)
 		box4_store(&node->b, nb.box);
 		uint32_t n = task.end - task.start;
 		SplitPlan plan;
-		bvh_split_plan(n, &nb.cbox, task.depth, &plan);
+		bvh_split_plan(n, &nb.cbox, task.depth, b->inst_from, &plan);
 		if (plan.nb) {
 			bvh_bins_clear(&bins, plan.nb);
 			bvh_bins_add(&bins, &plan, b->refs, task.start, task.end);
@@ -229,7 +237,7 @@ static ajar_status build_tree(Build *b)
 		BinNode *node = &b->bn[t.node];
 		box4_store(&node->b, nb.box);
 		SplitPlan plan;
-		bvh_split_plan(n, &nb.cbox, t.depth, &plan);
+		bvh_split_plan(n, &nb.cbox, t.depth, b->inst_from, &plan);
 		if (plan.nb) {
 			b->plan = &plan;
 			workers_run(&b->workers, part_bins, b);
@@ -255,6 +263,36 @@ static ajar_status build_tree(Build *b)
 	return AJAR_OK;
 }
 
+/* With instances: leaves renumbered (bvh_parts.h, BinNode) and the order
+ * of the triangles alone, walking the tree from its root. */
+static ajar_status number_leaves(Build *b)
+{
+	uint32_t *place = malloc(sizeof *place * (size_t)b->nrefs);
+	if (!place)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for %u references", b->nrefs);
+	uint32_t k = 0;
+	for (uint32_t i = 0; i < b->nrefs; i++)
+		if (b->refs[i].idx < b->inst_from) {
+			b->order[k] = b->refs[i].idx;
+			place[i] = k++;
+		}
+	uint32_t stack[BVH_MAX_DEPTH + 2];
+	int sp = 0;
+	stack[sp++] = 0;
+	while (sp > 0) {
+		BinNode *node = &b->bn[stack[--sp]];
+		if (node->count == 0) {
+			stack[sp++] = (uint32_t)node->index;
+			stack[sp++] = (uint32_t)(node - b->bn) + 1;
+			continue;
+		}
+		uint32_t idx = b->refs[node->index].idx;
+		node->index = idx >= b->inst_from ? -1 - (int)(idx - b->inst_from) : (int)place[node->index];
+	}
+	free(place);
+	return AJAR_OK;
+}
+
 static void order_fill(void *ctx, int part, int nparts)
 {
 	Build *b = ctx;
@@ -266,28 +304,32 @@ static void order_fill(void *ctx, int part, int nparts)
 
 int bvh_threads(void) { return workers_cores(); }
 
-ajar_status bvh_build_reorder(const Tri *tris, uint32_t ntris, int threads, BvhReorder reorder, void *ctx,
-			      Bvh *out)
+ajar_status bvh_build_input(const BvhInput *in, int threads, BvhReorder reorder, void *ctx, Bvh *out)
 {
+	BvhNode *base_nodes = out->nodes;
+	uint32_t base = base_nodes ? out->nnodes : 0;
 	memset(out, 0, sizeof(*out));
-	if (ntris == 0)
+	out->nodes = base_nodes;
+	out->nnodes = base;
+	if (in->n == 0)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "bvh_build: no triangles");
-	if (ntris > BVH_MAX_TRIS)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "bvh_build: %u triangles, at most %u supported",
-			       ntris, (unsigned)BVH_MAX_TRIS);
+	if (in->n > BVH_MAX_TRIS || in->n - in->ntris >= BVH_INSTANCE_BASE)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "bvh_build: %u triangles and instances, at most %u supported",
+			       in->n, (unsigned)BVH_MAX_TRIS);
 	Build b;
 	memset(&b, 0, sizeof b);
-	b.tris = tris;
-	b.nrefs = ntris;
+	b.in = in;
+	b.inst_from = in->ntris < in->n ? in->ntris : UINT32_MAX;
+	b.nrefs = in->n;
 	/* The binary tree's array is as large as any tree could need; pages
 	 * the build leaves untouched cost no memory. */
-	size_t max_nodes = 2 * (size_t)ntris - 1;
-	b.refs = malloc(sizeof(Ref) * ntris);
+	size_t max_nodes = 2 * (size_t)in->n - 1;
+	b.refs = malloc(sizeof(Ref) * in->n);
 	b.bn = malloc(sizeof(BinNode) * max_nodes);
-	out->order = malloc(sizeof(uint32_t) * ntris);
+	out->order = malloc(sizeof(uint32_t) * (in->ntris ? in->ntris : 1));
 	ajar_status st = AJAR_OK;
 	if (!b.refs || !b.bn || !out->order)
-		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for %u triangles", ntris);
+		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for %u triangles", in->n);
 	if (st == AJAR_OK)
 		st = workers_start(&b.workers, threads < 1 ? 1 : threads);
 	if (st == AJAR_OK) {
@@ -296,7 +338,10 @@ ajar_status bvh_build_reorder(const Tri *tris, uint32_t ntris, int threads, BvhR
 	}
 	if (st == AJAR_OK) {
 		b.order = out->order;
-		workers_run(&b.workers, order_fill, &b);
+		if (b.inst_from != UINT32_MAX)
+			st = number_leaves(&b);
+		else
+			workers_run(&b.workers, order_fill, &b);
 	}
 	if (b.workers.threads || b.workers.n)
 		workers_stop(&b.workers);
@@ -305,19 +350,31 @@ ajar_status bvh_build_reorder(const Tri *tris, uint32_t ntris, int threads, BvhR
 	free(b.part_bins);
 	free(b.refs);
 	if (st == AJAR_OK) {
-		out->ntris = ntris;
+		out->ntris = in->ntris;
 		out->depth = atomic_load(&b.max_depth);
 		if (reorder) {
-			reorder(out->order, ntris, ctx);
+			reorder(out->order, in->ntris, ctx);
 			free(out->order);
 			out->order = NULL;
 		}
-		st = bvh_collapse(b.bn, atomic_load(&b.ninterior), out);
+		st = bvh_collapse(b.bn, atomic_load(&b.ninterior), in->tri_base, out);
 	}
 	free(b.bn);
-	if (st != AJAR_OK)
-		bvh_free(out);
+	if (st != AJAR_OK) {
+		free(out->order);
+		out->order = NULL;
+		if (!base_nodes)
+			bvh_free(out);
+	}
 	return st;
+}
+
+ajar_status bvh_build_reorder(const Tri *tris, uint32_t ntris, int threads, BvhReorder reorder, void *ctx,
+			      Bvh *out)
+{
+	BvhInput in = {tris, NULL, ntris, NULL, NULL, ntris, 0};
+	memset(out, 0, sizeof *out);
+	return bvh_build_input(&in, threads, reorder, ctx, out);
 }
 
 ajar_status bvh_build_threads(const Tri *tris, uint32_t ntris, int threads, Bvh *out)

@@ -32,6 +32,20 @@ typedef struct {
 	uint32_t wide_depth; /* the wide tree: the same */
 } Bvh;
 
+/* What a tree is built over: primitives 0 .. ntris - 1 are triangles
+ * (tris[i], or tris[index[i]] with an index list), ntris .. n - 1 are
+ * instances with world-space boxes inst_lo/inst_hi[i - ntris], each a leaf
+ * of its own, BVH_INSTANCE(i - ntris) (kernels/geom/bvh.h). Leaves name
+ * triangles tri_base + their place in the leaf order. */
+typedef struct {
+	const Tri *tris;
+	const uint32_t *index; /* NULL: primitive i is tris[i] */
+	uint32_t ntris;
+	const V3 *inst_lo, *inst_hi;
+	uint32_t n;            /* ntris + instances, >= 1 */
+	uint32_t tri_base;
+} BvhInput;
+
 /* ntris >= 1, on bvh_threads() threads. On failure *out is left empty
  * (safe to bvh_free). out->nodes is a big array (core/big_array.h). */
 ajar_status bvh_build(const Tri *tris, uint32_t ntris, Bvh *out);
@@ -45,6 +59,11 @@ typedef void (*BvhReorder)(uint32_t *order, uint32_t n, void *ctx);
  * memory, and frees it (out->order NULL). */
 ajar_status bvh_build_reorder(const Tri *tris, uint32_t ntris, int threads, BvhReorder reorder, void *ctx,
 			      Bvh *out);
+/* The general build: out->order has in->ntris entries (primitive
+ * numbers); with out->nodes already holding a tree (out->nnodes nodes), the
+ * new tree is appended after it, its root node out->nnodes, and
+ * out->nnodes grows. */
+ajar_status bvh_build_input(const BvhInput *in, int threads, BvhReorder reorder, void *ctx, Bvh *out);
 /* The threads a build uses: the processors the process may run on. */
 int bvh_threads(void);
 void bvh_free(Bvh *b);

@@ -74,25 +74,29 @@ static void wide_set_slot(BvhNode *w, int k, const Box *b, int child)
 	w->pad[k] = 0;
 }
 
-ajar_status bvh_collapse(const BinNode *bn, uint32_t ninterior, Bvh *out)
+ajar_status bvh_collapse(const BinNode *bn, uint32_t ninterior, uint32_t tri_base, Bvh *out)
 {
 	/* One wide node per interior binary node at most, one for a root that
 	 * is a leaf. Written node by node (no memset): only the pages the
 	 * tree fills are touched. */
-	uint32_t cap = ninterior + 1;
-	out->nodes = big_alloc(sizeof(BvhNode) * cap);
-	if (!out->nodes)
-		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for %u nodes", cap);
+	uint32_t base = out->nodes ? out->nnodes : 0;
+	size_t cap = (size_t)base + ninterior + 1;
+	if (cap >= BVH_INSTANCE_BASE)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: %zu nodes, more than the BVH can address", cap);
+	BvhNode *nodes = big_resize(out->nodes, sizeof(BvhNode) * base, sizeof(BvhNode) * cap);
+	if (!nodes)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for %zu nodes", cap);
+	out->nodes = nodes;
 	/* Pending (binary node, wide id) pairs: at most BVH_WIDTH - 1 per wide
 	 * level plus one; BVH_MAX_DEPTH bounds the levels. */
 	struct {
 		uint32_t bin, wide, depth;
 	} stack[(BVH_WIDTH - 1) * BVH_MAX_DEPTH + BVH_WIDTH];
 	int sp = 0;
-	uint32_t nwide = 1;
+	uint32_t nwide = base + 1;
 	out->wide_depth = 1;
 	stack[sp].bin = 0;
-	stack[sp].wide = 0;
+	stack[sp].wide = base;
 	stack[sp++].depth = 1;
 	while (sp > 0) {
 		sp--;
@@ -114,8 +118,10 @@ ajar_status bvh_collapse(const BinNode *bn, uint32_t ninterior, Bvh *out)
 				continue;
 			}
 			const BinNode *c = &bn[s.bin[k]];
-			if (c->count > 0) {
-				wide_set_slot(w, k, &c->b, BVH_LEAF(c->index, c->count));
+			if (c->count > 0 && c->index < 0) {
+				wide_set_slot(w, k, &c->b, BVH_INSTANCE(-1 - c->index));
+			} else if (c->count > 0) {
+				wide_set_slot(w, k, &c->b, BVH_LEAF((int)tri_base + c->index, c->count));
 			} else {
 				wide_set_slot(w, k, &c->b, (int)nwide);
 				stack[sp].bin = s.bin[k];
@@ -125,9 +131,8 @@ ajar_status bvh_collapse(const BinNode *bn, uint32_t ninterior, Bvh *out)
 		}
 	}
 	BvhNode *shrunk = big_resize(out->nodes, sizeof(BvhNode) * cap, sizeof(BvhNode) * nwide);
-	if (!shrunk) {
-		big_free(out->nodes, sizeof(BvhNode) * cap);
-		out->nodes = NULL;
+	if (!shrunk) { /* cannot happen: a mapping shrinks in place */
+		out->nnodes = (uint32_t)cap;
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for %u nodes", nwide);
 	}
 	out->nodes = shrunk;

@@ -138,7 +138,9 @@ typedef struct {
 
 /* Node of the binary tree: an interior node's left child is the next
  * node, its right child node `index`; a leaf (count > 0) covers refs
- * [index, index + count). A subtree over n refs rooted at node p uses
+ * [index, index + count) (after a build with instances, bvh_build.c
+ * renumbers leaves: triangles by their place among the triangles, and an
+ * instance leaf index -1 - instance). A subtree over n refs rooted at node p uses
  * nodes within [p, p + 2n - 1), so a node's children can be placed before
  * either is built: left p + 1, right p + 2 n_left. */
 typedef struct {
@@ -218,9 +220,10 @@ typedef struct {
 	float cmin[3];    /* centroid bounds' low corner */
 	float scale[3];   /* nb / extent, 0 for a flat axis */
 	float ext[3];
+	uint32_t inst_from; /* refs with idx >= this are instances, leaves of one (UINT32_MAX: none) */
 } SplitPlan;
 
-void bvh_split_plan(uint32_t n, const Box4 *cbox, uint32_t depth, SplitPlan *p);
+void bvh_split_plan(uint32_t n, const Box4 *cbox, uint32_t depth, uint32_t inst_from, SplitPlan *p);
 void bvh_bins_clear(Bins *b, int nb);
 /* Bins refs [start, end) into b. */
 void bvh_bins_add(Bins *b, const SplitPlan *p, const Ref *refs, uint32_t start, uint32_t end);

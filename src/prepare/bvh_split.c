@@ -39,8 +39,9 @@ void bvh_bounds_merge(NodeBounds *acc, const NodeBounds *later)
 	acc->cbox = box4_grow(acc->cbox, later->cbox);
 }
 
-void bvh_split_plan(uint32_t n, const Box4 *cbox, uint32_t depth, SplitPlan *p)
+void bvh_split_plan(uint32_t n, const Box4 *cbox, uint32_t depth, uint32_t inst_from, SplitPlan *p)
 {
+	p->inst_from = inst_from;
 	float lo[4], hi[4];
 	f4_store(lo, cbox->lo);
 	f4_store(hi, cbox->hi);
@@ -200,19 +201,33 @@ static int sah_sweep(const Bins *bins, const SplitPlan *p, int *best_bin, float 
 	return best_axis;
 }
 
+/* Whether a node of at most BVH_MAX_LEAF refs may be a leaf: not if it
+ * holds an instance beside anything else. */
+static int may_be_leaf(const Ref *refs, uint32_t n, const SplitPlan *p)
+{
+	if (n > BVH_MAX_LEAF)
+		return 0;
+	if (p->inst_from != UINT32_MAX)
+		for (uint32_t i = 0; i < n; i++)
+			if (refs[i].idx >= p->inst_from)
+				return 0;
+	return 1;
+}
+
 uint32_t bvh_split_apply(Ref *refs, uint32_t n, const Box *box, const SplitPlan *p, const Bins *bins)
 {
 	if (n <= 1)
 		return 0;
+	int leaf_ok = may_be_leaf(refs, n, p);
 	if (p->ext[p->axis] <= 0.0f) /* all centroids equal: any halving will do */
-		return n <= BVH_MAX_LEAF ? 0 : n / 2;
+		return leaf_ok ? 0 : n / 2;
 	if (p->nb) {
 		int best_bin;
 		float best_cost;
 		int best_axis = sah_sweep(bins, p, &best_bin, &best_cost);
 		if (best_axis >= 0) {
 			float area = box_area(box);
-			if (n <= BVH_MAX_LEAF && (float)n * area <= BVH_COST_TRAVERSE * area + best_cost)
+			if (leaf_ok && (float)n * area <= BVH_COST_TRAVERSE * area + best_cost)
 				return 0;
 			float cmin = p->cmin[best_axis], scale = p->scale[best_axis];
 			uint32_t i = 0, j = n;
@@ -230,7 +245,7 @@ uint32_t bvh_split_apply(Ref *refs, uint32_t n, const Box *box, const SplitPlan 
 		/* Every centroid fell into one bin (float rounding on a tiny
 		 * extent): fall through to the median. */
 	}
-	if (n <= BVH_MAX_LEAF)
+	if (leaf_ok)
 		return 0;
 	select_nth(refs, n, n / 2, p->axis);
 	return n / 2;

@@ -55,6 +55,8 @@ static int tri_may_tilt(const Tri *t, const TriShade *sh)
 static unsigned kernel_omit(const SceneData *d)
 {
 	unsigned omit = KERNEL_OMIT_ALPHA | KERNEL_OMIT_BENT_NORMALS | KERNEL_OMIT_TRI_EXTRA | KERNEL_OMIT_PANES;
+	if (!d->n_instances)
+		omit |= KERNEL_OMIT_INSTANCES;
 	for (size_t i = 0; i < d->n_tris; i++) {
 		if (d->tris[i].flags & TRI_ALPHA)
 			omit &= ~KERNEL_OMIT_ALPHA;
@@ -122,6 +124,43 @@ static int lamp_behind_portal(const SceneData *d, V3 camera)
 	return 0;
 }
 
+/* The device's Instance entries (kernels/base/types.h): the transform and
+ * its inverse, computed in double and rounded once, and the mesh's BVH
+ * root. n_instances stays 0 without instances (one unused entry, so a
+ * device buffer exists). */
+static ajar_status prepare_instances(const Scene *s, const SceneShare *sh, SceneData *d)
+{
+	d->instances = calloc(s->ninstances ? s->ninstances : 1, sizeof *d->instances);
+	if (!d->instances)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory for %u instances", s->source, s->ninstances);
+	d->n_instances = s->ninstances;
+	for (uint32_t j = 0; j < s->ninstances; j++) {
+		const SceneInstance *si = &s->instances[j];
+		Instance *in = &d->instances[j];
+		const double *m = si->m;
+		/* The inverse of the 3x3 part by cofactors, then the translation. */
+		double c[9] = {m[5] * m[10] - m[6] * m[9], m[2] * m[9] - m[1] * m[10], m[1] * m[6] - m[2] * m[5],
+			       m[6] * m[8] - m[4] * m[10], m[0] * m[10] - m[2] * m[8], m[2] * m[4] - m[0] * m[6],
+			       m[4] * m[9] - m[5] * m[8], m[1] * m[8] - m[0] * m[9], m[0] * m[5] - m[1] * m[4]};
+		double det = m[0] * c[0] + m[1] * c[3] + m[2] * c[6];
+		for (int r = 0; r < 3; r++) {
+			double t = 0.0;
+			for (int k = 0; k < 3; k++) {
+				double v = c[3 * r + k] / det;
+				in->inv[4 * r + k] = (float)v;
+				t -= v * m[4 * k + 3];
+			}
+			in->inv[4 * r + 3] = (float)t;
+		}
+		for (int k = 0; k < 12; k++)
+			in->xf[k] = (float)m[k];
+		in->root = sh->mesh_root[si->mesh];
+		in->flags = det < 0.0 ? INSTANCE_MIRROR : 0;
+		in->mesh = (int)si->mesh;
+	}
+	return AJAR_OK;
+}
+
 /* A copy of n items of `size` (malloc), or NULL. */
 static void *dup_array(const void *p, size_t n, size_t size)
 {
@@ -137,7 +176,7 @@ ajar_status prepare_scene(Scene *s, const ajar_options *o, uint32_t width, uint3
 	ajar_status st;
 	uint32_t n = s->ntris;
 	memset(d, 0, sizeof *d);
-	if (n == 0)
+	if (scene_rendered_triangles(s) == 0)
 		return err_set(AJAR_ERROR_BAD_INPUT, "%s: the scene has no triangles", s->source);
 	if (s->nmaterials == 0)
 		return err_set(AJAR_ERROR_BAD_INPUT, "%s: the scene has no materials", s->source);
@@ -164,6 +203,10 @@ ajar_status prepare_scene(Scene *s, const ajar_options *o, uint32_t width, uint3
 	d->extra = s->extra ? sh->extra : calloc(1, sizeof *d->extra);
 	d->params = calloc(1, sizeof *d->params);
 	d->portals = malloc(sizeof *d->portals * (s->nportal_tris ? s->nportal_tris : 1));
+	if ((st = prepare_instances(s, sh, d)) != AJAR_OK) {
+		prepare_free(d);
+		return st;
+	}
 	if (over && over->panes_opaque) { /* a test's brute force: smooth thin glass is a delta surface */
 		d->tris = dup_array(sh->tris, n, sizeof *d->tris);
 		d->own_tris = 1;
@@ -183,7 +226,9 @@ ajar_status prepare_scene(Scene *s, const ajar_options *o, uint32_t width, uint3
 	scene_bounds(s, &d->bmin, &d->bmax);
 	V3 center = v3_scale(v3_add(d->bmin, d->bmax), 0.5f);
 	float radius = 0.5f * v3_len(v3_sub(d->bmax, d->bmin)) * 1.001f + 1e-4f;
-	if ((st = lights_build(s, d->tris, d->shade, d->extra, n, d->materials, d->portals, s->nportal_tris, center, radius,
+	/* Only flat triangles emit: they come first (scene_bvh.c), the
+	 * instanced meshes after them. */
+	if ((st = lights_build(s, d->tris, d->shade, d->extra, scene_flat_triangles(s), d->materials, d->portals, s->nportal_tris, center, radius,
 			       &d->lights)) != AJAR_OK) {
 		prepare_free(d);
 		return st;
@@ -315,6 +360,7 @@ void prepare_free(SceneData *d)
 	free(d->portals);
 	free(d->portal_planes);
 	free(d->portal_sky);
+	free(d->instances);
 	lights_free(&d->lights);
 	scene_share_release(d->share);
 	memset(d, 0, sizeof *d);

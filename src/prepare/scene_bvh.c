@@ -12,8 +12,11 @@
 #include "prepare/scene_bvh.h"
 
 #include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
+#include "core/big_array.h"
 #include "core/error.h"
 #include "prepare/bvh_build.h"
 
@@ -65,23 +68,115 @@ static void reorder_in_place(uint32_t *order, uint32_t n, void *ctx)
 	}
 }
 
+/* new[i] = old[order[i]] over the whole arrays (scene_bvh_two_level). */
+static void reorder_all(SceneShare *sh, uint32_t *order, uint32_t n) { reorder_in_place(order, n, sh); }
+
+/* With instanced meshes (scene.h, SceneMesh): a top-level tree over the
+ * flat triangles and the instances' world boxes, then one tree per mesh
+ * over its object-space triangles, appended; the arrays end up as the flat
+ * triangles in the top-level tree's order, then each mesh's in its own. */
+static ajar_status scene_bvh_two_level(Scene *s, SceneShare *sh)
+{
+	uint32_t n = s->ntris, nflat = scene_flat_triangles(s), ninst = s->ninstances, nm = s->nmeshes;
+	int threads = bvh_threads();
+	ajar_status st = AJAR_OK;
+	uint32_t *flat = malloc(sizeof *flat * (nflat ? nflat : 1));
+	uint32_t *order = malloc(sizeof *order * n);
+	V3 *mb = malloc(sizeof *mb * 2 * nm), *ib = malloc(sizeof *ib * 2 * (ninst ? ninst : 1));
+	int32_t *root = malloc(sizeof *root * nm);
+	if (!flat || !order || !mb || !ib || !root) {
+		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory for the BVH of %u triangles", s->source, n);
+		goto done;
+	}
+	for (uint32_t i = 0, k = 0, f = 0; k <= nm; k++) { /* the flat triangles before mesh k */
+		uint32_t end = k < nm ? s->meshes[k].first : n;
+		for (; i < end; i++)
+			flat[f++] = i;
+		if (k < nm)
+			i = s->meshes[k].first + s->meshes[k].count;
+	}
+	for (uint32_t k = 0; k < nm; k++) {
+		scene_mesh_bounds(s, k, &mb[2 * k], &mb[2 * k + 1]);
+		root[k] = -1;
+	}
+	for (uint32_t j = 0; j < ninst; j++) {
+		const SceneInstance *in = &s->instances[j];
+		scene_instance_bounds(in, mb[2 * in->mesh], mb[2 * in->mesh + 1], &ib[j], &ib[ninst + j]);
+		root[in->mesh] = 0; /* has instances: gets a tree */
+	}
+	Bvh bvh;
+	memset(&bvh, 0, sizeof bvh);
+	BvhInput top = {sh->tris, flat, nflat, ib, ib + ninst, nflat + ninst, 0};
+	if ((st = bvh_build_input(&top, threads, NULL, NULL, &bvh)) != AJAR_OK)
+		goto done;
+	sh->bvh_depth = bvh.depth;
+	sh->bvh_wide_depth = bvh.wide_depth;
+	for (uint32_t k = 0; k < nflat; k++)
+		order[k] = flat[bvh.order[k]];
+	free(bvh.order);
+	bvh.order = NULL;
+	uint32_t pos = nflat;
+	for (uint32_t k = 0; k < nm && st == AJAR_OK; k++) {
+		SceneMesh *m = &s->meshes[k];
+		if (root[k] == 0) {
+			root[k] = (int32_t)bvh.nnodes;
+			BvhInput mesh = {sh->tris + m->first, NULL, m->count, NULL, NULL, m->count, pos};
+			if ((st = bvh_build_input(&mesh, threads, NULL, NULL, &bvh)) != AJAR_OK)
+				break;
+			for (uint32_t i = 0; i < m->count; i++)
+				order[pos + i] = m->first + bvh.order[i];
+			free(bvh.order);
+			bvh.order = NULL;
+		} else {
+			for (uint32_t i = 0; i < m->count; i++)
+				order[pos + i] = m->first + i;
+		}
+		m->first = pos; /* where reorder_all moves it */
+		pos += m->count;
+	}
+	if (st != AJAR_OK) {
+		big_free(bvh.nodes, sizeof(BvhNode) * (size_t)bvh.nnodes);
+		goto done;
+	}
+	reorder_all(sh, order, n);
+	sh->nodes = bvh.nodes;
+	sh->nnodes = bvh.nnodes;
+	sh->mesh_root = root;
+	root = NULL;
+done:
+	free(flat);
+	free(order);
+	free(mb);
+	free(ib);
+	free(root);
+	return st;
+}
+
 ajar_status scene_bvh(Scene *s, SceneShare **out)
 {
 	*out = NULL;
 	pthread_mutex_lock(&scene_bvh_lock);
 	SceneShare *sh = scene_share(s);
 	ajar_status st = sh ? AJAR_OK : AJAR_ERROR_OUT_OF_MEMORY;
-	if (sh && !sh->nodes) {
+	if (sh && s->ntris > BVH_MAX_TRIS)
+		st = err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: %u triangles, at most %u supported", s->source, s->ntris,
+			     (unsigned)BVH_MAX_TRIS);
+	if (sh && !sh->nodes && st == AJAR_OK) {
 		double t0 = seconds();
-		Bvh bvh;
-		st = bvh_build_reorder(sh->tris, (uint32_t)sh->ntris, bvh_threads(), reorder_in_place, sh, &bvh);
-		if (st == AJAR_OK) {
-			sh->nodes = bvh.nodes;
-			sh->nnodes = bvh.nnodes;
-			sh->bvh_depth = bvh.depth;
-			sh->bvh_wide_depth = bvh.wide_depth;
-			sh->bvh_seconds = seconds() - t0;
+		if (s->nmeshes) {
+			st = scene_bvh_two_level(s, sh);
+		} else {
+			Bvh bvh;
+			st = bvh_build_reorder(sh->tris, (uint32_t)sh->ntris, bvh_threads(), reorder_in_place, sh, &bvh);
+			if (st == AJAR_OK) {
+				sh->nodes = bvh.nodes;
+				sh->nnodes = bvh.nnodes;
+				sh->bvh_depth = bvh.depth;
+				sh->bvh_wide_depth = bvh.wide_depth;
+			}
 		}
+		if (st == AJAR_OK)
+			sh->bvh_seconds = seconds() - t0;
 	}
 	pthread_mutex_unlock(&scene_bvh_lock);
 	if (st != AJAR_OK) {

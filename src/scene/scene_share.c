@@ -40,6 +40,7 @@ static void share_free(SceneShare *sh, int arrays)
 		big_free(sh->texels, sh->cap_texels * sizeof *sh->texels);
 	}
 	big_free(sh->nodes, (size_t)sh->nnodes * sizeof *sh->nodes);
+	free(sh->mesh_root);
 	free(sh);
 }
 

@@ -27,8 +27,9 @@ struct SceneShare {
 	size_t ntexels, cap_texels;
 	/* What src/prepare/ builds once for these triangles: the BVH, with
 	 * the triangles above in its leaf order. */
-	BvhNode *nodes;         /* a big array of nnodes */
+	BvhNode *nodes;         /* a big array of nnodes: the top-level tree first */
 	uint32_t nnodes;
+	int32_t *mesh_root;     /* with meshes: each one's BVH root node, -1 for one without instances */
 	uint32_t bvh_depth, bvh_wide_depth;
 	double bvh_seconds;
 };
