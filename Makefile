@@ -79,6 +79,7 @@ HOST_DEPS := $(BUILD)/tests/kernel_host.o $(call obj,core/error scene/scene scen
 DEPS_test_bdpt := $(BUILD)/tests/mis_oracle.o $(HOST_DEPS)
 DEPS_test_punctual := $(HOST_DEPS)
 DEPS_test_scene_share := $(HOST_DEPS)
+DEPS_test_instances := $(BUILD)/tests/instance_scenes.o $(HOST_DEPS)
 PORTAL_DEPS := $(BUILD)/tests/portal_scenes.o $(HOST_DEPS)
 DEPS_test_portal_mis := $(BUILD)/tests/mis_oracle.o $(PORTAL_DEPS)
 DEPS_test_portal_groups := $(PORTAL_DEPS)
