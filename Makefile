@@ -99,6 +99,7 @@ DEPS_test_aov := $(BUILD)/libajar.a
 DEPS_test_subpaths := $(BUILD)/libajar.a
 DEPS_test_mpi := $(BUILD)/libajar.a
 DEPS_test_glass := $(BUILD)/libajar.a
+DEPS_test_instances_render := $(BUILD)/tests/instance_scenes.o $(BUILD)/libajar.a
 
 .PHONY: FORCE all lib cli tests test test-unit asan demo bench bench-peers install uninstall clean deps help
 all: lib cli
