@@ -1154,9 +1154,11 @@ ajar_status load_primitive(Loader &L, int mi, int pi, const double world[16], co
 /* The rule that keeps a mesh used more than once as instances (one copy
  * of its triangles, transformed per ray) rather than flattened into world
  * space (a copy per use): when its copies would add at least
- * INSTANCE_MIN_EXTRA triangles. Below that, flat triangles trace faster
- * and cost little memory (src/scene/README.md, "Instances"). */
-#define INSTANCE_MIN_EXTRA 16384
+ * INSTANCE_MIN_EXTRA triangles. Measured (AJAR_BENCH_RULE=1 make bench,
+ * one thread): instances trace 0.70-0.84x as fast as flattened copies up
+ * to 16k triangles in all, 0.95-0.98x at 65k, 1.11-1.12x at 260k and 1.97x
+ * at 4M (src/scene/README.md, "Instances"); 65k flat triangles cost 10 MiB. */
+#define INSTANCE_MIN_EXTRA 65536
 
 bool mesh_instanced(uint64_t triangles, uint64_t uses)
 {

@@ -18,6 +18,7 @@
 #include "device/device_build.h"
 #include "device/kernel_source.h"
 #include "prepare/prepare.h"
+#include "scene/gltf.h"
 #include "scene/scene.h"
 #include "device/upload.h"
 #include "testutil.h"
@@ -46,7 +47,18 @@ static int check(ajar_status st)
 
 /* Million closest-hit rays per second: rays from random points in the
  * scene's bounds in random directions (incoherent by construction). */
+static double traversal_mrays_local(const SceneData *sd, Device *d, size_t *local);
+
 static double traversal_mrays(const SceneData *sd, Device *d)
+{
+	/* PoCL picks its own groups for a one-level tree, as the figures
+	 * before instances were measured; with instances groups of 64 (the
+	 * two-level stack, held for a whole group, is twice as deep). */
+	size_t local = 64;
+	return traversal_mrays_local(sd, d, sd->n_instances ? &local : NULL);
+}
+
+static double traversal_mrays_local(const SceneData *sd, Device *d, size_t *local)
 {
 	const uint32_t n = 1u << 20;
 	float *rays = malloc(sizeof(float) * 6 * n);
@@ -74,14 +86,11 @@ static double traversal_mrays(const SceneData *sd, Device *d)
 	clSetKernelArg(k, arg, sizeof mrays, &mrays);
 	clSetKernelArg(k, arg + 1, sizeof mhits, &mhits);
 	clSetKernelArg(k, arg + 2, sizeof count, &count);
-	size_t global = n, local = 64;
+	size_t global = n;
 	double best = 1e30;
 	for (int rep = 0; rep < 3; rep++) { /* the first run includes PoCL's work-group compile */
 		double t0 = now();
-		/* PoCL picks its own groups for a one-level tree, as the figures
-		 * before instances were measured; with instances groups of 64 (the
-		 * two-level stack, held for a whole group, is twice as deep). */
-		clEnqueueNDRangeKernel(d->queue, k, 1, NULL, &global, sd->n_instances ? &local : NULL, 0, NULL, NULL);
+		clEnqueueNDRangeKernel(d->queue, k, 1, NULL, &global, local, 0, NULL, NULL);
 		clFinish(d->queue);
 		double t = now() - t0;
 		if (rep > 0 && t < best)
@@ -307,6 +316,66 @@ static void bench_scale(const char *dir)
 	}
 }
 
+/* ---- The flattening rule ---------------------------------------------- */
+
+/* One rule scene (make_scale_scenes.py rule-T-U) flattened and as
+ * instances: closest-hit rays per second of each (groups of 64 for both),
+ * and the memory of its triangles and BVH. */
+static void rule_row(const char *name, Device *flat, Device *inst)
+{
+	char path[256];
+	snprintf(path, sizeof path, "build/scale/%s.gltf", name);
+	double mrays[2];
+	size_t bytes[2];
+	for (int m = 0; m < 2; m++) {
+		Scene *s;
+		SceneData sd;
+		check(gltf_load_instancing(path, 0, m ? GLTF_INSTANCING_ALL : GLTF_INSTANCING_NONE, &s));
+		ajar_options po;
+		ajar_options_default(&po);
+		po.max_depth = 8;
+		check(prepare_scene(s, &po, 64, 64, NULL, &sd));
+		size_t local = 64;
+		mrays[m] = traversal_mrays_local(&sd, m ? inst : flat, &local);
+		bytes[m] = sd.n_tris * (sizeof(Tri) + sizeof(TriShade)) + sd.n_nodes * sizeof(BvhNode);
+		prepare_free(&sd);
+		scene_free(s);
+	}
+	printf("%-16s flattened %6.2f Mrays/s %7.1f MiB   instances %6.2f Mrays/s %7.1f MiB   speed inst/flat %.2f\n",
+	       name, mrays[0], bytes[0] / 1048576.0, mrays[1], bytes[1] / 1048576.0, mrays[1] / mrays[0]);
+}
+
+/* AJAR_BENCH_RULE=1: every rule scene, both ways. */
+static void bench_rule(void)
+{
+	static const unsigned tris[] = {64, 1024, 16384}, copies[] = {4, 16, 64, 256};
+	char cmd[2048] = "python3 tests/bench/make_scale_scenes.py build/scale";
+	for (int t = 0; t < 3; t++)
+		for (int u = 0; u < 4; u++)
+			snprintf(cmd + strlen(cmd), sizeof cmd - strlen(cmd), " rule-%u-%u", tris[t], copies[u]);
+	if (system(cmd) != 0) {
+		fprintf(stderr, "bench: %s failed\n", cmd);
+		exit(1);
+	}
+	Device flat, inst;
+	cl_platform_id plat;
+	cl_device_id id;
+	uint32_t ndev;
+	check(device_select(NULL, &plat, &id, 1, &ndev));
+	check(device_open(&flat, plat, id));
+	check(device_build(&flat, ajar_kernel_source, KERNEL_OPTIONS "0 -DAJAR_NO_INSTANCES"));
+	check(device_open(&inst, plat, id));
+	check(device_build(&inst, ajar_kernel_source, KERNEL_OPTIONS "0"));
+	for (int t = 0; t < 3; t++)
+		for (int u = 0; u < 4; u++) {
+			char name[64];
+			snprintf(name, sizeof name, "rule-%u-%u", tris[t], copies[u]);
+			rule_row(name, &flat, &inst);
+		}
+	device_close(&flat);
+	device_close(&inst);
+}
+
 /* ---- Efficiency at equal time ------------------------------------------- */
 
 /* Renders for `seconds` (or spp samples if seconds is 0); returns the
@@ -411,6 +480,10 @@ int main(int argc, char **argv)
 		return 1;
 	if (getenv("AJAR_BENCH_SCENES"))
 		goto equal_time;
+	if (getenv("AJAR_BENCH_RULE")) {
+		bench_rule(); /* the flattening rule's rows alone */
+		goto done;
+	}
 	if (getenv("AJAR_BENCH_SCALE") && strcmp(getenv("AJAR_BENCH_SCALE"), "0")) {
 		bench_scale(dir); /* AJAR_BENCH_SCALE=list: those rows alone */
 		goto done;

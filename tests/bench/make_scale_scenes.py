@@ -208,6 +208,30 @@ def instanced(name, copies, outdir, gpu=False):
     return copies * (len(ti) // 3)
 
 
+def rule(name, stacks, slices, copies, outdir):
+    """The flattening rule's scenes (bench.c, AJAR_BENCH_RULE): a bumpy
+    sphere of slices x (2 stacks - 2) triangles in `copies` nodes on a grid
+    over the room's floor, turned and scaled."""
+    w = Writer(name)
+    w.room()
+    tp, tn, ti = uv_sphere(stacks, slices, bump=0.05)
+    mesh = w.mesh(tp, tn, ti, 0)
+    rng = random.Random(3)
+    side = math.ceil(math.sqrt(copies))
+    step = (ROOM[0] - 1.0) / side
+    for k in range(copies):
+        i, j = divmod(k, side)
+        s = 0.4 * step * rng.uniform(0.7, 1.0)
+        a = rng.uniform(0, 2 * math.pi)
+        w.node(name="copy%d" % k, mesh=mesh, translation=[0.5 + (j + 0.5) * step, s, 0.5 + (i + 0.5) * step],
+               rotation=[0, math.sin(a / 2), 0, math.cos(a / 2)], scale=[s, s, s])
+    w.write(outdir)
+    return copies * (len(ti) // 3)
+
+
+RULE_MESHES = {64: (4, 11), 1024: (16, 34), 16384: (64, 130)}
+RULE_COPIES = (4, 16, 64, 256)
+
 SCENES = {
     "unique-1m": lambda d: unique("unique-1m", 1000000, d),
     "unique-10m": lambda d: unique("unique-10m", 10000000, d),
@@ -215,6 +239,10 @@ SCENES = {
     "inst-1000": lambda d: instanced("inst-1000", 1000, d),
     "inst-1000-gpu": lambda d: instanced("inst-1000-gpu", 1000, d, gpu=True),
 }
+for _t, (_st, _sl) in RULE_MESHES.items():
+    for _u in RULE_COPIES:
+        SCENES["rule-%d-%d" % (_t, _u)] = (lambda st, sl, u, t: lambda d: rule("rule-%d-%d" % (t, u), st, sl, u, d))(
+            _st, _sl, _u, _t)
 
 
 def main():
