@@ -187,6 +187,40 @@ ajar_status scene_bvh(Scene *s, SceneShare **out)
 	return AJAR_OK;
 }
 
+ajar_status scene_bvh_instances(const Scene *s, const SceneShare *sh, Instance **out, size_t *n)
+{
+	*out = calloc(s->ninstances ? s->ninstances : 1, sizeof **out);
+	*n = 0;
+	if (!*out)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory for %u instances", s->source, s->ninstances);
+	*n = s->ninstances;
+	for (uint32_t j = 0; j < s->ninstances; j++) {
+		const SceneInstance *si = &s->instances[j];
+		Instance *in = &(*out)[j];
+		const double *m = si->m;
+		/* The inverse of the 3x3 part by cofactors, then the translation. */
+		double c[9] = {m[5] * m[10] - m[6] * m[9], m[2] * m[9] - m[1] * m[10], m[1] * m[6] - m[2] * m[5],
+			       m[6] * m[8] - m[4] * m[10], m[0] * m[10] - m[2] * m[8], m[2] * m[4] - m[0] * m[6],
+			       m[4] * m[9] - m[5] * m[8], m[1] * m[8] - m[0] * m[9], m[0] * m[5] - m[1] * m[4]};
+		double det = m[0] * c[0] + m[1] * c[3] + m[2] * c[6];
+		for (int r = 0; r < 3; r++) {
+			double t = 0.0;
+			for (int k = 0; k < 3; k++) {
+				double v = c[3 * r + k] / det;
+				in->inv[4 * r + k] = (float)v;
+				t -= v * m[4 * k + 3];
+			}
+			in->inv[4 * r + 3] = (float)t;
+		}
+		for (int k = 0; k < 12; k++)
+			in->xf[k] = (float)m[k];
+		in->root = sh->mesh_root[si->mesh];
+		in->flags = det < 0.0 ? INSTANCE_MIRROR : 0;
+		in->mesh = (int)si->mesh;
+	}
+	return AJAR_OK;
+}
+
 ajar_status ajar_scene_build_bvh(ajar_scene *s)
 {
 	if (!s)
