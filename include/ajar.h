@@ -46,7 +46,10 @@ void ajar_set_log_callback(ajar_log_fn fn, void *user);
 typedef struct ajar_scene ajar_scene;
 
 /* Loads .gltf (with .bin, images) or .glb. Portals are mesh nodes with
- * extras {"portal": true}; the environment comes from scene extras. */
+ * extras {"portal": true}; the environment comes from scene extras. A mesh
+ * whose copies (nodes, EXT_mesh_gpu_instancing) would add 65,536 triangles
+ * or more is kept once, as instances. Renderers share the scene's
+ * triangles (held once) and put them in their BVH's order. */
 ajar_status ajar_scene_load(const char *path, ajar_scene **out);
 /* How ajar_scene_load_with reads a scene. By default every file the scene
  * names (buffer and image URIs, the environment image in its extras) must

@@ -272,8 +272,51 @@ static void test_two_level_structure(void **state)
 	free(path);
 }
 
-/* A top level of 60,000 triangles and 2,000 instance boxes, built on 1, 2,
- * 3 and 8 threads: the same nodes and order; instances in leaves of one. */
+/* A random top level's invariants: every triangle in one leaf (its box
+ * inside the slot's), every instance in one slot of its own (its box
+ * inside), children's boxes inside their slot's. */
+static void check_top_level(const Bvh *b, const Tri *t, uint32_t nt, const V3 *lo, const V3 *hi, uint32_t ni)
+{
+	uint32_t *seen = calloc(nt, sizeof *seen), *iseen = calloc(ni, sizeof *iseen);
+	for (uint32_t i = 0; i < b->nnodes; i++) {
+		const BvhNode *n = &b->nodes[i];
+		for (int k = 0; k < BVH_WIDTH; k++) {
+			int c = n->child[k];
+			if (c == BVH_EMPTY)
+				continue;
+			if (c >= BVH_INSTANCE_BASE) {
+				uint32_t j = (uint32_t)(c - BVH_INSTANCE_BASE);
+				assert_true(j < ni);
+				iseen[j]++;
+				assert_true(box_in(n, k, lo[j], hi[j]));
+			} else if (c < 0) {
+				for (int q = BVH_LEAF_FIRST(c); q < BVH_LEAF_FIRST(c) + BVH_LEAF_COUNT(c); q++) {
+					assert_true((uint32_t)q < nt);
+					const Tri *tr = &t[b->order[q]];
+					assert_true(box_in(n, k, v3_min(tr->p0, v3_min(tr->p1, tr->p2)),
+							   v3_max(tr->p0, v3_max(tr->p1, tr->p2))));
+					seen[b->order[q]]++;
+				}
+			} else {
+				assert_true((uint32_t)c > i && (uint32_t)c < b->nnodes);
+				const BvhNode *ch = &b->nodes[c];
+				for (int q = 0; q < BVH_WIDTH; q++)
+					if (ch->child[q] != BVH_EMPTY)
+						assert_true(box_in(n, k, v3(ch->lo_x[q], ch->lo_y[q], ch->lo_z[q]),
+								   v3(ch->hi_x[q], ch->hi_y[q], ch->hi_z[q])));
+			}
+		}
+	}
+	for (uint32_t i = 0; i < nt; i++)
+		assert_int_equal(seen[i], 1);
+	for (uint32_t j = 0; j < ni; j++)
+		assert_int_equal(iseen[j], 1);
+	free(seen);
+	free(iseen);
+}
+
+/* A top level of 60,000 triangles and 2,000 instance boxes: its
+ * invariants, and the same nodes and order on 1, 2, 3 and 8 threads. */
 static void test_threads_with_instances(void **state)
 {
 	uint32_t nt = 60000, ni = 2000;
@@ -294,11 +337,7 @@ static void test_threads_with_instances(void **state)
 	Bvh ref;
 	memset(&ref, 0, sizeof ref);
 	assert_int_equal(bvh_build_input(&in, 1, NULL, NULL, &ref), AJAR_OK);
-	uint32_t inst_slots = 0;
-	for (uint32_t i = 0; i < ref.nnodes; i++)
-		for (int k = 0; k < BVH_WIDTH; k++)
-			inst_slots += ref.nodes[i].child[k] >= BVH_INSTANCE_BASE;
-	assert_int_equal(inst_slots, ni);
+	check_top_level(&ref, t, nt, lo, hi, ni);
 	static const int threads[] = {2, 3, 8};
 	for (size_t k = 0; k < 3; k++) {
 		Bvh b;
