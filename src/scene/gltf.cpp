@@ -1155,9 +1155,10 @@ ajar_status load_primitive(Loader &L, int mi, int pi, const double world[16], co
  * of its triangles, transformed per ray) rather than flattened into world
  * space (a copy per use): when its copies would add at least
  * INSTANCE_MIN_EXTRA triangles. Measured (AJAR_BENCH_RULE=1 make bench,
- * one thread): instances trace 0.70-0.84x as fast as flattened copies up
- * to 16k triangles in all, 0.95-0.98x at 65k, 1.11-1.12x at 260k and 1.97x
- * at 4M (src/scene/README.md, "Instances"); 65k flat triangles cost 10 MiB. */
+ * one thread): instances trace 0.64-0.82x as fast as flattened copies up
+ * to 17k triangles in all, 0.94x (and once 1.59x) at 65k, 1.14x at 260k
+ * and 2.07x at 4M (src/scene/README.md, "Instances"); 65k flat triangles
+ * cost 10 MiB. */
 #define INSTANCE_MIN_EXTRA 65536
 
 bool mesh_instanced(uint64_t triangles, uint64_t uses)
