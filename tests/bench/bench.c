@@ -316,9 +316,9 @@ static void bench_scale(const char *dir)
 	for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
 		if (in_list(want, names[i]))
 			snprintf(cmd + strlen(cmd), sizeof cmd - strlen(cmd), " %s", names[i]);
-	if (system(cmd) != 0) {
-		fprintf(stderr, "bench: %s failed\n", cmd);
-		exit(1);
+	if (system(cmd) != 0) { /* no python3, or no room in build/ */
+		printf("scale rows skipped: %s failed\n", cmd);
+		return;
 	}
 	int first = 1;
 	for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
