@@ -57,16 +57,18 @@ TESTS := $(UNIT_TESTS) $(notdir $(basename $(wildcard tests/render/test_*.c test
 obj = $(addprefix $(BUILD)/src/,$(addsuffix .o,$(1)))
 DEPS_test_bsdf := $(call obj,core/error)
 DEPS_test_sampling := $(call obj,core/error)
-DEPS_test_bvh := $(call obj,core/error core/input_file scene/scene scene/emit_mask prepare/bvh_build scene/gltf scene/tangents image/texture_file image/exr image/exr_read image/hdr)
+# The BVH build: its driver and threads, the node split, the wide collapse.
+BVH_OBJS := prepare/bvh_build prepare/bvh_split prepare/bvh_collapse core/workers
+DEPS_test_bvh := $(call obj,core/error core/input_file scene/scene scene/emit_mask scene/scene_share core/big_array $(BVH_OBJS) scene/gltf scene/tangents image/texture_file image/exr image/exr_read image/hdr)
 # The light tests share tests/support/lit.c (the kernels' light code inside).
-LIGHT_DEPS := $(BUILD)/tests/lit.o $(call obj,core/error core/input_file scene/scene scene/emit_mask prepare/light_tables image/exr image/exr_read image/hdr)
+LIGHT_DEPS := $(BUILD)/tests/lit.o $(call obj,core/error core/input_file scene/scene scene/emit_mask scene/scene_share core/big_array prepare/light_tables image/exr image/exr_read image/hdr)
 DEPS_test_lights_env := $(LIGHT_DEPS) $(call obj,prepare/portal_flux)
 DEPS_test_lights_emitters := $(LIGHT_DEPS)
 DEPS_test_lights_sample := $(LIGHT_DEPS)
 DEPS_test_lights_sky_planes := $(LIGHT_DEPS) $(call obj,prepare/sky_tables)
 DEPS_test_lights_sky_planes_fine := $(patsubst %/lit.o,%/lit_fine.o,$(DEPS_test_lights_sky_planes))
 # The scene module: the loader, the API's scene calls, the images a scene reads.
-SCENE_DEPS := $(call obj,core/error core/input_file scene/scene scene/emit_mask scene/scene_api scene/gltf scene/tangents image/texture_file image/exr image/exr_read image/hdr)
+SCENE_DEPS := $(call obj,core/error core/input_file scene/scene scene/emit_mask scene/scene_share core/big_array scene/scene_api scene/gltf scene/tangents image/texture_file image/exr image/exr_read image/hdr)
 DEPS_test_scene_shipped := $(BUILD)/tests/scene_files.o $(SCENE_DEPS)
 DEPS_test_scene_api := $(BUILD)/tests/scene_files.o $(SCENE_DEPS)
 DEPS_test_scene_gltf := $(BUILD)/tests/scene_files.o $(SCENE_DEPS)
@@ -76,9 +78,11 @@ DEPS_test_exr := $(call obj,core/error core/input_file image/exr image/exr_read 
 DEPS_test_confine := $(SCENE_DEPS) $(call obj,image/png)
 # The kernels' integrators run on the host (tests/support/kernel_host.c) on
 # scenes as prepare_scene makes them; the MIS tests add the oracle.
-HOST_DEPS := $(BUILD)/tests/kernel_host.o $(call obj,core/error core/input_file scene/scene scene/emit_mask scene/scene_api scene/gltf scene/tangents image/texture_file image/exr image/exr_read image/hdr prepare/bvh_build prepare/light_tables prepare/prepare prepare/policy prepare/portal_flux prepare/sky_tables prepare/portal_find prepare/found_portals render/render_options)
+HOST_DEPS := $(BUILD)/tests/kernel_host.o $(call obj,core/error core/input_file scene/scene scene/emit_mask scene/scene_share core/big_array scene/scene_api scene/gltf scene/tangents image/texture_file image/exr image/exr_read image/hdr $(BVH_OBJS) prepare/light_tables prepare/prepare prepare/scene_bvh prepare/policy prepare/portal_flux prepare/sky_tables prepare/portal_find prepare/found_portals render/render_options)
 DEPS_test_bdpt := $(BUILD)/tests/mis_oracle.o $(HOST_DEPS)
 DEPS_test_punctual := $(HOST_DEPS)
+DEPS_test_scene_share := $(HOST_DEPS)
+DEPS_test_instances := $(BUILD)/tests/instance_scenes.o $(HOST_DEPS)
 PORTAL_DEPS := $(BUILD)/tests/portal_scenes.o $(HOST_DEPS)
 DEPS_test_portal_mis := $(BUILD)/tests/mis_oracle.o $(PORTAL_DEPS)
 DEPS_test_portal_groups := $(PORTAL_DEPS)
@@ -104,6 +108,7 @@ DEPS_test_cli_scene := $(BUILD)/libajar.a
 DEPS_test_noise := $(BUILD)/libajar.a
 DEPS_test_glass := $(BUILD)/libajar.a
 DEPS_test_limits := $(BUILD)/libajar.a
+DEPS_test_instances_render := $(BUILD)/tests/instance_scenes.o $(BUILD)/libajar.a
 
 .PHONY: FORCE all lib cli tests test test-unit asan fuzz fuzz-check fuzzers demo bench bench-portals bench-peers install uninstall clean deps help
 all: lib cli

@@ -46,7 +46,10 @@ void ajar_set_log_callback(ajar_log_fn fn, void *user);
 typedef struct ajar_scene ajar_scene;
 
 /* Loads .gltf (with .bin, images) or .glb. Portals are mesh nodes with
- * extras {"portal": true}; the environment comes from scene extras. */
+ * extras {"portal": true}; the environment comes from scene extras. A mesh
+ * whose copies (nodes, EXT_mesh_gpu_instancing) would add 65,536 triangles
+ * or more is kept once, as instances. Renderers share the scene's
+ * triangles (held once) and put them in their BVH's order. */
 ajar_status ajar_scene_load(const char *path, ajar_scene **out);
 /* How ajar_scene_load_with reads a scene. By default every file the scene
  * names (buffer and image URIs, the environment image in its extras) must
@@ -159,8 +162,18 @@ typedef struct {
 	uint64_t alpha_triangles; /* triangles whose alpha (MASK, BLEND) rays test */
 	uint32_t normal_textures; /* images used as normal maps */
 	uint32_t lights;         /* KHR_lights_punctual lights (ajar_scene_light_get) */
+	/* triangles counts every instance's; these hold each mesh once. */
+	uint64_t unique_triangles;
+	uint32_t instances;      /* copies of meshes kept as instances, not flattened */
+	uint64_t geometry_bytes; /* the triangles' memory (held once, shared with renderers) */
+	uint64_t bvh_bytes;      /* the BVH's memory; 0 until built */
+	double load_seconds;     /* ajar_scene_load's time (0 for a scene built in code) */
+	double bvh_seconds;      /* the BVH build's time; 0 until built */
 } ajar_scene_info;
 ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info);
+/* Builds the scene's BVH now (on every core), else the first renderer does;
+ * later renderers of the unchanged scene reuse it. */
+ajar_status ajar_scene_build_bvh(ajar_scene *s);
 
 /* A portal found without markup: a rectangle over an opening (a window, a
  * door ajar, a roof opening) through which light from outside the camera's

@@ -8,7 +8,7 @@
 #define AJAR_LAYOUT_TYPES(X) \
 	X(BvhNode, 256) X(Tri, 48) X(TriShade, 64) X(TriExtra, 128) X(Material, 96) X(Texture, 48) \
 	X(Emitter, 16) X(PortalTri, 64) X(Camera, 64) X(Params, 240) \
-	X(PortalPlane, 80) X(PunctualLight, 64)
+	X(PortalPlane, 80) X(PunctualLight, 64) X(Instance, 112)
 
 #define AJAR_LAYOUT_FIELDS(X)                                                          \
 	X(BvhNode, lo_x) X(BvhNode, lo_z) X(BvhNode, hi_x) X(BvhNode, hi_z) X(BvhNode, child)\
@@ -48,5 +48,6 @@
 	X(Params, num_portal_planes) X(Params, env_rot_cos) X(Params, env_rot_sin)     \
 	X(Params, bdpt_conn) X(Params, env_lines) X(Params, num_panes)                 \
 	X(PortalPlane, o) X(PortalPlane, a0) X(PortalPlane, t) X(PortalPlane, n)      \
-	X(PortalPlane, b1) X(PortalPlane, table)
+	X(PortalPlane, b1) X(PortalPlane, table)                                       \
+	X(Instance, xf) X(Instance, inv) X(Instance, root) X(Instance, flags) X(Instance, mesh)
 #endif

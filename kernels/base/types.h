@@ -23,6 +23,23 @@ typedef struct {
 	int pad[BVH_WIDTH]; /* to four whole cache lines */
 } BvhNode; /* 256 */
 
+/* A copy of a mesh: its triangles in object space under their own BVH
+ * (child BVH_INSTANCE(i) of a top-level slot, kernels/geom/bvh.h), placed
+ * by an affine transform: p_world = xf p_obj, rows of 3x4, and inv its
+ * inverse. Normals go by inv's transpose, tangents by xf; a mirroring
+ * transform (negative determinant, INSTANCE_MIRROR) turns the bitangent
+ * sign over. Its triangles never emit (emissive primitives are flattened,
+ * src/scene/gltf.cpp), so the light tables see world-space triangles only. */
+#define INSTANCE_MIRROR 1
+typedef struct {
+	float xf[12];  /* object to world, row-major 3x4 */
+	float inv[12]; /* world to object */
+	int root;      /* its mesh's BVH root node */
+	int flags;     /* INSTANCE_* */
+	int mesh;
+	int pad0;
+} Instance; /* 112 */
+
 /* Triangle as traversal sees it. `emitter` indexes Emitter (or -1). */
 #define TRI_EXTRA 1 /* has TriExtra data (TEXCOORD_1, COLOR_0) */
 #define TRI_ALPHA 2 /* its material may be transparent here: rays test its alpha (bvh.h) */
@@ -282,6 +299,7 @@ typedef struct {
 	X(PunctualLight, punctual) \
 	X(PortalPlane, portal_planes) \
 	X(float, portal_sky)      \
+	X(Instance, instances)    \
 	X(Params, params)
 
 /* What device code sees of the scene: one pointer per array. */

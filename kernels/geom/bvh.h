@@ -13,12 +13,20 @@
 #include "material/texture.h"
 #include "base/types.h"
 
+/* Any traversal of one eight-wide tree pushes at most 7 entries a level
+ * for 32 levels (src/prepare/bvh_build.c); with instances, a top-level
+ * tree's and a mesh's. */
+#ifdef AJAR_NO_INSTANCES
 #define BVH_STACK_SIZE 224
+#else
+#define BVH_STACK_SIZE 448
+#endif
 
 typedef struct {
 	float t;
 	float u, v; /* barycentrics of p1 and p2 */
 	int tri;
+	int inst;   /* the Instance the triangle was hit in, -1 for world-space triangles */
 } Hit;
 
 /* The panes (TRI_PANE triangles) a shadow ray crosses, kept by the traversal
@@ -126,6 +134,9 @@ HOT_INLINE void box_slab(float lo, float hi, float o, float inv_d, float *tn, fl
 /* Leaf slots: triangles [first, first + count), 1 <= count <= 4. */
 #define BVH_LEAF(first, count) (-1 - (4 * (first) + (count) - 1))
 #define BVH_EMPTY (-2147483647 - 1)
+/* A top-level slot holding Instance i: past every node index. */
+#define BVH_INSTANCE_BASE 0x40000000
+#define BVH_INSTANCE(i) (BVH_INSTANCE_BASE + (i))
 #define BVH_LEAF_FIRST(c) ((-1 - (c)) >> 2)
 #define BVH_LEAF_COUNT(c) (((-1 - (c)) & 3) + 1)
 
@@ -189,6 +200,26 @@ INLINE int v3_finite(V3 a)
 	return fabs(a.x) <= AJAR_INF && fabs(a.y) <= AJAR_INF && fabs(a.z) <= AJAR_INF;
 }
 
+/* An affine transform's rows of 3x4 (Instance.xf, .inv) applied to a
+ * point, and its 3x3 part to a vector. */
+INLINE V3 xf_point(GLOBAL const float *m, V3 p)
+{
+	return v3(m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3], m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
+		  m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]);
+}
+INLINE V3 xf_vector(GLOBAL const float *m, V3 v)
+{
+	return v3(m[0] * v.x + m[1] * v.y + m[2] * v.z, m[4] * v.x + m[5] * v.y + m[6] * v.z,
+		  m[8] * v.x + m[9] * v.y + m[10] * v.z);
+}
+/* A normal by the transpose of inv's 3x3 part (inv^T n: the inverse
+ * transpose of the object-to-world transform). */
+INLINE V3 xf_normal(GLOBAL const float *inv, V3 n)
+{
+	return v3(inv[0] * n.x + inv[4] * n.y + inv[8] * n.z, inv[1] * n.x + inv[5] * n.y + inv[9] * n.z,
+		  inv[2] * n.x + inv[6] * n.y + inv[10] * n.z);
+}
+
 /* Closest hit with 0 < t < tmax (any_hit = 0), or the first hit found
  * (any_hit = 1), where with `panes` a pane is no hit but goes on the list.
  * Shared by the queries so the kernel holds one copy.
@@ -207,9 +238,28 @@ INLINE int bvh_traverse(const SceneView *sc, V3 o, V3 d, float tmax, int any_hit
 	float stack_t[BVH_STACK_SIZE];
 	int sp = 0;
 	int found = 0;
-	int entry = 0; /* the root */
+	int entry = 0; /* the root: the top-level tree's with instances */
+#ifdef AJAR_NO_INSTANCES
+	const int inst = -1;
+#else
+	/* Inside an instance the ray is the object-space one, r; the world's
+	 * comes back when the stack falls below inst_sp, where it stood on
+	 * entering. d is transformed unnormalized, so t is the same on both
+	 * sides. */
+	int inst = -1, inst_sp = 0;
+#endif
 	for (;;) {
 		if (entry >= 0) {
+#ifndef AJAR_NO_INSTANCES
+			if (entry >= BVH_INSTANCE_BASE) {
+				inst = entry - BVH_INSTANCE_BASE;
+				inst_sp = sp;
+				GLOBAL const Instance *in = &sc->instances[inst];
+				r = ray_pre(xf_point(in->inv, o), xf_vector(in->inv, d));
+				entry = in->root;
+				continue;
+			}
+#endif
 			GLOBAL const BvhNode *n = &sc->nodes[entry];
 			float tn[BVH_WIDTH];
 			int mask = bvh_node_enter(&r, n, fmin(tmax * 1.00001f, AJAR_INF), tn);
@@ -275,6 +325,7 @@ INLINE int bvh_traverse(const SceneView *sc, V3 o, V3 d, float tmax, int any_hit
 							ph->u = u;
 							ph->v = v;
 							ph->tri = i;
+							ph->inst = inst;
 						}
 						panes->n++;
 						continue;
@@ -286,6 +337,7 @@ INLINE int bvh_traverse(const SceneView *sc, V3 o, V3 d, float tmax, int any_hit
 					hit->u = u;
 					hit->v = v;
 					hit->tri = i;
+					hit->inst = inst;
 					if (any_hit)
 						return 1;
 				}
@@ -297,6 +349,12 @@ INLINE int bvh_traverse(const SceneView *sc, V3 o, V3 d, float tmax, int any_hit
 			sp--;
 		} while (stack_t[sp] > tmax * 1.00001f);
 		entry = stack[sp];
+#ifndef AJAR_NO_INSTANCES
+		if (inst >= 0 && sp < inst_sp) { /* back out of the instance */
+			inst = -1;
+			r = ray_pre(o, d);
+		}
+#endif
 	}
 }
 
@@ -327,6 +385,17 @@ CALLED int bvh_occluded_panes(const SceneView *sc, V3 o, V3 d, float tmax, PaneH
 INLINE V3 tri_normal(GLOBAL const Tri *t)
 {
 	return v3_cross(v3_sub(t->p1, t->p0), v3_sub(t->p2, t->p0));
+}
+
+/* The world-space geometric normal (any length, the front face's side) of
+ * the triangle a hit found: through its instance's transform if any. */
+INLINE V3 hit_normal(const SceneView *sc, const Hit *h)
+{
+#ifndef AJAR_NO_INSTANCES
+	if (h->inst >= 0)
+		return xf_normal(sc->instances[h->inst].inv, tri_normal(&sc->tris[h->tri]));
+#endif
+	return tri_normal(&sc->tris[h->tri]);
 }
 
 /* Spawn point for a ray leaving surface point p in direction d: p moved

@@ -34,14 +34,10 @@ INLINE Rgba surface_texture(const SceneView *sc, const Surface *s, int tex, int 
 
 /* A normal map's normal at s (glTF 3.9.3): the texel (linear) as a
  * tangent-space vector, x and y times the scale, in the frame of the
- * interpolated tangent (made orthogonal to n), sign x (n x t) and n. */
-INLINE V3 surface_normal_map(const SceneView *sc, const Surface *s, GLOBAL const TriExtra *e, float w, float b1,
-			     float b2, V3 n)
+ * interpolated tangent t (made orthogonal to n), sign x (n x t) and n. */
+INLINE V3 surface_normal_map(const SceneView *sc, const Surface *s, V3 t, float sign, V3 n)
 {
 	GLOBAL const Material *m = &sc->materials[s->material];
-	V3 t = v3(w * e->t0[0] + b1 * e->t1[0] + b2 * e->t2[0], w * e->t0[1] + b1 * e->t1[1] + b2 * e->t2[1],
-		  w * e->t0[2] + b1 * e->t1[2] + b2 * e->t2[2]);
-	float sign = w * e->t0[3] + b1 * e->t1[3] + b2 * e->t2[3] < 0.0f ? -1.0f : 1.0f;
 	t = v3_madd(t, n, -v3_dot(t, n));
 	float lt = v3_len2(t);
 	if (!(lt > 1e-12f))
@@ -55,13 +51,27 @@ INLINE V3 surface_normal_map(const SceneView *sc, const Surface *s, GLOBAL const
 	return lr > 1e-12f ? v3_scale(r, 1.0f / sqrt(lr)) : n;
 }
 
+/* A hit in an instance (Hit.inst) is a triangle in object space: its
+ * point goes by the instance's transform, its normals by the inverse
+ * transpose (each vertex normal made unit, as the loader makes a flattened
+ * copy's), its tangent by the transform, and a mirroring instance turns
+ * the bitangent over, so a copy shades as its flattened triangle would. */
 INLINE void surface_from_hit(const SceneView *sc, const Hit *h, Surface *s)
 {
 	GLOBAL const Tri *t = &sc->tris[h->tri];
 	GLOBAL const TriShade *sh = &sc->shade[h->tri];
+#ifndef AJAR_NO_INSTANCES
+	GLOBAL const Instance *in = h->inst >= 0 ? &sc->instances[h->inst] : 0;
+#endif
 	float w = 1.0f - h->u - h->v;
 	s->p = v3_add(v3_add(v3_scale(t->p0, w), v3_scale(t->p1, h->u)), v3_scale(t->p2, h->v));
 	s->ng = v3_norm(tri_normal(t));
+#ifndef AJAR_NO_INSTANCES
+	if (in) {
+		s->p = xf_point(in->xf, s->p);
+		s->ng = v3_norm(xf_normal(in->inv, tri_normal(t)));
+	}
+#endif
 	s->tu = w * sh->u0 + h->u * sh->u1 + h->v * sh->u2;
 	s->tv = w * sh->v0 + h->u * sh->v1 + h->v * sh->v2;
 	s->tu1 = s->tv1 = 0.0f;
@@ -83,14 +93,35 @@ INLINE void surface_from_hit(const SceneView *sc, const Hit *h, Surface *s)
 #endif
 	V3 n = s->ng;
 	if (sh->has_normals) {
-		V3 ni = v3_add(v3_add(v3_scale(sh->n0, w), v3_scale(sh->n1, h->u)), v3_scale(sh->n2, h->v));
+		V3 n0 = sh->n0, n1 = sh->n1, n2 = sh->n2;
+#ifndef AJAR_NO_INSTANCES
+		if (in) {
+			n0 = v3_norm(xf_normal(in->inv, n0));
+			n1 = v3_norm(xf_normal(in->inv, n1));
+			n2 = v3_norm(xf_normal(in->inv, n2));
+		}
+#endif
+		V3 ni = v3_add(v3_add(v3_scale(n0, w), v3_scale(n1, h->u)), v3_scale(n2, h->v));
 		float len2 = v3_len2(ni);
 		if (len2 > 1e-12f)
 			n = v3_scale(ni, 1.0f / sqrt(len2));
 	}
 #ifndef AJAR_NO_BENT_NORMALS
-	if (t->flags & TRI_TANGENT)
-		n = surface_normal_map(sc, s, &sc->extra[h->tri], w, h->u, h->v, n);
+	if (t->flags & TRI_TANGENT) {
+		GLOBAL const TriExtra *e = &sc->extra[h->tri];
+		float b1 = h->u, b2 = h->v;
+		V3 tan = v3(w * e->t0[0] + b1 * e->t1[0] + b2 * e->t2[0], w * e->t0[1] + b1 * e->t1[1] + b2 * e->t2[1],
+			    w * e->t0[2] + b1 * e->t1[2] + b2 * e->t2[2]);
+		float sign = w * e->t0[3] + b1 * e->t1[3] + b2 * e->t2[3] < 0.0f ? -1.0f : 1.0f;
+#ifndef AJAR_NO_INSTANCES
+		if (in) {
+			tan = xf_vector(in->xf, tan);
+			if (in->flags & INSTANCE_MIRROR)
+				sign = -sign;
+		}
+#endif
+		n = surface_normal_map(sc, s, tan, sign, n);
+	}
 #endif
 	s->ns = v3_dot(n, s->ng) < 0.0f ? v3_neg(n) : n;
 }

@@ -51,7 +51,7 @@ INLINE V3 ray_transmittance(const SceneView *sc, V3 o, V3 d, float tmax)
 			return zero;
 		T = v3_mul(T, pane_transmittance(sc, &h, d));
 		V3 q = v3_add(p, v3_scale(d, h.t));
-		p = ray_offset(q, tri_normal(&sc->tris[h.tri]), d);
+		p = ray_offset(q, hit_normal(sc, &h), d);
 		left = tmax - v3_len(v3_sub(p, o));
 	}
 	return T;

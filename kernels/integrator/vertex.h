@@ -224,7 +224,7 @@ CALLED int vertex_trace(const SceneView *sc, VRef path, int n, V3 o, V3 d, V3 be
 	VTMP(vt);
 	const PathVertex *prev = VLOAD(VAT(path, n - 1), pt);
 	PathVertex *v = VNEW(VAT(path, n), vt);
-	Hit h = {0.0f, 0.0f, 0.0f, -1}; /* gcc cannot see bvh_intersect set it */
+	Hit h = {0.0f, 0.0f, 0.0f, -1, -1}; /* gcc cannot see bvh_intersect set it */
 	int portals = PARAMS_INTEGRATOR(sc->params) == INTEGRATOR_PORTAL;
 	v->wo = v3_neg(d);
 	v->delta = 0;

@@ -41,9 +41,9 @@ static const char usage_main[] =
 	"\n"
 	"commands:\n"
 	"  render SCENE -o OUT.exr [options]  render a .gltf/.glb scene to OpenEXR (see 'ajar render --help')\n"
-	"  info SCENE [options]               what the scene holds: triangles, lights, portals (marked\n"
-	"                                     and found), camera (see 'ajar info --help')\n"
-	"  devices                            list OpenCL devices and how to select one\n"
+	"  info SCENE [options]               what the scene holds: triangles, instances, lights, portals\n"
+	"                                     (marked and found), camera, memory of geometry, BVH and\n"
+	"                                     textures (see 'ajar info --help')\n"	"  devices                            list OpenCL devices and how to select one\n"
 	"  help [render]                      this text, or the render options\n"
 	"  --version                          print the version\n"
 	"\n"
@@ -684,6 +684,15 @@ static int cmd_render(int argc, char **argv)
 		goto done;
 	}
 	if (!a.quiet) {
+		/* The scene as loaded and prepared: its size and the time it took. */
+		ajar_scene_info si;
+		if (ajar_scene_info_get(scene, &si) == AJAR_OK)
+			fprintf(stderr,
+				"ajar: scene: %llu triangles (%llu unique, %u instances), geometry %.1f MiB, BVH %.1f MiB, "
+				"textures %.1f MiB; loaded in %.2f s, BVH built in %.2f s\n",
+				(unsigned long long)si.triangles, (unsigned long long)si.unique_triangles, si.instances,
+				si.geometry_bytes / 1048576.0, si.bvh_bytes / 1048576.0, si.texture_bytes / 1048576.0,
+				si.load_seconds, si.bvh_seconds);
 		char budget[64] = "";
 		if (a.opt.spp)
 			snprintf(budget, sizeof budget, "%u spp", a.opt.spp);
@@ -845,7 +854,9 @@ static int cmd_info(int argc, char **argv)
 		return rc;
 	}
 	ajar_scene_info in;
-	ajar_status st = ajar_scene_info_get(scene, &in);
+	ajar_status st = ajar_scene_build_bvh(scene);
+	if (st == AJAR_OK)
+		st = ajar_scene_info_get(scene, &in);
 	if (st != AJAR_OK) {
 		report(st, ia.scene);
 		ajar_scene_destroy(&scene);
@@ -853,7 +864,8 @@ static int cmd_info(int argc, char **argv)
 	}
 	static const char *const env[] = {"none", "colour", "image"};
 	printf("scene:        %s\n", ia.scene);
-	printf("triangles:    %llu\n", (unsigned long long)in.triangles);
+	printf("triangles:    %llu (%llu unique, %u instances)\n", (unsigned long long)in.triangles,
+	       (unsigned long long)in.unique_triangles, in.instances);
 	printf("materials:    %u\n", in.materials);
 	printf("emissive:     %u triangles\n", in.emissive_triangles);
 	printf("portals:      %u objects, %u triangles (marked)\n", in.portals, in.portal_triangles);
@@ -900,6 +912,9 @@ static int cmd_info(int argc, char **argv)
 	       in.normal_textures,
 	       (double)in.texture_bytes / (1024.0 * 1024.0));
 	printf("alpha-tested: %llu triangles\n", (unsigned long long)in.alpha_triangles);
+	printf("memory:       geometry %.1f MiB, BVH %.1f MiB, textures %.1f MiB\n", in.geometry_bytes / 1048576.0,
+	       in.bvh_bytes / 1048576.0, in.texture_bytes / 1048576.0);
+	printf("times:        loaded in %.2f s, BVH built in %.2f s\n", in.load_seconds, in.bvh_seconds);
 	printf("environment:  %s\n", in.environment >= 0 && in.environment <= 2 ? env[in.environment] : "?");
 	printf("bounds:       (%g, %g, %g) .. (%g, %g, %g)\n", in.bounds_min[0], in.bounds_min[1],
 	       in.bounds_min[2], in.bounds_max[0], in.bounds_max[1], in.bounds_max[2]);

@@ -128,7 +128,9 @@ ajar_status device_buffer(Device *d, cl_mem_flags flags, size_t bytes, const voi
 		bytes = 16; /* OpenCL forbids empty buffers; kernels never read it */
 		host = NULL;
 	}
-	if (host)
+	if (!host)
+		flags &= ~(cl_mem_flags)CL_MEM_USE_HOST_PTR;
+	else if (!(flags & CL_MEM_USE_HOST_PTR))
 		flags |= CL_MEM_COPY_HOST_PTR;
 	*out = clCreateBuffer(d->ctx, flags, bytes, (void *)host, &err);
 	if (!*out)

@@ -26,6 +26,9 @@ typedef struct Device {
 ajar_status device_open(Device *d, cl_platform_id platform, cl_device_id id);
 void device_close(Device *d);
 ajar_status device_kernel(Device *d, const char *name, cl_kernel *out);
+/* A buffer of `bytes`; with `host`, its contents copied from there, or the
+ * host memory itself where flags has CL_MEM_USE_HOST_PTR (which must then
+ * outlive the buffer and stay unchanged). */
 ajar_status device_buffer(Device *d, cl_mem_flags flags, size_t bytes, const void *host, cl_mem *out);
 /* Whether buffers of the n sizes can all be had on d, asked before any is
  * made: OpenCL's limits for one buffer and for all, and on a CPU device,

@@ -5,7 +5,7 @@
 #include "device/device.h"
 #include "prepare/prepare.h"
 
-#define AJAR_MAX_BUFFERS 16
+#define AJAR_MAX_BUFFERS 24
 
 typedef struct {
 	cl_mem mem[AJAR_MAX_BUFFERS];

@@ -1,420 +1,178 @@
-/* bvh_build.c — binned SAH build of the flattened BVH (see bvh_build.h).
+/* bvh_build.c — the binned SAH build of the flattened BVH (see bvh_build.h),
+ * on every core.
  *
- * Top-down, one node at a time from an explicit stack (no recursion, so a
- * million triangles or a pathological input cannot overflow the C stack).
- * Each node bins its triangles' centroids into BVH_BINS bins on each axis
- * and takes the cheapest surface-area-heuristic split (Wald 2007, "On fast
- * construction of SAH-based bounding volume hierarchies"). Where SAH cannot
- * split (all centroids equal, or every centroid in one bin) or the tree is
- * getting deep, an object-median split halves the node instead, which keeps
- * the depth within BVH_MAX_DEPTH whatever the input.
+ * Top-down: each node bins its triangles' centroids and takes the cheapest
+ * SAH split (bvh_split.c); the binary tree is then collapsed into
+ * eight-wide nodes (bvh_collapse.c). Two phases share the cores:
  *
- * The binary tree is then collapsed into eight-wide nodes (Dammertz et al.
- * 2008, "Shallow bounding volume hierarchies for fast SIMD ray tracing of
- * incoherent rays"; Embree's BVH8 on AVX machines): a node takes its binary
- * node's children, opens every interior one into its two children, and
- * fills a slot still free by opening its largest interior child again.
- * Every interior slot thus lies at least two binary levels down, which
- * halves the depth the traversal stack must hold; the kernel tests a
- * node's eight boxes side by side. Against four-wide nodes, a ray visits
- * fewer of them for the same box-test instructions: living-room pt 1.11x,
- * bathroom 1.07x, door-ajar portal 1.09x faster at one thread. */
+ *  1. The nodes of more than PAR_MIN references at the top, one at a time:
+ *     their bounds and bins are filled by every thread over a slice of the
+ *     references each and merged in slice order (bvh_parts.h: the same
+ *     bits as one pass); the partition is one thread's.
+ *  2. The subtrees below them, largest first, one thread each, from an
+ *     explicit stack (no recursion, so a pathological input cannot
+ *     overflow the C stack), numbered depth-first as the one-thread build
+ *     numbers them.
+ *
+ * A node's split depends on its references alone, and a subtree over n
+ * references rooted at binary node p fits in [p, p + 2n - 1): phase 1
+ * places a node's children at p + 1 and p + 2 n_left before they are
+ * built, so the phases need no stitching, and the tree is the same, bit for
+ * bit, whatever the number of threads (test_bvh's test_threads_same_tree,
+ * test_instances).
+ *
+ * A top-level tree (scene_bvh.c) takes instances too: boxes given by the
+ * caller, each a leaf of its own (bvh_split.c), its slot BVH_INSTANCE(i);
+ * the leaves are then renumbered to the triangles' places among the
+ * triangles alone (number_leaves).
+ *
+ * Times (src/prepare/README.md, "The BVH"): bathroom, 592,188 triangles,
+ * 0.69 s of CPU before the vector bins, 0.23 s after. */
 #include "prepare/bvh_build.h"
 
-#include <float.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/big_array.h"
 #include "core/error.h"
+#include "core/workers.h"
 #include "geom/bvh.h"
+#include "prepare/bvh_collapse.h"
+#include "prepare/bvh_parts.h"
 
 /* Traversal pushes at most BVH_WIDTH - 1 entries per wide level, and the
  * wide tree has at most BVH_MAX_DEPTH / 2 interior levels (bvh.h). */
 _Static_assert((BVH_WIDTH - 1) * (BVH_MAX_DEPTH / 2) <= BVH_STACK_SIZE, "kernels/geom/bvh.h: traversal stack too small");
-
-#define BVH_BINS 32
-#define BVH_MAX_LEAF 4
 _Static_assert(BVH_MAX_LEAF <= 4, "leaf slots encode at most 4 triangles");
-/* Traversal cost relative to one triangle test. */
-#define BVH_COST_TRAVERSE 1.0f
-/* From this depth on only median splits: each halves the node, so even
- * 2^32 triangles in leaves of BVH_MAX_LEAF need at most 30 more levels. */
-#define BVH_MEDIAN_DEPTH (BVH_MAX_DEPTH - 32)
+
+/* Phase 1 takes nodes of at least this many references, and of at least
+ * 1/(4 threads) of them all, so phase 2 has some 4 subtrees a thread. */
+#define PAR_MIN (1u << 15)
 
 typedef struct {
-	float lo[3], hi[3];
-} Box;
-
-/* Node of the binary tree, depth-first: an interior node's left child is
- * the next node, its right child node `index`; a leaf (count > 0) covers
- * triangles [index, index + count). */
-typedef struct {
-	Box b;
-	int index;
-	int count;
-} BinNode;
-
-/* A triangle's bounds and where it came from; the build permutes these. */
-typedef struct {
-	Box b;
-	uint32_t idx;
-} Ref;
-
-typedef struct {
-	uint32_t start, end;
-	uint32_t parent; /* node whose right child this is, or NO_PARENT */
+	uint32_t start, end; /* references */
+	uint32_t node;       /* its binary node */
 	uint32_t depth;
 } Task;
 
-#define NO_PARENT UINT32_MAX
-
-static void box_empty(Box *b)
-{
-	for (int a = 0; a < 3; a++) {
-		b->lo[a] = FLT_MAX;
-		b->hi[a] = -FLT_MAX;
-	}
-}
-
-static void box_grow(Box *b, const Box *o)
-{
-	for (int a = 0; a < 3; a++) {
-		if (o->lo[a] < b->lo[a])
-			b->lo[a] = o->lo[a];
-		if (o->hi[a] > b->hi[a])
-			b->hi[a] = o->hi[a];
-	}
-}
-
-/* Half the surface area; 0 for an empty box. */
-static float box_area(const Box *b)
-{
-	float d[3];
-	for (int a = 0; a < 3; a++) {
-		d[a] = b->hi[a] - b->lo[a];
-		if (d[a] < 0.0f)
-			return 0.0f;
-	}
-	return d[0] * d[1] + d[1] * d[2] + d[2] * d[0];
-}
-
-/* Centroid times two: only compared, never used as a position. */
-static float ref_key(const Ref *r, int axis) { return r->b.lo[axis] + r->b.hi[axis]; }
-
-/* Clamped before the cast: a NaN or huge position (e.g. the builder API's
- * sums near FLT_MAX) is a bad bin, never undefined behaviour. */
-static int bin_of(float key, float cmin, float scale, int nbins)
-{
-	float f = (key - cmin) * scale;
-	return !(f > 0.0f) ? 0 : (f >= (float)nbins ? nbins - 1 : (int)f);
-}
-
-/* Reorders r[0, n) so that r[k] has the k-th smallest key on `axis` and
- * nothing before it is larger (Hoare partition, median-of-three pivot;
- * stops on equal keys, so all-equal input stays linear). */
-static void select_nth(Ref *r, uint32_t n, uint32_t k, int axis)
-{
-	uint32_t lo = 0, hi = n - 1;
-	while (hi > lo) {
-		float a = ref_key(&r[lo], axis), b = ref_key(&r[lo + (hi - lo) / 2], axis);
-		float c = ref_key(&r[hi], axis);
-		float pivot = a < b ? (b < c ? b : (a < c ? c : a)) : (a < c ? a : (b < c ? c : b));
-		uint32_t i = lo, j = hi;
-		while (i <= j) {
-			while (ref_key(&r[i], axis) < pivot)
-				i++;
-			while (ref_key(&r[j], axis) > pivot)
-				j--;
-			if (i <= j) {
-				Ref t = r[i];
-				r[i] = r[j];
-				r[j] = t;
-				i++;
-				if (j == 0)
-					break;
-				j--;
-			}
-		}
-		if (k <= j)
-			hi = j;
-		else if (k >= i)
-			lo = i;
-		else
-			break;
-	}
-}
-
-/* Chooses a split of refs[0, n) with bounds `box` and centroid bounds
- * `cbox`. Returns the number of refs put on the left (refs reordered), or
- * 0 to make a leaf. */
-static uint32_t split_node(Ref *refs, uint32_t n, const Box *box, const Box *cbox, uint32_t depth)
-{
-	int axis = 0;
-	float ext[3];
-	for (int a = 0; a < 3; a++) {
-		ext[a] = cbox->hi[a] - cbox->lo[a];
-		if (ext[a] > ext[axis])
-			axis = a;
-	}
-	if (n <= 1)
-		return 0;
-	if (ext[axis] <= 0.0f) /* all centroids equal: any halving will do */
-		return n <= BVH_MAX_LEAF ? 0 : n / 2;
-
-	if (depth < BVH_MEDIAN_DEPTH) {
-		/* Small nodes get fewer bins: the sweep below costs per bin, and
-		 * most nodes are small. */
-		int nb = n < BVH_BINS ? (int)n : BVH_BINS;
-		uint32_t count[3][BVH_BINS] = {{0}};
-		Box bins[3][BVH_BINS];
-		float scale[3];
-		for (int a = 0; a < 3; a++) {
-			scale[a] = ext[a] > 0.0f ? (float)nb / ext[a] : 0.0f;
-			for (int k = 0; k < nb; k++)
-				box_empty(&bins[a][k]);
-		}
-		for (uint32_t i = 0; i < n; i++) {
-			for (int a = 0; a < 3; a++) {
-				int k = bin_of(ref_key(&refs[i], a), cbox->lo[a], scale[a], nb);
-				count[a][k]++;
-				box_grow(&bins[a][k], &refs[i].b);
-			}
-		}
-		/* Costs in units of one triangle test times the parent's area, so
-		 * a zero-area node still compares splits consistently. */
-		float best_cost = FLT_MAX;
-		int best_axis = -1, best_bin = 0;
-		for (int a = 0; a < 3; a++) {
-			if (ext[a] <= 0.0f)
-				continue;
-			float right_area[BVH_BINS];
-			uint32_t right_count[BVH_BINS];
-			Box acc;
-			box_empty(&acc);
-			uint32_t cnt = 0;
-			for (int k = nb - 1; k > 0; k--) {
-				box_grow(&acc, &bins[a][k]);
-				cnt += count[a][k];
-				right_area[k] = box_area(&acc);
-				right_count[k] = cnt;
-			}
-			box_empty(&acc);
-			cnt = 0;
-			for (int k = 0; k < nb - 1; k++) {
-				box_grow(&acc, &bins[a][k]);
-				cnt += count[a][k];
-				if (cnt == 0 || right_count[k + 1] == 0)
-					continue;
-				float cost = box_area(&acc) * (float)cnt +
-					     right_area[k + 1] * (float)right_count[k + 1];
-				if (cost < best_cost) {
-					best_cost = cost;
-					best_axis = a;
-					best_bin = k;
-				}
-			}
-		}
-		if (best_axis >= 0) {
-			float area = box_area(box);
-			if (n <= BVH_MAX_LEAF && (float)n * area <= BVH_COST_TRAVERSE * area + best_cost)
-				return 0;
-			uint32_t i = 0, j = n;
-			while (i < j) {
-				if (bin_of(ref_key(&refs[i], best_axis), cbox->lo[best_axis],
-					   scale[best_axis], nb) <= best_bin) {
-					i++;
-				} else {
-					Ref t = refs[i];
-					refs[i] = refs[--j];
-					refs[j] = t;
-				}
-			}
-			return i; /* both sides non-empty by construction of the bins */
-		}
-		/* Every centroid fell into one bin (float rounding on a tiny
-		 * extent): fall through to the median. */
-	}
-	if (n <= BVH_MAX_LEAF)
-		return 0;
-	select_nth(refs, n, n / 2, axis);
-	return n / 2;
-}
-
-/* Slots of a wide node under construction: binary node ids. */
 typedef struct {
-	uint32_t bin[BVH_WIDTH];
-	int n;
-} Slots;
+	const BvhInput *in;
+	uint32_t inst_from;      /* in->ntris with instances, else UINT32_MAX */
+	Ref *refs;
+	BinNode *bn;
+	uint32_t *order;
+	uint32_t nrefs;
+	Workers workers;
+	/* Phase 1: the node whose bounds or bins the threads fill. */
+	Task node;
+	const SplitPlan *plan;
+	NodeBounds *part_bounds; /* one per thread */
+	Bins *part_bins;         /* one per thread */
+	/* Phase 2. */
+	Task *tasks;
+	uint32_t ntasks;
+	atomic_uint next_task;
+	atomic_uint ninterior, max_depth;
+} Build;
 
-static int bin_is_leaf(const BinNode *bn, uint32_t i) { return bn[i].count > 0; }
-
-/* Opens slot k (an interior binary node) into its two children. */
-static void slots_open(const BinNode *bn, Slots *s, int k)
+static void slice(uint32_t start, uint32_t end, int part, int nparts, uint32_t *s, uint32_t *e)
 {
-	uint32_t i = s->bin[k];
-	s->bin[k] = i + 1;
-	s->bin[s->n++] = (uint32_t)bn[i].index;
+	uint64_t n = end - start;
+	*s = start + (uint32_t)(n * (uint64_t)part / (uint64_t)nparts);
+	*e = start + (uint32_t)(n * (uint64_t)(part + 1) / (uint64_t)nparts);
 }
 
-/* The binary children of interior node i, each interior one opened, then
- * while a slot is free the interior slot of largest box area opened. */
-static void slots_fill(const BinNode *bn, uint32_t i, Slots *s)
+/* A triangle's bounds: fmin/fmax of its corners, which keep the first
+ * argument on ties (-0 and +0 as the scalar build had them); an
+ * instance's as given. */
+static void refs_fill(void *ctx, int part, int nparts)
 {
-	s->n = 0;
-	s->bin[s->n++] = i + 1;
-	s->bin[s->n++] = (uint32_t)bn[i].index;
-	for (int k = 0, n0 = s->n; k < n0; k++)
-		if (!bin_is_leaf(bn, s->bin[k]))
-			slots_open(bn, s, k);
-	while (s->n < BVH_WIDTH) {
-		int best = -1;
-		float best_area = -1.0f;
-		for (int k = 0; k < s->n; k++)
-			if (!bin_is_leaf(bn, s->bin[k]) && box_area(&bn[s->bin[k]].b) > best_area) {
-				best_area = box_area(&bn[s->bin[k]].b);
-				best = k;
-			}
-		if (best < 0)
-			break;
-		slots_open(bn, s, best);
+	Build *b = ctx;
+	const BvhInput *in = b->in;
+	uint32_t s, e;
+	slice(0, b->nrefs, part, nparts, &s, &e);
+	for (uint32_t i = s; i < e; i++) {
+		Ref *r = &b->refs[i];
+		r->idx = i;
+		if (i >= in->ntris) {
+			V3 lo = in->inst_lo[i - in->ntris], hi = in->inst_hi[i - in->ntris];
+			r->b = (Box){{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}};
+			continue;
+		}
+		const Tri *t = &in->tris[in->index ? in->index[i] : i];
+		F4 p0 = f4_load3(&t->p0.x), p1 = f4_load3(&t->p1.x), p2 = f4_load3(&t->p2.x);
+		float lo[4], hi[4];
+		f4_store(lo, f4_min(f4_min(p2, p1), p0));
+		f4_store(hi, f4_max(f4_max(p2, p1), p0));
+		for (int a = 0; a < 3; a++) {
+			r->b.lo[a] = lo[a];
+			r->b.hi[a] = hi[a];
+		}
 	}
 }
 
-static void wide_set_slot(BvhNode *w, int k, const Box *b, int child)
+static void part_bounds(void *ctx, int part, int nparts)
 {
-	w->lo_x[k] = b->lo[0];
-	w->lo_y[k] = b->lo[1];
-	w->lo_z[k] = b->lo[2];
-	w->hi_x[k] = b->hi[0];
-	w->hi_y[k] = b->hi[1];
-	w->hi_z[k] = b->hi[2];
-	w->child[k] = child;
+	Build *b = ctx;
+	uint32_t s, e;
+	slice(b->node.start, b->node.end, part, nparts, &s, &e);
+	NodeBounds *nb = &b->part_bounds[part];
+	nb->box = nb->cbox = box4_empty();
+	bvh_bounds(b->refs, s, e, nb);
 }
 
-/* Collapses the binary tree bn[0, nbin) into out->nodes. Children of a
- * node get consecutive ids, handed out as the node is written. */
-static ajar_status collapse(const BinNode *bn, uint32_t nbin, Bvh *out)
+static void part_bins(void *ctx, int part, int nparts)
 {
-	/* At most one per interior binary node, of which a full binary tree of
-	 * nbin nodes has (nbin - 1) / 2; one for a root that is a leaf. */
-	uint32_t cap = nbin / 2 + 1;
-	out->nodes = malloc(sizeof(BvhNode) * cap);
-	if (!out->nodes)
-		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for %u nodes", cap);
-	memset(out->nodes, 0, sizeof(BvhNode) * cap);
-	/* Pending (binary node, wide id) pairs: at most BVH_WIDTH - 1 per wide
-	 * level plus one; BVH_MAX_DEPTH bounds the levels. */
+	Build *b = ctx;
+	uint32_t s, e;
+	slice(b->node.start, b->node.end, part, nparts, &s, &e);
+	bvh_bins_clear(&b->part_bins[part], b->plan->nb);
+	bvh_bins_add(&b->part_bins[part], b->plan, b->refs, s, e);
+}
+
+static void note_depth(Build *b, uint32_t depth)
+{
+	uint32_t d = atomic_load(&b->max_depth);
+	while (depth > d && !atomic_compare_exchange_weak(&b->max_depth, &d, depth))
+		;
+}
+
+/* Phase 2: the subtree of task `root`, numbered depth-first from
+ * root.node. LIFO: a split pushes the right task, then the left, so the
+ * left subtree is written completely before the right one starts; at
+ * most one pending right sibling per level plus the current task. */
+static void build_subtree(Build *b, Task root)
+{
+	Bins bins;
 	struct {
-		uint32_t bin, wide, depth;
-	} stack[(BVH_WIDTH - 1) * BVH_MAX_DEPTH + BVH_WIDTH];
+		Task t;
+		uint32_t parent; /* node whose right child this is, or UINT32_MAX */
+	} stack[BVH_MAX_DEPTH + 2];
 	int sp = 0;
-	uint32_t nwide = 1;
-	out->wide_depth = 1;
-	stack[sp].bin = 0;
-	stack[sp].wide = 0;
-	stack[sp++].depth = 1;
+	uint32_t next = root.node, ninterior = 0, max_depth = 0;
+	stack[sp].t = root;
+	stack[sp++].parent = UINT32_MAX;
 	while (sp > 0) {
 		sp--;
-		uint32_t i = stack[sp].bin, id = stack[sp].wide, depth = stack[sp].depth;
-		if (depth > out->wide_depth)
-			out->wide_depth = depth;
-		Slots s;
-		if (bin_is_leaf(bn, i)) { /* only the root: a scene of at most 4 triangles */
-			s.n = 1;
-			s.bin[0] = i;
-		} else {
-			slots_fill(bn, i, &s);
-		}
-		BvhNode *w = &out->nodes[id];
-		for (int k = 0; k < BVH_WIDTH; k++) {
-			if (k >= s.n) {
-				const Box none = {{INFINITY, INFINITY, INFINITY}, {INFINITY, INFINITY, INFINITY}};
-				wide_set_slot(w, k, &none, BVH_EMPTY);
-				continue;
-			}
-			const BinNode *c = &bn[s.bin[k]];
-			if (c->count > 0) {
-				wide_set_slot(w, k, &c->b, BVH_LEAF(c->index, c->count));
-			} else {
-				wide_set_slot(w, k, &c->b, (int)nwide);
-				stack[sp].bin = s.bin[k];
-				stack[sp].wide = nwide++;
-				stack[sp++].depth = depth + 1;
-			}
-		}
-	}
-	BvhNode *shrunk = realloc(out->nodes, sizeof(BvhNode) * nwide);
-	if (shrunk)
-		out->nodes = shrunk;
-	out->nnodes = nwide;
-	return AJAR_OK;
-}
-
-ajar_status bvh_build(const Tri *tris, uint32_t ntris, Bvh *out)
-{
-	memset(out, 0, sizeof(*out));
-	if (ntris == 0)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "bvh_build: no triangles");
-	if (ntris > BVH_MAX_TRIS)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "bvh_build: %u triangles, at most %u supported",
-			       ntris, (unsigned)BVH_MAX_TRIS);
-
-	size_t max_nodes = 2 * (size_t)ntris - 1;
-	Ref *refs = malloc(sizeof(Ref) * ntris);
-	BinNode *bn = malloc(sizeof(BinNode) * max_nodes);
-	out->order = malloc(sizeof(uint32_t) * ntris);
-	if (!refs || !bn || !out->order) {
-		free(refs);
-		free(bn);
-		bvh_free(out);
-		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for %u triangles",
-			       ntris);
-	}
-	for (uint32_t i = 0; i < ntris; i++) {
-		const Tri *t = &tris[i];
-		Box *b = &refs[i].b;
-		b->lo[0] = fmin(t->p0.x, fmin(t->p1.x, t->p2.x));
-		b->lo[1] = fmin(t->p0.y, fmin(t->p1.y, t->p2.y));
-		b->lo[2] = fmin(t->p0.z, fmin(t->p1.z, t->p2.z));
-		b->hi[0] = fmax(t->p0.x, fmax(t->p1.x, t->p2.x));
-		b->hi[1] = fmax(t->p0.y, fmax(t->p1.y, t->p2.y));
-		b->hi[2] = fmax(t->p0.z, fmax(t->p1.z, t->p2.z));
-		refs[i].idx = i;
-	}
-
-	/* LIFO: a split pushes the right task, then the left, so the left
-	 * subtree is written completely before the right one starts. At most
-	 * one pending right sibling per level plus the current task. */
-	Task stack[BVH_MAX_DEPTH + 2];
-	int sp = 0;
-	uint32_t nnodes = 0, max_depth = 0;
-	stack[sp++] = (Task){0, ntris, NO_PARENT, 0};
-	while (sp > 0) {
-		Task task = stack[--sp];
-		uint32_t id = nnodes++;
-		if (task.parent != NO_PARENT)
-			bn[task.parent].index = (int)id;
+		Task task = stack[sp].t;
+		uint32_t parent = stack[sp].parent, id = next++;
+		if (parent != UINT32_MAX)
+			b->bn[parent].index = (int)id;
 		if (task.depth + 1 > max_depth)
 			max_depth = task.depth + 1;
-
-		Box box, cbox;
-		box_empty(&box);
-		box_empty(&cbox);
-		for (uint32_t i = task.start; i < task.end; i++) {
-			const Ref *r = &refs[i];
-			box_grow(&box, &r->b);
-			for (int a = 0; a < 3; a++) {
-				float k = ref_key(r, a);
-				if (k < cbox.lo[a])
-					cbox.lo[a] = k;
-				if (k > cbox.hi[a])
-					cbox.hi[a] = k;
-			}
-		}
-		BinNode *node = &bn[id];
-		node->b = box;
+		NodeBounds nb = {box4_empty(), box4_empty()};
+		bvh_bounds(b->refs, task.start, task.end, &nb);
+		BinNode *node = &b->bn[id];
+		box4_store(&node->b, nb.box);
 		uint32_t n = task.end - task.start;
-		uint32_t nleft = split_node(refs + task.start, n, &box, &cbox, task.depth);
+		SplitPlan plan;
+		bvh_split_plan(n, &nb.cbox, task.depth, b->inst_from, &plan);
+		if (plan.nb) {
+			bvh_bins_clear(&bins, plan.nb);
+			bvh_bins_add(&bins, &plan, b->refs, task.start, task.end);
+		}
+		uint32_t nleft = bvh_split_apply(b->refs + task.start, n, &node->b, &plan, &bins);
 		if (nleft == 0) {
 			node->index = (int)task.start;
 			node->count = (int)n;
@@ -422,25 +180,222 @@ ajar_status bvh_build(const Tri *tris, uint32_t ntris, Bvh *out)
 		}
 		node->index = -1; /* patched when the right child is written */
 		node->count = 0;
+		ninterior++;
 		uint32_t mid = task.start + nleft;
-		stack[sp++] = (Task){mid, task.end, id, task.depth + 1};
-		stack[sp++] = (Task){task.start, mid, NO_PARENT, task.depth + 1};
+		stack[sp].t = (Task){mid, task.end, 0, task.depth + 1};
+		stack[sp++].parent = id;
+		stack[sp].t = (Task){task.start, mid, 0, task.depth + 1};
+		stack[sp++].parent = UINT32_MAX;
 	}
-	for (uint32_t i = 0; i < ntris; i++)
-		out->order[i] = refs[i].idx;
-	free(refs);
-	out->ntris = ntris;
-	out->depth = max_depth;
-	ajar_status st = collapse(bn, nnodes, out);
-	free(bn);
-	if (st != AJAR_OK)
-		bvh_free(out);
+	atomic_fetch_add(&b->ninterior, ninterior);
+	note_depth(b, max_depth);
+}
+
+static void part_subtrees(void *ctx, int part, int nparts)
+{
+	(void)part;
+	(void)nparts;
+	Build *b = ctx;
+	for (uint32_t k; (k = atomic_fetch_add(&b->next_task, 1)) < b->ntasks;)
+		build_subtree(b, b->tasks[k]);
+}
+
+static int task_larger(const void *x, const void *y)
+{
+	const Task *a = x, *c = y;
+	uint32_t na = a->end - a->start, nc = c->end - c->start;
+	return na > nc ? -1 : na < nc ? 1 : (a->start > c->start) - (a->start < c->start);
+}
+
+/* Phase 1 from the root, then phase 2 over the subtrees it left. */
+static ajar_status build_tree(Build *b)
+{
+	int nt = b->workers.n;
+	uint32_t big = b->nrefs / (4u * (uint32_t)nt);
+	if (big < PAR_MIN)
+		big = PAR_MIN;
+	/* Phase-1 nodes of one depth are disjoint, so at most nrefs / big of
+	 * them a level, each leaving at most two subtrees. The queue is
+	 * depth-first: one pending sibling a level. */
+	size_t cap = 2 * BVH_MAX_DEPTH * ((size_t)b->nrefs / big + 1) + 1;
+	Task queue[BVH_MAX_DEPTH + 2];
+	b->tasks = malloc(sizeof *b->tasks * cap);
+	b->part_bounds = malloc(sizeof *b->part_bounds * (size_t)nt);
+	b->part_bins = malloc(sizeof *b->part_bins * (size_t)nt);
+	if (!b->tasks || !b->part_bounds || !b->part_bins)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for the build's tasks");
+	size_t nq = 0;
+	queue[nq++] = (Task){0, b->nrefs, 0, 0};
+	b->ntasks = 0;
+	while (nq > 0) {
+		Task t = queue[--nq];
+		uint32_t n = t.end - t.start;
+		if (n < big || nt == 1) {
+			b->tasks[b->ntasks++] = t;
+			continue;
+		}
+		note_depth(b, t.depth + 1);
+		b->node = t;
+		workers_run(&b->workers, part_bounds, b);
+		NodeBounds nb = b->part_bounds[0];
+		for (int k = 1; k < nt; k++)
+			bvh_bounds_merge(&nb, &b->part_bounds[k]);
+		BinNode *node = &b->bn[t.node];
+		box4_store(&node->b, nb.box);
+		SplitPlan plan;
+		bvh_split_plan(n, &nb.cbox, t.depth, b->inst_from, &plan);
+		if (plan.nb) {
+			b->plan = &plan;
+			workers_run(&b->workers, part_bins, b);
+			for (int k = 1; k < nt; k++)
+				bvh_bins_merge(&b->part_bins[0], &b->part_bins[k], plan.nb);
+		}
+		uint32_t nleft = bvh_split_apply(b->refs + t.start, n, &node->b, &plan, &b->part_bins[0]);
+		if (nleft == 0) { /* not for n >= PAR_MIN, but harmless */
+			node->index = (int)t.start;
+			node->count = (int)n;
+			continue;
+		}
+		node->index = (int)(t.node + 2 * nleft);
+		node->count = 0;
+		atomic_fetch_add(&b->ninterior, 1);
+		uint32_t mid = t.start + nleft;
+		queue[nq++] = (Task){mid, t.end, t.node + 2 * nleft, t.depth + 1};
+		queue[nq++] = (Task){t.start, mid, t.node + 1, t.depth + 1};
+	}
+	qsort(b->tasks, b->ntasks, sizeof *b->tasks, task_larger);
+	atomic_store(&b->next_task, 0);
+	workers_run(&b->workers, part_subtrees, b);
+	return AJAR_OK;
+}
+
+/* With instances: leaves renumbered (bvh_parts.h, BinNode) and the order
+ * of the triangles alone, walking the tree from its root. */
+static ajar_status number_leaves(Build *b)
+{
+	uint32_t *place = malloc(sizeof *place * (size_t)b->nrefs);
+	if (!place)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for %u references", b->nrefs);
+	uint32_t k = 0;
+	for (uint32_t i = 0; i < b->nrefs; i++)
+		if (b->refs[i].idx < b->inst_from) {
+			b->order[k] = b->refs[i].idx;
+			place[i] = k++;
+		}
+	uint32_t stack[BVH_MAX_DEPTH + 2];
+	int sp = 0;
+	stack[sp++] = 0;
+	while (sp > 0) {
+		BinNode *node = &b->bn[stack[--sp]];
+		if (node->count == 0) {
+			stack[sp++] = (uint32_t)node->index;
+			stack[sp++] = (uint32_t)(node - b->bn) + 1;
+			continue;
+		}
+		uint32_t idx = b->refs[node->index].idx;
+		node->index = idx >= b->inst_from ? -1 - (int)(idx - b->inst_from) : (int)place[node->index];
+	}
+	free(place);
+	return AJAR_OK;
+}
+
+static void order_fill(void *ctx, int part, int nparts)
+{
+	Build *b = ctx;
+	uint32_t s, e;
+	slice(0, b->nrefs, part, nparts, &s, &e);
+	for (uint32_t i = s; i < e; i++)
+		b->order[i] = b->refs[i].idx;
+}
+
+int bvh_threads(void) { return workers_cores(); }
+
+ajar_status bvh_build_input(const BvhInput *in, int threads, BvhReorder reorder, void *ctx, Bvh *out)
+{
+	BvhNode *base_nodes = out->nodes;
+	uint32_t base = base_nodes ? out->nnodes : 0;
+	memset(out, 0, sizeof(*out));
+	out->nodes = base_nodes;
+	out->nnodes = base;
+	if (in->n == 0)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "bvh_build: no triangles");
+	if (in->n > BVH_MAX_TRIS || in->n - in->ntris >= BVH_INSTANCE_BASE)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "bvh_build: %u triangles and instances, at most %u supported",
+			       in->n, (unsigned)BVH_MAX_TRIS);
+	Build b;
+	memset(&b, 0, sizeof b);
+	b.in = in;
+	b.inst_from = in->ntris < in->n ? in->ntris : UINT32_MAX;
+	b.nrefs = in->n;
+	/* The binary tree's array is as large as any tree could need; pages
+	 * the build leaves untouched cost no memory. */
+	size_t max_nodes = 2 * (size_t)in->n - 1;
+	b.refs = malloc(sizeof(Ref) * in->n);
+	b.bn = malloc(sizeof(BinNode) * max_nodes);
+	out->order = malloc(sizeof(uint32_t) * (in->ntris ? in->ntris : 1));
+	ajar_status st = AJAR_OK;
+	if (!b.refs || !b.bn || !out->order)
+		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for %u triangles", in->n);
+	if (st == AJAR_OK)
+		st = workers_start(&b.workers, threads < 1 ? 1 : threads);
+	if (st == AJAR_OK) {
+		workers_run(&b.workers, refs_fill, &b);
+		st = build_tree(&b);
+	}
+	if (st == AJAR_OK) {
+		b.order = out->order;
+		if (b.inst_from != UINT32_MAX)
+			st = number_leaves(&b);
+		else
+			workers_run(&b.workers, order_fill, &b);
+	}
+	if (b.workers.threads || b.workers.n)
+		workers_stop(&b.workers);
+	free(b.tasks);
+	free(b.part_bounds);
+	free(b.part_bins);
+	free(b.refs);
+	if (st == AJAR_OK) {
+		out->ntris = in->ntris;
+		out->depth = atomic_load(&b.max_depth);
+		if (reorder) {
+			reorder(out->order, in->ntris, ctx);
+			free(out->order);
+			out->order = NULL;
+		}
+		st = bvh_collapse(b.bn, atomic_load(&b.ninterior), in->tri_base, out);
+	}
+	free(b.bn);
+	if (st != AJAR_OK) {
+		free(out->order);
+		out->order = NULL;
+		if (!base_nodes)
+			bvh_free(out);
+	}
 	return st;
+}
+
+ajar_status bvh_build_reorder(const Tri *tris, uint32_t ntris, int threads, BvhReorder reorder, void *ctx,
+			      Bvh *out)
+{
+	BvhInput in = {tris, NULL, ntris, NULL, NULL, ntris, 0};
+	memset(out, 0, sizeof *out);
+	return bvh_build_input(&in, threads, reorder, ctx, out);
+}
+
+ajar_status bvh_build_threads(const Tri *tris, uint32_t ntris, int threads, Bvh *out)
+{
+	return bvh_build_reorder(tris, ntris, threads, NULL, NULL, out);
+}
+
+ajar_status bvh_build(const Tri *tris, uint32_t ntris, Bvh *out)
+{
+	return bvh_build_threads(tris, ntris, bvh_threads(), out);
 }
 
 void bvh_free(Bvh *b)
 {
-	free(b->nodes);
+	big_free(b->nodes, sizeof(BvhNode) * (size_t)b->nnodes);
 	free(b->order);
 	memset(b, 0, sizeof(*b));
 }

@@ -26,14 +26,46 @@
 typedef struct {
 	BvhNode *nodes;      /* BVH_WIDTH-wide */
 	uint32_t nnodes;
-	uint32_t *order;     /* order[i] = original index of reordered triangle i */
+	uint32_t *order;     /* order[i] = original index of reordered triangle i (NULL after a reorder) */
 	uint32_t ntris;
 	uint32_t depth;      /* binary tree: nodes on the longest root-to-leaf path */
 	uint32_t wide_depth; /* the wide tree: the same */
 } Bvh;
 
-/* ntris >= 1. On failure *out is left empty (safe to bvh_free). */
+/* What a tree is built over: primitives 0 .. ntris - 1 are triangles
+ * (tris[i], or tris[index[i]] with an index list), ntris .. n - 1 are
+ * instances with world-space boxes inst_lo/inst_hi[i - ntris], each a leaf
+ * of its own, BVH_INSTANCE(i - ntris) (kernels/geom/bvh.h). Leaves name
+ * triangles tri_base + their place in the leaf order. */
+typedef struct {
+	const Tri *tris;
+	const uint32_t *index; /* NULL: primitive i is tris[i] */
+	uint32_t ntris;
+	const V3 *inst_lo, *inst_hi;
+	uint32_t n;            /* ntris + instances, >= 1 */
+	uint32_t tri_base;
+} BvhInput;
+
+/* ntris >= 1, on bvh_threads() threads. On failure *out is left empty
+ * (safe to bvh_free). out->nodes is a big array (core/big_array.h). */
 ajar_status bvh_build(const Tri *tris, uint32_t ntris, Bvh *out);
+/* The same tree, bit for bit, on `threads` threads (1: the caller's alone). */
+ajar_status bvh_build_threads(const Tri *tris, uint32_t ntris, int threads, Bvh *out);
+/* Puts the caller's triangle arrays in the leaf order: order[i] is the
+ * original index of triangle i, and order may be written (scratch). */
+typedef void (*BvhReorder)(uint32_t *order, uint32_t n, void *ctx);
+/* bvh_build_threads that hands the order to `reorder` between building
+ * the binary tree and collapsing it, when the build holds the least
+ * memory, and frees it (out->order NULL). */
+ajar_status bvh_build_reorder(const Tri *tris, uint32_t ntris, int threads, BvhReorder reorder, void *ctx,
+			      Bvh *out);
+/* The general build: out->order has in->ntris entries (primitive
+ * numbers); with out->nodes already holding a tree (out->nnodes nodes), the
+ * new tree is appended after it, its root node out->nnodes, and
+ * out->nnodes grows. */
+ajar_status bvh_build_input(const BvhInput *in, int threads, BvhReorder reorder, void *ctx, Bvh *out);
+/* The threads a build uses: the processors the process may run on. */
+int bvh_threads(void);
 void bvh_free(Bvh *b);
 /* Bytes of nodes + order. */
 size_t bvh_memory(const Bvh *b);

@@ -1,57 +1,57 @@
 /* found_portals.c — the portal search (portal_find.c) on a loaded scene:
- * the BVH built for it alone, for `ajar info` and programs that want to
- * see the portals a render would find (ajar_scene_find_portals). A render
- * runs the same search inside prepare_scene, on the BVH it builds anyway. */
+ * the scene's own BVH (built once for it and its renderers, scene_bvh.c),
+ * for `ajar info` and programs that want to see the portals a render would
+ * find (ajar_scene_find_portals). A render runs the same search inside
+ * prepare_scene. */
 #include "prepare/found_portals.h"
 
 #include <stdlib.h>
 #include <string.h>
 
 #include "core/error.h"
-#include "prepare/bvh_build.h"
+#include "prepare/scene_bvh.h"
 
 ajar_status portal_find_scene(const Scene *s, PortalSearch *out)
 {
 	memset(out, 0, sizeof *out);
-	if (s->ntris == 0)
+	if (scene_rendered_triangles(s) == 0)
 		return AJAR_OK;
-	Bvh bvh;
-	ajar_status st = bvh_build(s->tris, s->ntris, &bvh);
+	/* The scene's own BVH and triangles (built now if no renderer has;
+	 * scene_bvh.c), so the search costs no copy: the scene changes in
+	 * their order alone, as a render changes it. */
+	SceneShare *sh;
+	ajar_status st = scene_bvh((Scene *)s, &sh);
 	if (st != AJAR_OK)
 		return st;
-	Tri *tris = malloc(sizeof *tris * s->ntris);
-	TriShade *shade = malloc(sizeof *shade * s->ntris);
-	TriExtra *extra = calloc(s->extra ? s->ntris : 1, sizeof *extra);
+	Instance *inst = NULL;
+	size_t ninst;
+	TriExtra *extra = s->extra ? NULL : calloc(1, sizeof *extra);
 	Params *params = calloc(1, sizeof *params);
-	if (!tris || !shade || !extra || !params) {
+	if ((st = scene_bvh_instances(s, sh, &inst, &ninst)) != AJAR_OK)
+		goto done;
+	if ((!s->extra && !extra) || !params) {
 		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory for the portal search", s->source);
 		goto done;
 	}
-	for (uint32_t i = 0; i < s->ntris; i++) {
-		tris[i] = s->tris[bvh.order[i]];
-		shade[i] = s->shade[bvh.order[i]];
-		if (s->extra)
-			extra[i] = s->extra[bvh.order[i]];
-	}
 	SceneView v;
 	memset(&v, 0, sizeof v);
-	v.nodes = bvh.nodes;
-	v.tris = tris;
-	v.shade = shade;
-	v.extra = extra;
+	v.nodes = sh->nodes;
+	v.tris = sh->tris;
+	v.shade = sh->shade;
+	v.extra = s->extra ? sh->extra : extra;
 	v.materials = s->materials;
 	v.textures = s->textures;
-	v.texels = s->texels;
+	v.texels = sh->texels;
+	v.instances = inst;
 	v.params = params;
 	PortalFindInput in;
 	portal_find_input(s, &in);
-	st = portal_find(&v, s->ntris, &in, out);
+	st = portal_find(&v, scene_flat_triangles(s), &in, out);
 done:
-	free(tris);
-	free(shade);
+	free(inst);
 	free(extra);
 	free(params);
-	bvh_free(&bvh);
+	scene_share_release(sh);
 	return st;
 }
 

@@ -101,9 +101,8 @@ static ajar_status build_emitters(const Scene *s, Tri *tris, const TriShade *sha
 	}
 	/* Which triangles emit, and each one's finest level. */
 	for (uint32_t i = 0; i < ntris; i++) {
-		Tri *t = &tris[i];
+		const Tri *t = &tris[i];
 		const Material *m = &mats[t->material];
-		t->emitter = -1;
 		level[i] = -1;
 		if (!(v3_lum(m->emission) > 0.0f) || !(tri_area(t->p0, t->p1, t->p2) > 0.0f))
 			continue;
@@ -140,15 +139,20 @@ static ajar_status build_emitters(const Scene *s, Tri *tris, const TriShade *sha
 		free(level);
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "lights: out of memory for %llu emitters", (unsigned long long)n);
 	}
+	/* Tri.emitter is written only where it changes: the triangles are the
+	 * scene's, shared with renderers that may be reading them (their
+	 * values are the same, scene_share.h). */
 	uint32_t k = 0;
 	for (uint32_t i = 0; i < ntris; i++) {
 		Tri *t = &tris[i];
+		int emitter = level[i] < 0 ? -1 : (int)k;
+		if (t->emitter != emitter)
+			t->emitter = emitter;
 		if (level[i] < 0)
 			continue;
 		const Material *m = &mats[t->material];
 		int cells = 1 << (2 * level[i]);
 		float area = tri_area(t->p0, t->p1, t->p2);
-		t->emitter = (int)k;
 		for (int c = 0; c < cells; c++, k++) {
 			Emitter *e = &out->emitters[k];
 			e->tri = (int)i;

@@ -133,7 +133,7 @@ static int trace(Ctx *c, V3 o, V3 d, float tmax, Solid *s)
 			break;
 		GLOBAL const Tri *tri = &c->v->tris[h.tri];
 		GLOBAL const Material *m = &c->v->materials[tri->material];
-		V3 p = v3_madd(o, d, h.t), ng = tri_normal(tri);
+		V3 p = v3_madd(o, d, h.t), ng = hit_normal(c->v, &h); /* through its instance, if any */
 		if (m->transmission > 0.0f) { /* glass counts as open */
 			o = ray_offset(p, ng, d);
 			acc += h.t;

@@ -1,7 +1,7 @@
-/* prepare.c — from Scene to device arrays. Triangles and their shading data
- * are reordered to the BVH's leaf order so a leaf's triangles are
- * contiguous; the light tables are built on the reordered triangles so
- * emitter indices and Tri.emitter agree. */
+/* prepare.c — from Scene to device arrays. The scene's triangles and their
+ * shading data, in the BVH's leaf order so a leaf's triangles are
+ * contiguous, are shared, not copied (scene_bvh.c); the light tables are
+ * built on them in that order so emitter indices and Tri.emitter agree. */
 #include "prepare/prepare.h"
 
 #include <math.h>
@@ -14,14 +14,8 @@
 #include "prepare/found_portals.h"
 #include "prepare/policy.h"
 #include "prepare/portal_flux.h"
+#include "prepare/scene_bvh.h"
 #include "prepare/sky_tables.h"
-
-static double seconds(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-}
 
 /* Whether a hit on triangle t can get a shading normal that bsdf_setup_mr
  * counts as tilted (BSDF_TILTED: |n . ng| < BSDF_TILT_COS, kernels/material/bsdf.h).
@@ -62,6 +56,8 @@ static int tri_may_tilt(const Tri *t, const TriShade *sh)
 static unsigned kernel_omit(const SceneData *d)
 {
 	unsigned omit = KERNEL_OMIT_ALPHA | KERNEL_OMIT_BENT_NORMALS | KERNEL_OMIT_TRI_EXTRA | KERNEL_OMIT_PANES;
+	if (!d->n_instances)
+		omit |= KERNEL_OMIT_INSTANCES;
 	for (size_t i = 0; i < d->n_tris; i++) {
 		if (d->tris[i].flags & TRI_ALPHA)
 			omit &= ~KERNEL_OMIT_ALPHA;
@@ -136,6 +132,15 @@ static int lamp_behind_portal(const SceneData *d, V3 camera)
 	return 0;
 }
 
+/* A copy of n items of `size` (malloc), or NULL. */
+static void *dup_array(const void *p, size_t n, size_t size)
+{
+	void *q = malloc(n ? n * size : size);
+	if (q && n)
+		memcpy(q, p, n * size);
+	return q;
+}
+
 /* The portals the render uses (policy_portals): the scene's marked ones,
  * those the search finds from the camera (portal_find.c, on the BVH just
  * built), or none. d's triangles, shading and materials must be set. */
@@ -148,17 +153,20 @@ static ajar_status choose_portals(const Scene *s, const ajar_options *o, SceneDa
 	} else if (d->portal_source == POLICY_PORTALS_FOUND) {
 		SceneView v;
 		memset(&v, 0, sizeof v);
-		v.nodes = d->bvh.nodes;
+		v.nodes = d->nodes;
 		v.tris = d->tris;
 		v.shade = d->shade;
 		v.extra = d->extra;
-		v.materials = s->materials;
-		v.textures = s->textures;
-		v.texels = s->texels;
+		v.materials = d->materials;
+		v.textures = d->textures;
+		v.texels = d->texels;
+		v.instances = d->instances;
 		v.params = d->params;
 		PortalFindInput in;
 		portal_find_input(s, &in);
-		ajar_status st = portal_find(&v, s->ntris, &in, &d->found);
+		/* The flat triangles come first (scene_bvh.c); instances' are
+		 * reached through the BVH. */
+		ajar_status st = portal_find(&v, scene_flat_triangles(s), &in, &d->found);
 		if (st != AJAR_OK)
 			return st;
 		n = 2 * d->found.count;
@@ -177,15 +185,23 @@ static ajar_status choose_portals(const Scene *s, const ajar_options *o, SceneDa
 	return AJAR_OK;
 }
 
-/* Bounds of the prepared triangles and portals (the portals in use, not
- * those the scene marks). */
-static void prepared_bounds(const SceneData *d, V3 *bmin, V3 *bmax)
+/* Bounds of the prepared triangles, instances and portals (the portals
+ * in use, not those the scene marks). The flat triangles are the first
+ * nflat; the instances' world bounds come from their meshes'. */
+static void prepared_bounds(const Scene *s, const SceneData *d, uint32_t nflat, V3 *bmin, V3 *bmax)
 {
 	V3 lo = v3(AJAR_INF, AJAR_INF, AJAR_INF), hi = v3(-AJAR_INF, -AJAR_INF, -AJAR_INF);
-	for (size_t i = 0; i < d->n_tris; i++) {
+	for (size_t i = 0; i < nflat; i++) {
 		const Tri *t = &d->tris[i];
 		lo = v3_min(lo, v3_min(t->p0, v3_min(t->p1, t->p2)));
 		hi = v3_max(hi, v3_max(t->p0, v3_max(t->p1, t->p2)));
+	}
+	for (uint32_t j = 0; j < s->ninstances; j++) {
+		V3 mlo, mhi, a, b;
+		scene_mesh_bounds(s, s->instances[j].mesh, &mlo, &mhi);
+		scene_instance_bounds(&s->instances[j], mlo, mhi, &a, &b);
+		lo = v3_min(lo, a);
+		hi = v3_max(hi, b);
 	}
 	for (size_t i = 0; i < d->n_portals; i++) {
 		const PortalTri *t = &d->portals[i];
@@ -196,59 +212,65 @@ static void prepared_bounds(const SceneData *d, V3 *bmin, V3 *bmax)
 	*bmax = hi;
 }
 
-ajar_status prepare_scene(const Scene *s, const ajar_options *o, uint32_t width, uint32_t height,
+ajar_status prepare_scene(Scene *s, const ajar_options *o, uint32_t width, uint32_t height,
 			  const PolicyOverrides *over, SceneData *d)
 {
 	ajar_status st;
 	uint32_t n = s->ntris;
 	memset(d, 0, sizeof *d);
-	if (n == 0)
+	if (scene_rendered_triangles(s) == 0)
 		return err_set(AJAR_ERROR_BAD_INPUT, "%s: the scene has no triangles", s->source);
 	if (s->nmaterials == 0)
 		return err_set(AJAR_ERROR_BAD_INPUT, "%s: the scene has no materials", s->source);
 
-	double t0 = seconds();
-	if ((st = bvh_build(s->tris, n, &d->bvh)) != AJAR_OK)
+	if ((st = scene_bvh(s, &d->share)) != AJAR_OK)
 		return st;
-	d->bvh_seconds = seconds() - t0;
-	d->nodes = d->bvh.nodes;
-	d->n_nodes = d->bvh.nnodes;
-
-	d->tris = malloc(sizeof *d->tris * n);
-	d->shade = malloc(sizeof *d->shade * n);
+	SceneShare *sh = d->share;
+	d->nodes = sh->nodes;
+	d->n_nodes = sh->nnodes;
+	d->bvh_depth = sh->bvh_depth;
+	d->bvh_wide_depth = sh->bvh_wide_depth;
+	d->bvh_seconds = sh->bvh_seconds;
+	d->tris = sh->tris;
+	d->shade = sh->shade;
+	d->texels = sh->texels;
+	d->n_texels = sh->ntexels;
+	/* Materials and textures are small: copies, so a renderer needs
+	 * nothing of the scene but the share. */
+	d->materials = dup_array(s->materials, s->nmaterials, sizeof *s->materials);
+	d->n_materials = s->nmaterials;
+	d->textures = dup_array(s->textures, s->ntextures, sizeof *s->textures);
+	d->n_textures = s->ntextures;
 	d->n_extra = s->extra ? n : 1; /* one unused entry, so a device buffer exists */
-	d->extra = calloc(d->n_extra, sizeof *d->extra);
+	d->extra = s->extra ? sh->extra : calloc(1, sizeof *d->extra);
 	d->params = calloc(1, sizeof *d->params);
-	if (!d->tris || !d->shade || !d->params || !d->extra) {
+	if ((st = scene_bvh_instances(s, sh, &d->instances, &d->n_instances)) != AJAR_OK) {
+		prepare_free(d);
+		return st;
+	}
+	if (over && over->panes_opaque) { /* a test's brute force: smooth thin glass is a delta surface */
+		d->tris = dup_array(sh->tris, n, sizeof *d->tris);
+		d->own_tris = 1;
+		for (uint32_t i = 0; d->tris && i < n; i++)
+			d->tris[i].flags &= ~TRI_PANE;
+	}
+	if (!d->tris || !d->params || !d->extra || !d->materials || !d->textures) {
 		prepare_free(d);
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory preparing %u triangles", s->source, n);
 	}
-	for (uint32_t i = 0; i < n; i++) {
-		d->tris[i] = s->tris[d->bvh.order[i]];
-		d->shade[i] = s->shade[d->bvh.order[i]];
-		if (s->extra)
-			d->extra[i] = s->extra[d->bvh.order[i]];
-	}
 	d->n_tris = d->n_shade = n;
-	if (over && over->panes_opaque) /* a test's brute force: smooth thin glass is a delta surface */
-		for (uint32_t i = 0; i < n; i++)
-			d->tris[i].flags &= ~TRI_PANE;
-	d->materials = s->materials;
-	d->n_materials = s->nmaterials;
-	d->textures = s->textures;
-	d->n_textures = s->ntextures;
-	d->texels = s->texels;
-	d->n_texels = s->ntexels;
 	if ((st = choose_portals(s, o, d)) != AJAR_OK) {
 		prepare_free(d);
 		return st;
 	}
 	d->kernel_omit = kernel_omit(d);
 
-	prepared_bounds(d, &d->bmin, &d->bmax);
+	prepared_bounds(s, d, scene_flat_triangles(s), &d->bmin, &d->bmax);
 	V3 center = v3_scale(v3_add(d->bmin, d->bmax), 0.5f);
 	float radius = 0.5f * v3_len(v3_sub(d->bmax, d->bmin)) * 1.001f + 1e-4f;
-	if ((st = lights_build(s, d->tris, d->shade, d->extra, n, s->materials, d->portals, (uint32_t)d->n_portals, center, radius,
+	/* Only flat triangles emit: they come first (scene_bvh.c), the
+	 * instanced meshes after them. */
+	if ((st = lights_build(s, d->tris, d->shade, d->extra, scene_flat_triangles(s), d->materials, d->portals, (uint32_t)d->n_portals, center, radius,
 			       &d->lights)) != AJAR_OK) {
 		prepare_free(d);
 		return st;
@@ -369,16 +391,20 @@ ajar_status prepare_scene(const Scene *s, const ajar_options *o, uint32_t width,
 
 void prepare_free(SceneData *d)
 {
-	/* materials, textures and texels are borrowed from the Scene. */
-	free(d->tris);
-	free(d->shade);
-	free(d->extra);
+	/* nodes, shade, texels, tris and extra (unless copies) are the share's. */
+	if (d->own_tris)
+		free(d->tris);
+	if (!d->share || d->extra != d->share->extra)
+		free(d->extra);
+	free(d->materials);
+	free(d->textures);
 	free(d->params);
 	free(d->portals);
 	free(d->portal_planes);
 	free(d->portal_sky);
-	bvh_free(&d->bvh);
+	free(d->instances);
 	lights_free(&d->lights);
 	portal_search_free(&d->found);
+	scene_share_release(d->share);
 	memset(d, 0, sizeof *d);
 }

@@ -90,7 +90,10 @@ static ajar_status renderer_new(const ajar_scene *scene, const ajar_options *opt
 	r->opt.width = r->width;
 	r->opt.height = r->height;
 	snprintf(r->scene_name, sizeof r->scene_name, "%s", scene->source ? scene->source : "");
-	if ((st = prepare_scene(scene, opt, r->width, r->height, over, &r->data)) != AJAR_OK)
+	/* The renderer shares the scene's triangles, which the first one puts
+	 * in its BVH's order (src/prepare/scene_bvh.c): the scene changes in
+	 * that order alone, so the API keeps it const. */
+	if ((st = prepare_scene((ajar_scene *)scene, opt, r->width, r->height, over, &r->data)) != AJAR_OK)
 		goto fail;
 	if (ck && (st = render_checkpoint_check(r, ck, ck_path)) != AJAR_OK)
 		goto fail;

@@ -11,12 +11,14 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/big_array.h"
 #include "core/error.h"
 #include "image/exr.h"
 #include "image/hdr.h"
 #include "material/bsdf.h"
 #include "material/texture.h"
 #include "scene/emit_mask.h"
+#include "scene/scene_share.h"
 
 /* Device code indexes with int, so no array may pass INT32_MAX entries. */
 #define SCENE_MAX_ITEMS ((size_t)INT32_MAX)
@@ -33,6 +35,25 @@ static ajar_status grow(void **arr, size_t *cap, size_t need, size_t size)
 	if (ncap > SIZE_MAX / size)
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "scene: array of %zu items is too large", need);
 	void *p = realloc(*arr, ncap * size);
+	if (!p)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "scene: out of memory for %zu items", need);
+	*arr = p;
+	*cap = ncap;
+	return AJAR_OK;
+}
+
+/* grow() for the big arrays (core/big_array.h): page-aligned, grown in
+ * place, written only where filled. */
+static ajar_status grow_big(void **arr, size_t *cap, size_t need, size_t size)
+{
+	if (need <= *cap)
+		return AJAR_OK;
+	size_t ncap = *cap ? *cap : 16;
+	while (ncap < need)
+		ncap *= 2;
+	if (ncap > SIZE_MAX / size)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "scene: array of %zu items is too large", need);
+	void *p = big_resize(*arr, *cap * size, ncap * size);
 	if (!p)
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "scene: out of memory for %zu items", need);
 	*arr = p;
@@ -71,15 +92,21 @@ void scene_free(Scene *s)
 	if (!s)
 		return;
 	free(s->source);
-	free(s->tris);
-	free(s->shade);
+	if (s->share) {
+		scene_share_release(s->share); /* the arrays go with the last holder */
+	} else {
+		big_free(s->tris, (size_t)s->cap_tris * sizeof *s->tris);
+		big_free(s->shade, (size_t)s->cap_tris * sizeof *s->shade);
+		big_free(s->texels, s->cap_texels * sizeof *s->texels);
+		big_free(s->extra, s->cap_extra * sizeof *s->extra);
+	}
 	free(s->materials);
 	free(s->textures);
-	free(s->texels);
 	free(s->portals);
 	free(s->env_rgb);
-	free(s->extra);
 	free(s->lights);
+	free(s->meshes);
+	free(s->instances);
 	free(s);
 }
 
@@ -118,7 +145,9 @@ ajar_status scene_add_texture(Scene *s, uint32_t width, uint32_t height, const u
 	ajar_status st = grow32((void **)&s->textures, &s->cap_textures, (size_t)s->ntextures + 1,
 				sizeof *s->textures);
 	if (!st)
-		st = grow((void **)&s->texels, &s->cap_texels, s->ntexels + n, sizeof *s->texels);
+		st = scene_private(s);
+	if (!st)
+		st = grow_big((void **)&s->texels, &s->cap_texels, s->ntexels + n, sizeof *s->texels);
 	if (st)
 		return st;
 	uint32_t *dst = s->texels + s->ntexels;
@@ -230,7 +259,7 @@ static void extra_default(TriExtra *e)
 static ajar_status extra_reserve(Scene *s, const char *what, uint32_t ntris)
 {
 	size_t have = s->extra ? s->ntris : 0, need = (size_t)s->ntris + ntris;
-	ajar_status st = grow((void **)&s->extra, &s->cap_extra, need, sizeof *s->extra);
+	ajar_status st = grow_big((void **)&s->extra, &s->cap_extra, need, sizeof *s->extra);
 	if (st)
 		return err_set(st, "%s: %s: out of memory for vertex attributes", s->source, what);
 	for (size_t i = have; i < need; i++)
@@ -257,6 +286,8 @@ ajar_status scene_add_triangles_ex(Scene *s, const char *what, const float *pos,
 		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: a tangent is not finite", s->source, what);
 	if (material < s->nmaterials && !s->materials[material].normal_tex)
 		tangents = NULL; /* only normal maps read them */
+	if ((st = scene_private(s)) != AJAR_OK)
+		return st;
 	if ((uvs1 || colors || tangents || s->extra) && (st = extra_reserve(s, what, ntris)))
 		return st;
 	if (material >= s->nmaterials)
@@ -290,13 +321,20 @@ ajar_status scene_add_triangles_ex(Scene *s, const char *what, const float *pos,
 		size_t ncap = s->cap_tris ? s->cap_tris : 16;
 		while (ncap < need)
 			ncap *= 2;
-		Tri *t = realloc(s->tris, ncap * sizeof *t);
+		if (ncap > UINT32_MAX)
+			ncap = UINT32_MAX;
+		Tri *t = big_resize(s->tris, (size_t)s->cap_tris * sizeof *t, ncap * sizeof *t);
 		if (!t)
 			return err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: %s: out of memory", s->source, what);
 		s->tris = t;
-		TriShade *sh = realloc(s->shade, ncap * sizeof *sh);
-		if (!sh)
+		TriShade *sh = big_resize(s->shade, (size_t)s->cap_tris * sizeof *sh, ncap * sizeof *sh);
+		if (!sh) {
+			/* tris grew alone: shrink it back so both keep cap_tris */
+			Tri *back = big_resize(s->tris, ncap * sizeof *t, (size_t)s->cap_tris * sizeof *t);
+			if (back)
+				s->tris = back;
 			return err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: %s: out of memory", s->source, what);
+		}
 		s->shade = sh;
 		s->cap_tris = (uint32_t)ncap;
 	}
@@ -374,6 +412,64 @@ ajar_status scene_add_triangles_ex(Scene *s, const char *what, const float *pos,
 	}
 	s->ntris += ntris;
 	return AJAR_OK;
+}
+
+ajar_status scene_add_mesh_range(Scene *s, const char *what, uint32_t first, uint32_t *id)
+{
+	uint32_t end = s->nmeshes ? s->meshes[s->nmeshes - 1].first + s->meshes[s->nmeshes - 1].count : 0;
+	if (first < end || first >= s->ntris)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: %s: triangles from %u overlap a mesh or do not exist",
+			       s->source, what, first);
+	ajar_status st = scene_private(s);
+	if (!st)
+		st = grow32((void **)&s->meshes, &s->cap_meshes, (size_t)s->nmeshes + 1, sizeof *s->meshes);
+	if (st)
+		return st;
+	s->meshes[s->nmeshes].first = first;
+	s->meshes[s->nmeshes].count = s->ntris - first;
+	*id = s->nmeshes++;
+	return AJAR_OK;
+}
+
+ajar_status scene_add_instance(Scene *s, const char *what, uint32_t mesh, const double m[16])
+{
+	if (mesh >= s->nmeshes)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: %s: mesh %u does not exist (%u meshes)", s->source, what,
+			       mesh, s->nmeshes);
+	for (int k = 0; k < 16; k++)
+		if (!isfinite(m[k]))
+			return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: transform is not finite", s->source, what);
+	double det = m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) +
+		     m[8] * (m[1] * m[6] - m[5] * m[2]);
+	if (!(fabs(det) > 0.0) || !isfinite(det))
+		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: transform is singular", s->source, what);
+	ajar_status st = scene_private(s);
+	if (!st)
+		st = grow32((void **)&s->instances, &s->cap_instances, (size_t)s->ninstances + 1, sizeof *s->instances);
+	if (st)
+		return st;
+	SceneInstance *in = &s->instances[s->ninstances++];
+	in->mesh = mesh;
+	for (int r = 0; r < 3; r++)
+		for (int c = 0; c < 4; c++)
+			in->m[4 * r + c] = m[4 * c + r];
+	return AJAR_OK;
+}
+
+uint32_t scene_flat_triangles(const Scene *s)
+{
+	uint32_t n = s->ntris;
+	for (uint32_t k = 0; k < s->nmeshes; k++)
+		n -= s->meshes[k].count;
+	return n;
+}
+
+uint64_t scene_rendered_triangles(const Scene *s)
+{
+	uint64_t n = scene_flat_triangles(s);
+	for (uint32_t i = 0; i < s->ninstances; i++)
+		n += s->meshes[s->instances[i].mesh].count;
+	return n;
 }
 
 ajar_status scene_add_portal(Scene *s, const char *what, const float *pos, uint32_t nverts, const uint32_t *idx,
@@ -590,16 +686,83 @@ ajar_status scene_set_env_rotation(Scene *s, double degrees)
 	return AJAR_OK;
 }
 
+/* Min and max that take -0 below +0, so bounds do not depend on the order
+ * of the triangles (a renderer puts them in its BVH's), inline: a
+ * 10M-triangle scene's bounds in 40 ms, not 0.4 s of library calls. */
+static inline float min_signed(float a, float b) { return b < a || (b == a && signbit(b)) ? b : a; }
+static inline float max_signed(float a, float b) { return b > a || (b == a && !signbit(b)) ? b : a; }
+static inline V3 v3_min_signed(V3 a, V3 b) { return v3(min_signed(a.x, b.x), min_signed(a.y, b.y), min_signed(a.z, b.z)); }
+static inline V3 v3_max_signed(V3 a, V3 b) { return v3(max_signed(a.x, b.x), max_signed(a.y, b.y), max_signed(a.z, b.z)); }
+
+static void bounds_grow(const Tri *t, V3 *lo, V3 *hi)
+{
+	*lo = v3_min_signed(*lo, v3_min_signed(t->p0, v3_min_signed(t->p1, t->p2)));
+	*hi = v3_max_signed(*hi, v3_max_signed(t->p0, v3_max_signed(t->p1, t->p2)));
+}
+
+void scene_mesh_bounds(const Scene *s, uint32_t k, V3 *lo, V3 *hi)
+{
+	*lo = v3(AJAR_INF, AJAR_INF, AJAR_INF);
+	*hi = v3(-AJAR_INF, -AJAR_INF, -AJAR_INF);
+	const SceneMesh *m = &s->meshes[k];
+	for (uint32_t i = m->first; i < m->first + m->count; i++)
+		bounds_grow(&s->tris[i], lo, hi);
+}
+
+/* The float next below (dir < 0) or above a double's rounding. */
+static float round_out(double v, int dir)
+{
+	float f = (float)v;
+	if (dir < 0 && (double)f > v)
+		f = nextafterf(f, -INFINITY);
+	if (dir > 0 && (double)f < v)
+		f = nextafterf(f, INFINITY);
+	return f;
+}
+
+void scene_instance_bounds(const SceneInstance *in, V3 mlo, V3 mhi, V3 *lo, V3 *hi)
+{
+	double l[3] = {INFINITY, INFINITY, INFINITY}, h[3] = {-INFINITY, -INFINITY, -INFINITY};
+	for (int c = 0; c < 8; c++) {
+		double p[3] = {c & 1 ? mhi.x : mlo.x, c & 2 ? mhi.y : mlo.y, c & 4 ? mhi.z : mlo.z};
+		for (int r = 0; r < 3; r++) {
+			double w = in->m[4 * r] * p[0] + in->m[4 * r + 1] * p[1] + in->m[4 * r + 2] * p[2] + in->m[4 * r + 3];
+			l[r] = fmin(l[r], w);
+			h[r] = fmax(h[r], w);
+		}
+	}
+	*lo = v3(round_out(l[0], -1), round_out(l[1], -1), round_out(l[2], -1));
+	*hi = v3(round_out(h[0], 1), round_out(h[1], 1), round_out(h[2], 1));
+}
+
 void scene_bounds(const Scene *s, V3 *bmin, V3 *bmax)
 {
 	V3 lo = v3(AJAR_INF, AJAR_INF, AJAR_INF), hi = v3(-AJAR_INF, -AJAR_INF, -AJAR_INF);
-	for (uint32_t i = 0; i < s->ntris; i++) {
-		const Tri *t = &s->tris[i];
-		lo = v3_min(lo, v3_min(t->p0, v3_min(t->p1, t->p2)));
-		hi = v3_max(hi, v3_max(t->p0, v3_max(t->p1, t->p2)));
+	uint32_t i = 0;
+	for (uint32_t k = 0; k <= s->nmeshes; k++) { /* the flat triangles before mesh k */
+		uint32_t end = k < s->nmeshes ? s->meshes[k].first : s->ntris;
+		for (; i < end; i++)
+			bounds_grow(&s->tris[i], &lo, &hi);
+		if (k < s->nmeshes)
+			i = s->meshes[k].first + s->meshes[k].count;
 	}
-	for (uint32_t i = 0; i < s->nportal_tris; i++) {
-		const PortalTri *t = &s->portals[i];
+	if (s->ninstances) {
+		V3 *mb = malloc(sizeof *mb * 2 * s->nmeshes);
+		for (uint32_t k = 0; mb && k < s->nmeshes; k++)
+			scene_mesh_bounds(s, k, &mb[2 * k], &mb[2 * k + 1]);
+		for (uint32_t j = 0; mb && j < s->ninstances; j++) {
+			const SceneInstance *in = &s->instances[j];
+			if (!s->meshes[in->mesh].count)
+				continue;
+			V3 a, b;
+			scene_instance_bounds(in, mb[2 * in->mesh], mb[2 * in->mesh + 1], &a, &b);
+			lo = v3_min_signed(lo, a);
+			hi = v3_max_signed(hi, b);
+		}
+		free(mb);
+	}
+	for (uint32_t k = 0; k < s->nportal_tris; k++) {
+		const PortalTri *t = &s->portals[k];
 		lo = v3_min(lo, v3_min(t->p0, v3_min(t->p1, t->p2)));
 		hi = v3_max(hi, v3_max(t->p0, v3_max(t->p1, t->p2)));
 	}

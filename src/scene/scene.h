@@ -20,12 +20,32 @@ extern "C" {
  * of float RGBA as it is read), from the header before the pixels are
  * allocated; image/hdr.c holds .hdr files to the same. */
 #define SCENE_SKY_MAX_PIXELS ((uint64_t)1 << 27)
+/* The arrays a scene shares with its renderers (scene_share.h). */
+typedef struct SceneShare SceneShare;
+
+/* A mesh kept once, in object space, for its instances: triangles
+ * [first, first + count) of the scene's arrays. Meshes are in order of
+ * `first` and do not overlap; every triangle outside them is a
+ * world-space ("flat") one. */
+typedef struct {
+	uint32_t first, count;
+} SceneMesh;
+
+/* A copy of mesh `mesh` placed by m: object to world, rows of 3x4, its
+ * determinant non-zero. */
+typedef struct {
+	uint32_t mesh;
+	double m[12];
+} SceneInstance;
 
 /* The public ajar_scene handle is this struct. */
 typedef struct ajar_scene {
 	char *source;            /* file name for messages, or "<api>" */
 
-	Tri *tris;               /* world space, insertion order */
+	/* tris, shade, extra and texels are big arrays (core/big_array.h),
+	 * held with the renderers through `share` once one was prepared:
+	 * written only after scene_private(). */
+	Tri *tris;               /* world space, insertion order until a renderer puts them in its BVH's */
 	TriShade *shade;
 	uint32_t ntris, cap_tris;
 
@@ -59,10 +79,19 @@ typedef struct ajar_scene {
 	size_t cap_extra;
 	ajar_light *lights;      /* punctual lights, glTF units, direction unit */
 	uint32_t nlights, cap_lights;
+	SceneShare *share;       /* NULL until a renderer shares the arrays */
+	double load_seconds;     /* ajar_scene_load's */
+	SceneMesh *meshes;       /* instanced meshes (a renderer moves them after the flat triangles) */
+	uint32_t nmeshes, cap_meshes;
+	SceneInstance *instances;
+	uint32_t ninstances, cap_instances;
 } Scene;
 
 ajar_status scene_new(const char *source, Scene **out);
 void scene_free(Scene *s);
+/* Makes tris, shade, extra and texels the scene's alone, to be written
+ * (scene_share.c): copied if a renderer shares them. */
+ajar_status scene_private(Scene *s);
 
 /* Returns the new material's index in *id. */
 ajar_status scene_add_material(Scene *s, const Material *m, uint32_t *id);
@@ -85,6 +114,17 @@ ajar_status scene_add_triangles_ex(Scene *s, const char *what, const float *pos,
 				   const float *uvs, const float *uvs1, const float *colors, const float *tangents,
 				   uint32_t nverts,
 				   const uint32_t *idx, uint32_t ntris, uint32_t material);
+/* Makes triangles [first, s->ntris), added last, mesh *id: object space,
+ * drawn only through instances. first must not lie before the last
+ * mesh's end. */
+ajar_status scene_add_mesh_range(Scene *s, const char *what, uint32_t first, uint32_t *id);
+/* An instance of mesh `mesh` under the column-major 4x4 matrix m (glTF's;
+ * its last row 0 0 0 1); refused if not finite or singular. */
+ajar_status scene_add_instance(Scene *s, const char *what, uint32_t mesh, const double m[16]);
+/* Triangles as rendered: the flat ones and every instance's. */
+uint64_t scene_rendered_triangles(const Scene *s);
+/* Triangles outside every mesh. */
+uint32_t scene_flat_triangles(const Scene *s);
 ajar_status scene_add_portal(Scene *s, const char *what, const float *pos, uint32_t nverts,
 			     const uint32_t *idx, uint32_t ntris);
 ajar_status scene_set_camera(Scene *s, V3 pos, V3 forward, V3 up, float yfov, float aspect);
@@ -105,8 +145,12 @@ ajar_status scene_set_env_rotation(Scene *s, double degrees);
  * the direction is normalised. */
 ajar_status scene_add_light(Scene *s, const char *what, const ajar_light *l);
 
-/* Bounds of all renderable triangles (portals included). */
+/* Bounds of all renderable triangles (instances and portals included). */
 void scene_bounds(const Scene *s, V3 *bmin, V3 *bmax);
+/* Mesh k's bounds in object space, and an instance's world-space bounds
+ * (the mesh's corners transformed in double, rounded outward). */
+void scene_mesh_bounds(const Scene *s, uint32_t k, V3 *lo, V3 *hi);
+void scene_instance_bounds(const SceneInstance *in, V3 mlo, V3 mhi, V3 *lo, V3 *hi);
 /* The host scene's surfaces (triangles, shading, materials, textures) as
  * the kernels' surface code reads them; the other arrays are NULL. */
 SceneView scene_surface_view(const Scene *s);

@@ -9,10 +9,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "core/error.h"
 #include "scene/gltf.h"
 #include "scene/scene.h"
+#include "scene/scene_share.h"
 
 ajar_status ajar_scene_load(const char *path, ajar_scene **out)
 {
@@ -21,7 +23,7 @@ ajar_status ajar_scene_load(const char *path, ajar_scene **out)
 	*out = NULL;
 	if (!path || !*path)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_scene_load: no path");
-	return gltf_load(path, out);
+	return ajar_scene_load_with(path, NULL, out);
 }
 
 void ajar_load_options_default(ajar_load_options *o)
@@ -37,7 +39,13 @@ ajar_status ajar_scene_load_with(const char *path, const ajar_load_options *o, a
 	*out = NULL;
 	if (!path || !*path)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_scene_load_with: no path");
-	return gltf_load_with(path, o ? o->allow_outside_files : 0, out);
+	struct timespec t0, t1;
+	clock_gettime(CLOCK_MONOTONIC, &t0);
+	ajar_status st = gltf_load_instancing(path, o ? o->allow_outside_files : 0, GLTF_INSTANCING_AUTO, out);
+	clock_gettime(CLOCK_MONOTONIC, &t1);
+	if (st == AJAR_OK)
+		(*out)->load_seconds = (double)(t1.tv_sec - t0.tv_sec) + (t1.tv_nsec - t0.tv_nsec) * 1e-9;
+	return st;
 }
 
 ajar_status ajar_scene_create(ajar_scene **out)
@@ -339,7 +347,7 @@ ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info)
 	if (!s || !info)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "ajar_scene_info_get: NULL argument");
 	memset(info, 0, sizeof *info);
-	info->triangles = s->ntris;
+	info->triangles = scene_rendered_triangles(s);
 	info->materials = s->nmaterials;
 	info->emissive_triangles = scene_count_emissive(s);
 	info->portal_triangles = s->nportal_tris;
@@ -350,8 +358,20 @@ ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info)
 	info->emissive_textures = count_images(s, 2);
 	info->normal_textures = count_images(s, 3);
 	info->texture_bytes = (uint64_t)s->ntexels * sizeof *s->texels;
-	for (uint32_t i = 0; i < s->ntris; i++)
-		info->alpha_triangles += (s->tris[i].flags & TRI_ALPHA) != 0;
+	/* Every copy an instance draws counts. */
+	for (uint32_t i = 0, k = 0; i < s->ntris; i++) {
+		while (k < s->nmeshes && i >= s->meshes[k].first + s->meshes[k].count)
+			k++;
+		int in_mesh = k < s->nmeshes && i >= s->meshes[k].first;
+		if (!(s->tris[i].flags & TRI_ALPHA))
+			continue;
+		if (!in_mesh) {
+			info->alpha_triangles++;
+			continue;
+		}
+		for (uint32_t j = 0; j < s->ninstances; j++)
+			info->alpha_triangles += s->instances[j].mesh == k;
+	}
 	info->environment = s->env_type == ENV_IMAGE ? 2 : s->env_type == ENV_COLOR ? 1 : 0;
 	V3 lo, hi;
 	scene_bounds(s, &lo, &hi);
@@ -380,5 +400,13 @@ ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info)
 	info->width = s->width;
 	info->height = s->height;
 	info->lights = s->nlights;
+	info->unique_triangles = s->ntris;
+	info->instances = s->ninstances;
+	info->geometry_bytes = (uint64_t)s->ntris * (sizeof *s->tris + sizeof *s->shade + (s->extra ? sizeof *s->extra : 0));
+	if (s->share && s->share->nodes) {
+		info->bvh_bytes = (uint64_t)s->share->nnodes * sizeof(BvhNode);
+		info->bvh_seconds = s->share->bvh_seconds;
+	}
+	info->load_seconds = s->load_seconds;
 	return AJAR_OK;
 }

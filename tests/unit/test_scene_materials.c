@@ -252,7 +252,7 @@ static void test_texture_coordinates(void **state)
 	 * (0.6, 0.2, 0.2), alpha 0.6 + 0.2 + 0.2 x 128/255. */
 	assert_true(s->tris[0].flags & TRI_EXTRA);
 	assert_false(s->tris[1].flags & TRI_EXTRA);
-	Hit h = {1.0f, 0.2f, 0.2f, 0};
+	Hit h = {1.0f, 0.2f, 0.2f, 0, -1};
 	Surface sf;
 	surface_from_hit(&sc, &h, &sf);
 	assert_float_equal(sf.alpha, 0.8f + 0.2f * 128.0f / 255.0f, EPS);
@@ -456,7 +456,7 @@ static void test_normal_map(void **state)
 	/* b = w (n x t) = -(z x x) = -y */
 	V3 want = v3_norm(v3(x, -y, z));
 	for (int tri = 0; tri < 2; tri++) {
-		Hit h = {1.0f, 0.3f, 0.2f, tri};
+		Hit h = {1.0f, 0.3f, 0.2f, tri, -1};
 		Surface sf;
 		surface_from_hit(&sc, &h, &sf);
 		assert_v3(sf.ns, want.x, want.y, want.z);

@@ -1,0 +1,236 @@
+/* bvh_parts.h — what the BVH build's files share (bvh_build.c drives the
+ * build and its threads, bvh_split.c bins and splits a node, bvh_collapse.c
+ * makes the eight-wide tree): boxes as four-float vectors, references,
+ * binary nodes, bins.
+ *
+ * Every operation here gives the bits of the scalar build it replaced:
+ * min and max keep the earlier value on ties (so -0 and +0 come out as
+ * before), sums and products are the same IEEE single operations in the
+ * same order, and bins merged in the order of their ranges equal bins
+ * filled in one pass. That is why any number of threads builds the same
+ * tree. */
+#ifndef AJAR_BVH_PARTS_H
+#define AJAR_BVH_PARTS_H
+#include <stdint.h>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+typedef __m128 F4;
+static inline F4 f4_zero(void) { return _mm_setzero_ps(); }
+static inline F4 f4_set(float x, float y, float z) { return _mm_setr_ps(x, y, z, 0.0f); }
+static inline F4 f4_splat(float v) { return _mm_set1_ps(v); }
+/* Three floats at p (a fourth readable after them), the fourth lane 0. */
+static inline F4 f4_load3(const float *p)
+{
+	return _mm_and_ps(_mm_loadu_ps(p), _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0)));
+}
+static inline F4 f4_add(F4 a, F4 b) { return _mm_add_ps(a, b); }
+static inline F4 f4_sub(F4 a, F4 b) { return _mm_sub_ps(a, b); }
+static inline F4 f4_mul(F4 a, F4 b) { return _mm_mul_ps(a, b); }
+/* o < b ? o : b and o > b ? o : b, lane by lane: b stays on ties. */
+static inline F4 f4_min(F4 o, F4 b) { return _mm_min_ps(o, b); }
+static inline F4 f4_max(F4 o, F4 b) { return _mm_max_ps(o, b); }
+static inline void f4_store(float out[4], F4 a) { _mm_storeu_ps(out, a); }
+/* Lanes truncated toward zero (the values fit an int). */
+static inline void f4_trunc(int out[4], F4 a) { _mm_storeu_si128((__m128i *)out, _mm_cvttps_epi32(a)); }
+/* Lanes 0-2 truncated toward zero, without a trip through memory. */
+static inline void f4_trunc3(F4 a, int *k0, int *k1, int *k2)
+{
+	__m128i k = _mm_cvttps_epi32(a);
+	*k0 = _mm_cvtsi128_si32(k);
+	*k1 = _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 1));
+	*k2 = _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 2));
+}
+/* d0 d1 + d1 d2 + d2 d0 of lanes 0-2 (summed in that order), 0 where a
+ * lane is negative: half the area of a box of extents d. */
+static inline float f4_half_area(F4 d)
+{
+	if (_mm_movemask_ps(_mm_cmplt_ps(d, _mm_setzero_ps())) & 7)
+		return 0.0f;
+	F4 t = _mm_mul_ps(d, _mm_shuffle_ps(d, d, _MM_SHUFFLE(3, 0, 2, 1)));
+	F4 s = _mm_add_ss(t, _mm_shuffle_ps(t, t, _MM_SHUFFLE(1, 1, 1, 1)));
+	return _mm_cvtss_f32(_mm_add_ss(s, _mm_shuffle_ps(t, t, _MM_SHUFFLE(2, 2, 2, 2))));
+}
+#else
+typedef struct {
+	float v[4];
+} F4;
+static inline F4 f4_zero(void) { return (F4){{0.0f, 0.0f, 0.0f, 0.0f}}; }
+static inline F4 f4_set(float x, float y, float z) { return (F4){{x, y, z, 0.0f}}; }
+static inline F4 f4_splat(float v) { return (F4){{v, v, v, v}}; }
+static inline F4 f4_load3(const float *p) { return (F4){{p[0], p[1], p[2], 0.0f}}; }
+static inline F4 f4_add(F4 a, F4 b)
+{
+	for (int i = 0; i < 4; i++)
+		a.v[i] += b.v[i];
+	return a;
+}
+static inline F4 f4_sub(F4 a, F4 b)
+{
+	for (int i = 0; i < 4; i++)
+		a.v[i] -= b.v[i];
+	return a;
+}
+static inline F4 f4_mul(F4 a, F4 b)
+{
+	for (int i = 0; i < 4; i++)
+		a.v[i] *= b.v[i];
+	return a;
+}
+static inline F4 f4_min(F4 o, F4 b)
+{
+	for (int i = 0; i < 4; i++)
+		b.v[i] = o.v[i] < b.v[i] ? o.v[i] : b.v[i];
+	return b;
+}
+static inline F4 f4_max(F4 o, F4 b)
+{
+	for (int i = 0; i < 4; i++)
+		b.v[i] = o.v[i] > b.v[i] ? o.v[i] : b.v[i];
+	return b;
+}
+static inline void f4_store(float out[4], F4 a)
+{
+	for (int i = 0; i < 4; i++)
+		out[i] = a.v[i];
+}
+static inline void f4_trunc(int out[4], F4 a)
+{
+	for (int i = 0; i < 4; i++)
+		out[i] = (int)a.v[i];
+}
+static inline void f4_trunc3(F4 a, int *k0, int *k1, int *k2)
+{
+	*k0 = (int)a.v[0];
+	*k1 = (int)a.v[1];
+	*k2 = (int)a.v[2];
+}
+static inline float f4_half_area(F4 d)
+{
+	if (d.v[0] < 0.0f || d.v[1] < 0.0f || d.v[2] < 0.0f)
+		return 0.0f;
+	return d.v[0] * d.v[1] + d.v[1] * d.v[2] + d.v[2] * d.v[0];
+}
+#endif
+
+/* Leaves hold at most this many triangles (the leaf slot encodes 1-4). */
+#define BVH_MAX_LEAF 4
+/* SAH bins per axis at most; a node of fewer refs gets one per ref. */
+#define BVH_BINS 32
+/* Traversal cost relative to one triangle test. */
+#define BVH_COST_TRAVERSE 1.0f
+
+typedef struct {
+	float lo[3], hi[3];
+} Box;
+
+/* A box as vectors: lanes 0-2 the axes. */
+typedef struct {
+	F4 lo, hi;
+} Box4;
+
+/* A triangle's bounds and where it came from; the build permutes these.
+ * f4_load3 of b.lo reads b.hi[0] too, of b.hi reads idx: both inside. */
+typedef struct {
+	Box b;
+	uint32_t idx;
+} Ref;
+
+/* Node of the binary tree: an interior node's left child is the next
+ * node, its right child node `index`; a leaf (count > 0) covers refs
+ * [index, index + count) (after a build with instances, bvh_build.c
+ * renumbers leaves: triangles by their place among the triangles, and an
+ * instance leaf index -1 - instance). A subtree over n refs rooted at node p uses
+ * nodes within [p, p + 2n - 1), so a node's children can be placed before
+ * either is built: left p + 1, right p + 2 n_left. */
+typedef struct {
+	Box b;
+	int index;
+	int count;
+} BinNode;
+
+static inline Box4 box4_empty(void)
+{
+	Box4 b = {f4_splat(3.402823466e+38f), f4_splat(-3.402823466e+38f)};
+	return b;
+}
+
+/* Grows b by o: a lane of o replaces b's only where strictly outside. */
+static inline Box4 box4_grow(Box4 b, Box4 o)
+{
+	b.lo = f4_min(o.lo, b.lo);
+	b.hi = f4_max(o.hi, b.hi);
+	return b;
+}
+
+static inline Box4 box4_of_ref(const Ref *r)
+{
+	Box4 b = {f4_load3(r->b.lo), f4_load3(r->b.hi)};
+	return b;
+}
+
+/* Twice the centroid on every axis: only compared, never a position. */
+static inline F4 ref_keys(const Ref *r) { return f4_add(f4_load3(r->b.lo), f4_load3(r->b.hi)); }
+
+static inline void box4_store(Box *out, Box4 b)
+{
+	float lo[4], hi[4];
+	f4_store(lo, b.lo);
+	f4_store(hi, b.hi);
+	for (int a = 0; a < 3; a++) {
+		out->lo[a] = lo[a];
+		out->hi[a] = hi[a];
+	}
+}
+
+/* Half the surface area; 0 for an empty box. */
+static inline float box_area(const Box *b)
+{
+	float d[3];
+	for (int a = 0; a < 3; a++) {
+		d[a] = b->hi[a] - b->lo[a];
+		if (d[a] < 0.0f)
+			return 0.0f;
+	}
+	return d[0] * d[1] + d[1] * d[2] + d[2] * d[0];
+}
+
+/* A node's bounds and its refs' centroid (key) bounds. */
+typedef struct {
+	Box4 box, cbox;
+} NodeBounds;
+
+/* Bounds of refs [start, end), grown into *nb (box4_empty to start). */
+void bvh_bounds(const Ref *refs, uint32_t start, uint32_t end, NodeBounds *nb);
+/* *acc grown by `later`, the bounds of refs after acc's. */
+void bvh_bounds_merge(NodeBounds *acc, const NodeBounds *later);
+
+/* A node's SAH bins: one box and count per bin and axis. */
+typedef struct {
+	Box4 box[3][BVH_BINS];
+	uint32_t count[3][BVH_BINS];
+} Bins;
+
+/* How a node of n refs with centroid bounds cbox is split: the axis of
+ * largest centroid extent, and whether SAH bins are needed (else a leaf,
+ * a halving of equal centroids, or a median split). */
+typedef struct {
+	int axis;         /* of largest centroid extent (the median split's) */
+	int nb;           /* bins per axis; 0: no SAH for this node */
+	float cmin[3];    /* centroid bounds' low corner */
+	float scale[3];   /* nb / extent, 0 for a flat axis */
+	float ext[3];
+	uint32_t inst_from; /* refs with idx >= this are instances, leaves of one (UINT32_MAX: none) */
+} SplitPlan;
+
+void bvh_split_plan(uint32_t n, const Box4 *cbox, uint32_t depth, uint32_t inst_from, SplitPlan *p);
+void bvh_bins_clear(Bins *b, int nb);
+/* Bins refs [start, end) into b. */
+void bvh_bins_add(Bins *b, const SplitPlan *p, const Ref *refs, uint32_t start, uint32_t end);
+/* acc += later, the bins of refs after acc's. */
+void bvh_bins_merge(Bins *acc, const Bins *later, int nb);
+/* Chooses the split of refs[0, n) (node box `box`) with the plan and, when
+ * p->nb, its bins; reorders refs. Returns the count on the left, or 0 for
+ * a leaf. */
+uint32_t bvh_split_apply(Ref *refs, uint32_t n, const Box *box, const SplitPlan *p, const Bins *bins);
+#endif
