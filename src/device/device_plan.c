@@ -105,7 +105,9 @@ void device_render_options(const Device *d, int integrator, const DevicePlan *p,
 		    {KERNEL_OMIT_BENT_NORMALS, "-DAJAR_NO_BENT_NORMALS "},
 		    {KERNEL_OMIT_TEXTURES, "-DAJAR_NO_TEXTURES "},
 		    {KERNEL_OMIT_TRI_EXTRA, "-DAJAR_NO_TRI_EXTRA "},
-		    {KERNEL_OMIT_PANES, "-DAJAR_NO_PANES "}};
+		    {KERNEL_OMIT_PANES, "-DAJAR_NO_PANES "},
+		    {KERNEL_OMIT_LAYERS, "-DAJAR_NO_LAYERS "},
+		    {KERNEL_OMIT_ANISOTROPY, "-DAJAR_NO_ANISOTROPY "}};
 	device_build_options(d, integrator, NULL, buf, cap);
 	size_t n = strlen(buf);
 	if (p->soa)

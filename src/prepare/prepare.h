@@ -16,6 +16,8 @@
 #define KERNEL_OMIT_TEXTURES 4u     /* -DAJAR_NO_TEXTURES: no material reads a texture */
 #define KERNEL_OMIT_TRI_EXTRA 8u    /* -DAJAR_NO_TRI_EXTRA: no TRI_EXTRA triangle (TEXCOORD_1, COLOR_0, tangents) */
 #define KERNEL_OMIT_PANES 16u       /* -DAJAR_NO_PANES: no TRI_PANE triangle (thin glass that rays cross) */
+#define KERNEL_OMIT_LAYERS 32u      /* -DAJAR_NO_LAYERS: no sheen, clear coat or specular colour */
+#define KERNEL_OMIT_ANISOTROPY 64u  /* -DAJAR_NO_ANISOTROPY: no anisotropic material */
 
 typedef struct {
 #define AJAR_DATA_FIELD(type, name) type *name; size_t n_##name;

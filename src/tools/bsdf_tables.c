@@ -19,6 +19,27 @@
  * reflection included), their averages, and the mean Fresnel reflectance
  * Favg from outside.
  *
+ * Sheen (KHR_materials_sheen's Charlie lobe, microfacet.h): its albedo
+ * with colour 1, Esr(mu, r), over sheen roughness r and mu, exceeds 1 near
+ * grazing below r = 0.5 (7.4 at r = 0.07, mu = 0.001; 1.7 at r = 0.3,
+ * mu = 0.01: the fitted shadowing lets more out than comes in). The kernels
+ * divide the lobe by N(mu_o) N(mu_i), N = max(1, Esr) read from the first
+ * table, which bounds its albedo by 1 and leaves r >= 0.5 as it is; the
+ * second table is that lobe's albedo Es(mu, r) as the kernels interpolate
+ * N, and the cosine-weighted average per r is Es's, for the layering's
+ * energy compensation.
+ *
+ * Anisotropic GGX (KHR_materials_anisotropy: alpha_b = r^2, alpha_t =
+ * alpha_b + (1 - alpha_b) s^2 for strength s): E1 depends on wo's azimuth
+ * phi from the anisotropy direction too. Tabulated is the residual
+ * R(r, s, mu, phi) = E1(mu, phi) - E1iso(alpha_rms, mu), E1iso read from
+ * the isotropic table as the kernels interpolate it, alpha_rms =
+ * sqrt((alpha_t^2 + alpha_b^2) / 2): the residual is small and smooth, so a
+ * coarse grid (quadrilinear, 9 x 7 x 10 x 6) holds it within 1e-3 on
+ * average (worst 7e-3 at low roughness near grazing; a plain 4-D table of E1
+ * needs five times the nodes for that). Its average over mu (cosine
+ * weighted) and phi per (r, s) node makes E1avg with the isotropic average.
+ *
  * The output depends only on this file and microfacet.h, in float as the
  * kernels compute, summed in double: the same bits on every run. */
 #include <stdio.h>
@@ -37,6 +58,12 @@
 #define MIN_IOR 1.01f /* bsdf.h's BSDF_MIN_IOR: ior node 0 */
 #define MIN_ALPHA 1e-3f /* bsdf.h's BSDF_MIN_ALPHA: the tables start at it */
 #define MU0 1e-4f /* stands in for mu = 0, where wo lies in the surface */
+#define SR 16   /* sheen roughness nodes, r = SHEEN_MIN_R + (1 - SHEEN_MIN_R) i / (SR - 1) */
+#define SQ 256  /* sheen: quadrature points per axis */
+#define AR 9    /* anisotropy: roughness nodes, sqrt(alpha_b) = i / (AR - 1) */
+#define AS 7    /* strength nodes, s = j / (AS - 1) */
+#define AMU 10  /* cosine nodes, sqrt(mu) = k / (AMU - 1) */
+#define APHI 6  /* azimuth nodes, phi = (pi / 2) l / (APHI - 1) */
 
 static float node_alpha(int i, int n)
 {
@@ -75,6 +102,89 @@ static void albedo(float mu, float alpha, double *e1, double *ew)
 		}
 	*e1 = s1 / ((double)Q * Q);
 	*ew = sw / ((double)Q * Q);
+}
+
+/* Sheen albedo at one node: h drawn from D cos(theta_h) (the CDF of
+ * theta_h is sin^(2 + 1/a)), so E = integral D G / (4 mu_o) dw_i becomes
+ * the mean of G |wo.h| / (mu_o cos theta_h) over h, 0 where the mirror
+ * direction lies below the surface. */
+static const double *sheen_norm; /* Esr as computed, for N; NULL: N = 1 */
+static float sheen_n(float r, float mu);
+
+static double sheen_albedo(float mu, float r)
+{
+	float alpha = sheen_alpha(r);
+	float no = sheen_norm ? sheen_n(r, mu) : 1.0f;
+	V3 wo = v3(sqrt(fmax(0.0f, 1.0f - mu * mu)), 0.0f, mu);
+	float lo = sheen_lambda(mu, alpha), k = 1.0f / (2.0f + 1.0f / alpha);
+	double s = 0;
+	for (int a = 0; a < SQ; a++)
+		for (int b = 0; b < SQ; b++) {
+			float st = pow((a + 0.5f) / SQ, k), ct = sqrt(fmax(0.0f, 1.0f - st * st));
+			float ph = 2.0f * AJAR_PI * (b + 0.5f) / SQ;
+			V3 h = v3(st * cos(ph), st * sin(ph), ct);
+			float c = v3_dot(wo, h);
+			V3 wi = bsdf_reflect(wo, h);
+			if (!(c > 0.0f) || !(wi.z > 0.0f) || !(ct > 0.0f))
+				continue;
+			float ni = sheen_norm ? sheen_n(r, wi.z) : 1.0f;
+			s += (double)c / ((1.0 + lo + sheen_lambda(wi.z, alpha)) * mu * ct * no * ni);
+		}
+	return s / ((double)SQ * SQ);
+}
+
+/* N = max(1, Esr) as bsdf.h reads it: bilinear in (r, sqrt(mu)). */
+static float sheen_n(float r, float mu)
+{
+	float x = fmin(fmax((r - SHEEN_MIN_R) / (1.0f - SHEEN_MIN_R), 0.0f), 1.0f) * (SR - 1);
+	float y = sqrt(fmin(fmax(mu, 0.0f), 1.0f)) * (NMU - 1);
+	int i = x < SR - 2 ? (int)x : SR - 2, j = y < NMU - 2 ? (int)y : NMU - 2;
+	float wr = x - (float)i, wm = y - (float)j;
+	const double *t = sheen_norm;
+	float r00 = (float)t[i * NMU + j], r01 = (float)t[i * NMU + j + 1];
+	float r10 = (float)t[(i + 1) * NMU + j], r11 = (float)t[(i + 1) * NMU + j + 1];
+	float v0 = r00 + (r01 - r00) * wm, v1 = r10 + (r11 - r10) * wm;
+	return fmax(v0 + (v1 - v0) * wr, 1.0f);
+}
+
+/* Anisotropic E1 at (mu, phi) for roughness ax along x, ay along y. */
+static double aniso_albedo(float mu, float phi, float ax, float ay)
+{
+	float sm = sqrt(fmax(0.0f, 1.0f - mu * mu));
+	V3 wo = v3(sm * cos(phi), sm * sin(phi), mu);
+	float lo = ggx_lambda_aniso(wo, ax, ay);
+	double s = 0;
+	for (int a = 0; a < Q; a++)
+		for (int b = 0; b < Q; b++) {
+			V3 h = ggx_sample_visible_aniso(wo, ax, ay, (a + 0.5f) / Q, (b + 0.5f) / Q);
+			V3 wi = bsdf_reflect(wo, h);
+			if (!(wi.z > 0.0f))
+				continue;
+			s += (1.0 + lo) / (1.0 + lo + ggx_lambda_aniso(wi, ax, ay));
+		}
+	return s / ((double)Q * Q);
+}
+
+/* The isotropic E1 table as bsdf.h reads it (bsdf_tab_at, bsdf_tab2), in
+ * float from the floats printed. */
+static float e1_lookup(const double *e1, float alpha, float mu)
+{
+	float x = fmin(fmax(sqrt(fmax(alpha, 0.0f)), 0.0f), 1.0f) * (NR - 1);
+	float y = sqrt(fmin(fmax(mu, 0.0f), 1.0f)) * (NMU - 1);
+	int i = x < NR - 2 ? (int)x : NR - 2, j = y < NMU - 2 ? (int)y : NMU - 2;
+	float wr = x - (float)i, wm = y - (float)j;
+	float r00 = (float)e1[i * NMU + j], r01 = (float)e1[i * NMU + j + 1];
+	float r10 = (float)e1[(i + 1) * NMU + j], r11 = (float)e1[(i + 1) * NMU + j + 1];
+	float v0 = r00 + (r01 - r00) * wm, v1 = r10 + (r11 - r10) * wm;
+	return v0 + (v1 - v0) * wr;
+}
+
+/* glTF's anisotropic roughness at table node (i, j). */
+static void aniso_node(int i, int j, float *ax, float *ay)
+{
+	float r = (float)i / (AR - 1), st = (float)j / (AS - 1);
+	*ay = fmax(r * r, MIN_ALPHA);
+	*ax = *ay + (1.0f - *ay) * st * st;
 }
 
 /* Rough dielectric (Walter et al. 2007, exact Fresnel): reflection and
@@ -161,6 +271,35 @@ int main(void)
 			goavg[row] = cosine_average(&go[row * GMU], GMU);
 			giavg[row] = cosine_average(&gi[row * GMU], GMU);
 		}
+	static double shr[SR * NMU], sh[SR * NMU], shavg[SR], an[AR * AS * AMU * APHI], anavg[AR * AS];
+	for (int pass = 0; pass < 2; pass++) {
+		sheen_norm = pass ? shr : NULL;
+		for (int i = 0; i < SR; i++) {
+			float r = SHEEN_MIN_R + (1.0f - SHEEN_MIN_R) * i / (SR - 1);
+			for (int j = 0; j < NMU; j++)
+				(pass ? sh : shr)[i * NMU + j] = sheen_albedo(node_mu(j, NMU), r);
+		}
+	}
+	for (int i = 0; i < SR; i++)
+		shavg[i] = cosine_average(&sh[i * NMU], NMU);
+	for (int i = 0; i < AR; i++)
+		for (int j = 0; j < AS; j++) {
+			float ax, ay;
+			aniso_node(i, j, &ax, &ay);
+			float arms = sqrt(0.5f * (ax * ax + ay * ay));
+			double avg = 0;
+			for (int l = 0; l < APHI; l++) {
+				double *row = &an[((i * AS + j) * APHI + l) * AMU];
+				for (int k = 0; k < AMU; k++) {
+					float mu = node_mu(k, AMU);
+					row[k] = aniso_albedo(mu, 0.5f * AJAR_PI * l / (APHI - 1), ax, ay) -
+						 e1_lookup(e1, arms, mu);
+				}
+				/* Piecewise linear in phi: the trapezoid rule is its exact mean. */
+				avg += cosine_average(row, AMU) * (l == 0 || l == APHI - 1 ? 0.5 : 1.0) / (APHI - 1);
+			}
+			anavg[i * AS + j] = avg;
+		}
 	printf("/* bsdf_tables.h — generated by src/tools/bsdf_tables.c (make kernels/material/bsdf_tables.h).\n"
 	       " * Do not edit. GGX directional albedos, row i: r = sqrt(alpha) = i / %d\n"
 	       " * (alpha >= %g), column j: sqrt(mu) = sqrt(cos theta_o) = j / %d. */\n",
@@ -181,6 +320,22 @@ int main(void)
 	print_table("bsdf_tab_goavg", "2 int Go mu dmu per ior and roughness", goavg, GE * GR);
 	print_table("bsdf_tab_giavg", "2 int Gi mu dmu per ior and roughness", giavg, GE * GR);
 	print_table("bsdf_tab_gfavg", "2 int F mu dmu of the exact Fresnel from outside, per ior", gfavg, GE);
+	printf("/* Sheen (KHR_materials_sheen): row i: r = %g + %g i / %d, column j as above. */\n",
+	       (double)SHEEN_MIN_R, 1.0 - (double)SHEEN_MIN_R, SR - 1);
+	printf("#define BSDF_TAB_SR %d\n", SR);
+	print_table("bsdf_tab_sheenr", "Esr(mu, r): the Charlie lobe's albedo with colour 1", shr, SR * NMU);
+	print_table("bsdf_tab_sheen", "Es(mu, r): the albedo of the lobe divided by max(1, Esr) at both ends", sh,
+		    SR * NMU);
+	print_table("bsdf_tab_sheenavg", "2 int Es mu dmu per sheen roughness", shavg, SR);
+	printf("/* Anisotropic GGX: block (i, j): sqrt(alpha_b) = i / %d, s = j / %d, row l: phi = (pi / 2) l / %d,\n"
+	       " * column k: sqrt(mu) = k / %d. */\n",
+	       AR - 1, AS - 1, APHI - 1, AMU - 1);
+	printf("#define BSDF_TAB_AR %d\n#define BSDF_TAB_AS %d\n#define BSDF_TAB_AMU %d\n#define BSDF_TAB_APHI %d\n", AR, AS,
+	       AMU, APHI);
+	printf("#ifndef AJAR_NO_ANISOTROPY\n");
+	print_table("bsdf_tab_aniso", "E1(mu, phi) - E1iso(alpha_rms, mu) of anisotropic GGX", an, AR * AS * AMU * APHI);
+	print_table("bsdf_tab_anisoavg", "its mean over mu (2 int .. mu dmu) and phi per (r, s)", anavg, AR * AS);
+	printf("#endif\n");
 	printf("#endif\n");
 	return 0;
 }
