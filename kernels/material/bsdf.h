@@ -1095,10 +1095,43 @@ INLINE V3 bsdf_eval_core(const Bsdf *bs, V3 wo, V3 wi, int mode, float *pdf_w, f
 	return f;
 }
 
+/* The normal n's frame for direction w, n turned toward ng along their arc
+ * just far enough that w's mirror image lies min(0.9 cos, 0.01) above the
+ * surface where it would not (bsdf_bend_t's rule, for any normal: the
+ * layers' normals, the top). */
+INLINE BsdfFrame bsdf_frame_about(const Bsdf *bs, V3 n, V3 w)
+{
+	BsdfFrame f;
+	float iz = v3_dot(w, bs->ng), sgn = iz < 0.0f ? -1.0f : 1.0f, nz = v3_dot(n, bs->ng);
+	iz *= sgn;
+	float thr = fmin(0.9f * iz, 0.01f);
+	f.n = n;
+	if (sgn * 2.0f * v3_dot(w, n) * nz - iz < thr) {
+		V3 d = v3_madd(n, bs->ng, -nz);
+		float l = v3_len(d), ix;
+		V3 x = l > 0.0f ? v3_scale(d, 1.0f / l) : bs->t;
+		float tn = fast_atan2(l, fmax(nz, 0.0f));
+		ix = sgn * v3_dot(w, x);
+		float a = sqrt(ix * ix + iz * iz), t = 0.0f;
+		if (a > 0.0f) {
+			float c = fmin(thr / a, 1.0f);
+			t = fmin(fmax(0.5f * (fast_atan2(ix, iz) + fast_atan2(sqrt((1.0f - c) * (1.0f + c)), c)), 0.0f), tn);
+		}
+		float st, ct;
+		fast_sincos(t, &st, &ct);
+		f.n = v3_norm(v3_add(v3_scale(x, st), v3_scale(bs->ng, ct)));
+	}
+	v3_basis(f.n, &f.t, &f.b);
+	return f;
+}
+
 /* What the layers are seen from direction w on side `side` of ng: the
- * sheen lobe's albedo (colour 1) and its normaliser N, the clear coat's
- * E1, single-scattering albedo (Fresnel included) and whole albedo Et. */
+ * sheen's and the clear coat's normals for w (bsdf_frame_about: where a
+ * normal map turns them away, as the core's bend), the sheen lobe's albedo
+ * (colour 1) and its normaliser N, the clear coat's E1, single-scattering
+ * albedo (Fresnel included) and whole albedo Et. */
 typedef struct {
+	BsdfFrame fs, fc;
 	float es, ns, e1c, esc, etc;
 } BsdfLayerAt;
 
@@ -1109,13 +1142,17 @@ INLINE BsdfLayerAt bsdf_layer_at(const Bsdf *bs, V3 w, float side)
 	l.ns = 1.0f;
 	l.e1c = 1.0f;
 	l.esc = l.etc = 0.0f;
+	l.fs = l.fc = bsdf_frame_own(bs);
 	if (bs->sheen_c > 0.0f) {
-		BsdfTabAt a = bsdf_sheen_at(bs->sheen_r, side * v3_dot(w, bs->n));
+		if (BSDF_IS_TILTED(bs))
+			l.fs = bsdf_frame_about(bs, bs->n, w);
+		BsdfTabAt a = bsdf_sheen_at(bs->sheen_r, side * v3_dot(w, l.fs.n));
 		l.es = bsdf_tab2(bsdf_tab_sheen, a);
 		l.ns = fmax(bsdf_tab2(bsdf_tab_sheenr, a), 1.0f);
 	}
 	if (bs->cc > 0.0f) {
-		BsdfTabAt a = bsdf_tab_at(bs->cc_alpha, side * v3_dot(w, bs->cc_n));
+		l.fc = bsdf_frame_about(bs, bs->cc_n, w);
+		BsdfTabAt a = bsdf_tab_at(bs->cc_alpha, side * v3_dot(w, l.fc.n));
 		l.e1c = bsdf_tab2(bsdf_tab_e1, a);
 		l.esc = BSDF_CC_F0 * l.e1c + (1.0f - BSDF_CC_F0) * bsdf_tab2(bsdf_tab_ew, a);
 		l.etc = l.esc + bs->cc_fms * (1.0f - l.e1c);
@@ -1184,43 +1221,42 @@ INLINE void bsdf_layer_t(const Bsdf *bs, BsdfLayerAt o, BsdfLayerAt i, float *tg
 	*tsh = ld;
 }
 
-/* The clear coat's frame. */
-INLINE BsdfFrame bsdf_frame_cc(const Bsdf *bs)
-{
-	BsdfFrame f;
-	f.n = bs->cc_n;
-	v3_basis(f.n, &f.t, &f.b);
-	return f;
-}
-
-/* The layers' own lobes for a reflection pair (both on side so): f (the
- * sheen's under the clear coat by tsh; the clear coat's in its normal, so
- * times |wl . cc_n| / |wl . n| as bent lobes are, the top) and, added to
- * *pdf, their densities with p's probabilities. */
+/* The layers' own lobes for a reflection pair (both on side so): f in the
+ * frames of the camera side's direction (lo_at's in radiance mode, li_at's
+ * in importance mode), times |wl . m| / |wl . n| as bent lobes are (the
+ * top), the sheen's under the clear coat by tsh; and, added to *pdf,
+ * their densities from wo (its frames) with p's probabilities. */
 INLINE V3 bsdf_layer_lobes(const Bsdf *bs, V3 wo, V3 wi, float so, BsdfLayerAt lo_at, BsdfLayerAt li_at, float tsh,
 			   int mode, BsdfLayerP p, float *pdf)
 {
 	V3 f = v3(0.0f, 0.0f, 0.0f);
+	int radiance = mode == BSDF_RADIANCE;
+	V3 wl = radiance ? wi : wo;
 	if (bs->sheen_c > 0.0f) {
-		BsdfFrame fr = bsdf_frame_own(bs);
-		V3 lo = bsdf_local(&fr, wo, so), li = bsdf_local(&fr, wi, so);
+		const BsdfFrame *fr = radiance ? &lo_at.fs : &li_at.fs;
+		V3 lo = bsdf_local(fr, wo, so), li = bsdf_local(fr, wi, so);
 		float sh = sheen_f(lo, li, sheen_alpha(bs->sheen_r)) / (lo_at.ns * li_at.ns);
-		f = v3_scale(bs->sheen, tsh * sh);
-		*pdf += p.sh * pdf_cosine_hemisphere_w(li.z);
+		f = v3_scale(bs->sheen, tsh * sh * bsdf_bend_ratio(bs, fr->n, wl));
+		*pdf += p.sh * pdf_cosine_hemisphere_w(so * v3_dot(wi, lo_at.fs.n));
 	}
 	if (bs->cc > 0.0f) {
-		BsdfFrame fr = bsdf_frame_cc(bs);
-		V3 lo = bsdf_local(&fr, wo, so), li = bsdf_local(&fr, wi, so);
+		const BsdfFrame *fr = radiance ? &lo_at.fc : &li_at.fc;
+		V3 lo = bsdf_local(fr, wo, so), li = bsdf_local(fr, wi, so);
+		float a = bs->cc_alpha;
 		if (lo.z > 0.0f && li.z > 0.0f) {
 			V3 h = v3_norm(v3_add(lo, li));
-			float cos_oh = v3_dot(lo, h), a = bs->cc_alpha;
-			float fr0 = BSDF_CC_F0 + (1.0f - BSDF_CC_F0) * bsdf_schlick_w(cos_oh);
+			float fr0 = BSDF_CC_F0 + (1.0f - BSDF_CC_F0) * bsdf_schlick_w(v3_dot(lo, h));
 			float spec = ggx_d(h, a) * ggx_g2(lo, li, a) * fr0 / (4.0f * lo.z * li.z);
 			float ms = bs->cc_fms * bsdf_kc_factor(lo_at.e1c, li_at.e1c, bs->cc_e1avg);
-			float r = bsdf_bend_ratio(bs, bs->cc_n, mode == BSDF_RADIANCE ? wi : wo);
-			float w = bs->cc * (spec + ms) * r;
+			float w = bs->cc * (spec + ms) * bsdf_bend_ratio(bs, fr->n, wl);
 			f = v3_add(f, v3(w, w, w));
-			*pdf += p.ccs * ggx_pdf_visible(lo, h, a) / (4.0f * cos_oh) + p.ccm * pdf_cosine_hemisphere_w(li.z);
+		}
+		lo = bsdf_local(&lo_at.fc, wo, so);
+		li = bsdf_local(&lo_at.fc, wi, so);
+		if (lo.z > 0.0f && li.z > 0.0f) {
+			V3 h = v3_norm(v3_add(lo, li));
+			*pdf += p.ccs * ggx_pdf_visible(lo, h, a) / (4.0f * v3_dot(lo, h)) +
+				p.ccm * pdf_cosine_hemisphere_w(li.z);
 		}
 	}
 	return f;
@@ -1544,21 +1580,20 @@ INLINE int bsdf_sample_layered(const Bsdf *bs, V3 wo, float u0, float u1, float 
 	float so = bsdf_side(bs, wo);
 	if (so == 0.0f)
 		return 0;
-	BsdfLayerP p = bsdf_layer_p(bs, bsdf_layer_at(bs, wo, so));
+	BsdfLayerAt at = bsdf_layer_at(bs, wo, so);
+	BsdfLayerP p = bsdf_layer_p(bs, at);
 	V3 wi;
 	if (u0 < p.ccs + p.ccm) {
-		BsdfFrame fr = bsdf_frame_cc(bs);
-		V3 lo = bsdf_local(&fr, wo, so);
+		V3 lo = bsdf_local(&at.fc, wo, so);
 		if (!(lo.z > 0.0f))
 			return 0;
 		V3 li = u0 < p.ccs ? bsdf_reflect(lo, ggx_sample_visible(lo, bs->cc_alpha, u1, u2))
 				   : sample_cosine_hemisphere(u1, u2);
 		if (!(li.z > 0.0f))
 			return 0;
-		wi = bsdf_world(&fr, li, so);
+		wi = bsdf_world(&at.fc, li, so);
 	} else if (u0 < p.ccs + p.ccm + p.sh) {
-		BsdfFrame fr = bsdf_frame_own(bs);
-		wi = bsdf_world(&fr, sample_cosine_hemisphere(u1, u2), so);
+		wi = bsdf_world(&at.fs, sample_cosine_hemisphere(u1, u2), so);
 	} else {
 		float u = fmin((u0 - (p.ccs + p.ccm + p.sh)) / p.core, 0.99999994f);
 		if (!bsdf_sample_core(bs, wo, u, u1, u2, mode, s, rev))
@@ -1567,7 +1602,7 @@ INLINE int bsdf_sample_layered(const Bsdf *bs, V3 wo, float u0, float u1, float 
 			float si = bsdf_side(bs, s->wi), tg, td, tsh;
 			BsdfLayerAt li = bsdf_layer_at(bs, s->wi, si == 0.0f ? so : si);
 			if (s->delta != BSDF_NULL) {
-				bsdf_layer_t(bs, bsdf_layer_at(bs, wo, so), li, &tg, &td, &tsh);
+				bsdf_layer_t(bs, at, li, &tg, &td, &tsh);
 				s->f = v3_scale(s->f, tg);
 				s->pdf_rev_w *= bsdf_layer_p(bs, li).core;
 			}

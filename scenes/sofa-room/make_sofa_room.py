@@ -1,8 +1,12 @@
 """make_sofa_room.py — writes sofa-room.gltf and sofa-room.bin (python3, no
 dependencies): a room lit by a white sky through a 2 x 1.4 m window, with a
-velvet sofa (KHR_materials_sheen), a varnished floor
-(KHR_materials_clearcoat) and a brushed-steel table (KHR_materials_anisotropy
-along its TANGENT), the materials of issue 44. +Y up, metres.
+velvet sofa (KHR_materials_sheen) on a varnished floor
+(KHR_materials_clearcoat), the materials of issue 44 that Cycles can be
+compared with through Blender's importer. +Y up, metres. With --table, a
+brushed-steel table too (KHR_materials_anisotropy along its TANGENT):
+sofa-room-table.gltf (Blender's importer leaves an anisotropic material
+without a texture on Cycles' default radial tangent, so that one is not
+compared).
 
     python3 scenes/sofa-room/make_sofa_room.py
 """
@@ -101,10 +105,11 @@ def look_at(eye, target):
 	return [x, y, z, w]
 
 
-def main():
+def main(table):
 	W, H, D = 5.0, 2.7, 4.0
 	wx0, wx1, wy0, wy1 = 1.5, 3.5, 0.8, 2.2  # the window in the wall z = 0
 	b = Builder()
+	name = "sofa-room-table" if table else "sofa-room"
 	lambert = {"KHR_materials_specular": {"specularFactor": 0.0}}
 	materials = [
 		{"name": "wall", "pbrMetallicRoughness": {"baseColorFactor": [0.75, 0.75, 0.75, 1], "metallicFactor": 0,
@@ -134,26 +139,28 @@ def main():
 	sofa = (box(1.8, 4.0, 0.05, 0.45, 3.05, 3.95, True) + box(1.8, 4.0, 0.45, 0.95, 3.7, 3.95) +
 		box(1.8, 2.05, 0.45, 0.7, 3.05, 3.7) + box(3.75, 4.0, 0.45, 0.7, 3.05, 3.7))
 	b.mesh("sofa", sofa, 2)
-	b.mesh("table", box(2.3, 3.5, 0.0, 0.35, 1.9, 2.5), 3, tangent=(1.0, 0.0, 0.0))
+	if table:
+		b.mesh("table", box(2.3, 3.5, 0.0, 0.35, 1.9, 2.5), 3, tangent=(1.0, 0.0, 0.0))
 	b.mesh("window_portal", [[(wx0, wy0, 0), (wx1, wy0, 0), (wx1, wy1, 0), (wx0, wy1, 0)]], None, portal=True)
 	eye, target = (0.7, 1.55, 0.5), (3.0, 0.55, 3.4)
 	b.nodes.append({"name": "camera", "camera": 0, "translation": list(eye), "rotation": look_at(eye, target)})
 	g = {"asset": {"version": "2.0", "generator": "scenes/sofa-room/make_sofa_room.py"},
-	     "extensionsUsed": ["KHR_materials_specular", "KHR_materials_clearcoat", "KHR_materials_sheen",
-				"KHR_materials_anisotropy"],
+	     "extensionsUsed": ["KHR_materials_specular", "KHR_materials_clearcoat", "KHR_materials_sheen"] +
+			       (["KHR_materials_anisotropy"] if table else []),
 	     "scene": 0,
 	     "scenes": [{"nodes": list(range(len(b.nodes))), "extras": {"environment": {"color": [1.0, 1.0, 1.0]}}}],
-	     "nodes": b.nodes, "meshes": b.meshes, "materials": materials,
+	     "nodes": b.nodes, "meshes": b.meshes, "materials": materials if table else materials[:3],
 	     "cameras": [{"type": "perspective", "perspective": {"yfov": 0.9, "aspectRatio": 16 / 9, "znear": 0.05,
 								   "zfar": 100}, "extras": {"resolution": [192, 108]}}],
-	     "buffers": [{"uri": "sofa-room.bin", "byteLength": len(b.blob)}], "bufferViews": b.views,
+	     "buffers": [{"uri": name + ".bin", "byteLength": len(b.blob)}], "bufferViews": b.views,
 	     "accessors": b.accessors}
-	with open(os.path.join(HERE, "sofa-room.bin"), "wb") as f:
+	with open(os.path.join(HERE, name + ".bin"), "wb") as f:
 		f.write(bytes(b.blob))
-	with open(os.path.join(HERE, "sofa-room.gltf"), "w") as f:
+	with open(os.path.join(HERE, name + ".gltf"), "w") as f:
 		json.dump(g, f, indent=1)
 		f.write("\n")
 
 
 if __name__ == "__main__":
-	main()
+	main(False)
+	main(True)

@@ -309,7 +309,7 @@ def main():
 					if p.returncode != 0:
 						raise SystemExit(f"assets: cycles failed on {path}: {(p.stderr or p.stdout)[-800:]}")
 					rgb = np.load(out + ".npy").astype(np.float64)
-					os.remove(out + ".npy")
+					# kept: build/peers/assets/<name>-cycles-<seed>.npy, for a closer look
 				imgs[r].append(rgb)
 		a = (imgs["ajar"][0] + imgs["ajar"][1]) / 2
 		c = (imgs["cycles"][0] + imgs["cycles"][1]) / 2
