@@ -106,8 +106,9 @@
  * Layers (BSDF_LAYERED; KHR_materials_sheen and _clearcoat, glTF's order:
  * the clear coat over the sheen over all of the above, "the core"):
  *   f = cc fc + Ld fsheen + Tg fg + Td fd,
- * fc the clear coat (a GGX dielectric at ior 1.5 with Schlick's Fresnel,
- * in its own normal, with its Kulla-Conty lobe as the plastic's coat),
+ * fc the clear coat (a GGX dielectric at ior 1.5 with the exact Fresnel, as
+ * Blender's coat: Schlick's is a fifth low at cos 0.55; in its own normal,
+ * with its Kulla-Conty lobe as the plastic's coat),
  * fsheen the Charlie sheen times its colour, divided by N(mu_o) N(mu_i)
  * (N = max(1, its tabulated albedo): the fitted lobe reflects more than it
  * receives near grazing below sheen roughness 0.5), fg the core's
@@ -149,7 +150,7 @@
 #define BSDF_ANISO (1 << 27)   /* in Bsdf.flags: anisotropic metal and coat */
 #define BSDF_TINT (1 << 26)    /* in Bsdf.flags: the coat's F0 tinted per channel */
 #define BSDF_TILT_COS 0.99999f /* n . ng below this counts as tilted */
-#define BSDF_CC_F0 0.04f       /* the clear coat's F0: ior 1.5, as KHR_materials_clearcoat fixes it */
+#define BSDF_CC_IOR 1.5f       /* the clear coat's ior, as KHR_materials_clearcoat fixes it */
 /* Scenes without sheen, clear coats or specular colours are built with
  * AJAR_NO_LAYERS, without anisotropy with AJAR_NO_ANISOTROPY
  * (src/prepare/prepare.c, kernel_omit): their code and Bsdf fields are
@@ -174,6 +175,15 @@
 #else
 #define BSDF_IS_TILTED(bs) ((bs)->flags & BSDF_TILTED)
 #endif
+
+/* Selection probabilities of the seven sampled lobes for one outgoing
+ * direction (ms: the metal's and the coat's multiple scattering, both
+ * cosine-shaped in the glossy normal; glass_r, glass_t: the glass's), and
+ * the albedos at it that bsdf_eval_local reuses. */
+typedef struct {
+	float metal, coat, diffuse, glass, ms, glass_r, glass_t;
+	float e_metal, e_coat, e_coat1, e_glass; /* E1 at alpha, Es, E1 at the coat's alpha, Go or Gi */
+} BsdfLobes;
 
 typedef struct {
 	V3 t, b, n;      /* shading frame, n on the side of ng */
@@ -207,6 +217,11 @@ typedef struct {
 	V3 cc_n;
 	V3 tint_s1, tint_fms, tint_eavg;
 #endif
+	/* The lobe probabilities for one outgoing direction, the vertex's own
+	 * (bsdf_cache_wo): connections evaluate a vertex's BSDF many times from
+	 * it (bsdf_lobes). Its local coordinates and eta are the key. */
+	float lc_x, lc_y, lc_z, lc_eta;
+	BsdfLobes lc;
 #ifndef AJAR_NO_ANISOTROPY
 	/* Anisotropic GGX: alpha along t and b, alpha_rms, the azimuth warp
 	 * and where (r, s) falls in the anisotropic table (bsdf_aniso_e1). */
@@ -223,15 +238,6 @@ typedef struct {
 	float pdf_rev_w; /* density of wo given wi (lobe probability for delta) */
 	int delta;
 } BsdfSample;
-
-/* Selection probabilities of the seven sampled lobes for one outgoing
- * direction (ms: the metal's and the coat's multiple scattering, both
- * cosine-shaped in the glossy normal; glass_r, glass_t: the glass's), and
- * the albedos at it that bsdf_eval_local reuses. */
-typedef struct {
-	float metal, coat, diffuse, glass, ms, glass_r, glass_t;
-	float e_metal, e_coat, e_coat1, e_glass; /* E1 at alpha, Es, E1 at the coat's alpha, Go or Gi */
-} BsdfLobes;
 
 /* Where (alpha, mu) falls in bsdf_tables.h's grid: the lower row and column
  * and the weights of the upper ones. */
@@ -359,6 +365,7 @@ INLINE void bsdf_setup_mr(Bsdf *bs, GLOBAL const Material *m, V3 base_color, flo
 #ifndef AJAR_NO_BENT_NORMALS
 	bs->flags |= fabs(cn) < BSDF_TILT_COS ? BSDF_TILTED : 0;
 #endif
+	bs->lc_z = -1.0f; /* no cached lobes: a local wo has z > 0 */
 	bsdf_setup_energy(bs);
 }
 
@@ -525,12 +532,16 @@ INLINE void bsdf_setup_layers(Bsdf *bs, V3 sheen, float sheen_r, float cc, float
 		bs->cc_n = bs->n;
 	if (v3_dot(bs->cc_n, bs->ng) < 0.0f)
 		bs->cc_n = v3_neg(bs->cc_n);
-	if (bs->cc > 0.0f) {
+	if (bs->cc > 0.0f) { /* Kulla-Conty with the exact Fresnel's mean at ior 1.5 (the glass tables' node) */
 		BsdfTabAt a = bsdf_tab_at(bs->cc_alpha, 1.0f);
-		float e1 = bsdf_tab1(bsdf_tab_e1avg, a), fa = BSDF_CC_F0 + (1.0f - BSDF_CC_F0) * (1.0f / 21.0f);
+		float e1 = bsdf_tab1(bsdf_tab_e1avg, a), x = sqrt(bsdf_clamp01(bs->cc_alpha)) * (BSDF_TAB_CR - 1);
+		float q = (BSDF_CC_IOR - 1.0f) / (BSDF_CC_IOR + 1.0f) * ((BSDF_TAB_GE - 1) / BSDF_TAB_GT_MAX);
+		int k = min((int)q, BSDF_TAB_GE - 2), i = min((int)x, BSDF_TAB_CR - 2);
+		float fa = bsdf_tab_gfavg[k] + (bsdf_tab_gfavg[k + 1] - bsdf_tab_gfavg[k]) * bsdf_clamp01(q - (float)k);
 		bs->cc_e1avg = e1;
 		bs->cc_fms = fa * fa * e1 / (1.0f - fa * (1.0f - e1));
-		bs->cc_eavg = BSDF_CC_F0 * e1 + (1.0f - BSDF_CC_F0) * bsdf_tab1(bsdf_tab_ewavg, a) + bs->cc_fms * (1.0f - e1);
+		bs->cc_eavg = bsdf_tab_eccavg[i] + (bsdf_tab_eccavg[i + 1] - bsdf_tab_eccavg[i]) * (x - (float)i) +
+			      bs->cc_fms * (1.0f - e1);
 	}
 	if (bs->sheen_c > 0.0f || bs->cc > 0.0f)
 		bs->flags |= BSDF_LAYERED; /* BSDF_LAMBERT still says what the core is */
@@ -671,7 +682,7 @@ INLINE int bsdf_lambert(const Bsdf *bs) { return bs->flags & BSDF_LAMBERT; /* se
 
 /* Lobe selection for local outgoing wo (wo.z > 0) on the side of relative
  * ior eta: weight x albedo estimate. */
-INLINE BsdfLobes bsdf_lobes(const Bsdf *bs, V3 wo, float eta)
+INLINE BsdfLobes bsdf_lobes_calc(const Bsdf *bs, V3 wo, float eta)
 {
 	float cos_o = wo.z;
 	BsdfLobes p;
@@ -716,6 +727,17 @@ INLINE BsdfLobes bsdf_lobes(const Bsdf *bs, V3 wo, float eta)
 	p.glass_r *= inv;
 	p.glass_t *= inv;
 	return p;
+}
+
+/* bsdf_lobes_calc, or the same values cached for that (wo, eta) by
+ * bsdf_cache_wo: the living-room's portal render evaluated 208,789 lobes
+ * for 53,524 hits, a vertex many times from its own wo (kernels/material/
+ * README.md, "Cost"). Equal keys give equal bits. */
+INLINE BsdfLobes bsdf_lobes(const Bsdf *bs, V3 wo, float eta)
+{
+	if (wo.z == bs->lc_z && wo.x == bs->lc_x && wo.y == bs->lc_y && eta == bs->lc_eta && !bsdf_lambert(bs))
+		return bs->lc;
+	return bsdf_lobes_calc(bs, wo, eta);
 }
 
 /* A shading frame: the Bsdf's own, or a bent one (bsdf_bend_t). */
@@ -1095,6 +1117,18 @@ INLINE V3 bsdf_eval_core(const Bsdf *bs, V3 wo, V3 wi, int mode, float *pdf_w, f
 	return f;
 }
 
+/* The clear coat's single-scattering albedo at mu (Fresnel at ior 1.5
+ * included), bilinear in its table (bsdf_tables.h). */
+INLINE float bsdf_cc_albedo(const Bsdf *bs, float mu)
+{
+	float x = sqrt(bsdf_clamp01(bs->cc_alpha)) * (BSDF_TAB_CR - 1), y = sqrt(bsdf_clamp01(mu)) * (BSDF_TAB_CMU - 1);
+	int i = min((int)x, BSDF_TAB_CR - 2), j = min((int)y, BSDF_TAB_CMU - 2);
+	float wr = x - (float)i, wm = y - (float)j;
+	CONSTANT float *r0 = bsdf_tab_ecc + i * BSDF_TAB_CMU + j, *r1 = r0 + BSDF_TAB_CMU;
+	float v0 = r0[0] + (r0[1] - r0[0]) * wm, v1 = r1[0] + (r1[1] - r1[0]) * wm;
+	return v0 + (v1 - v0) * wr;
+}
+
 /* The normal n's frame for direction w, n turned toward ng along their arc
  * just far enough that w's mirror image lies min(0.9 cos, 0.01) above the
  * surface where it would not (bsdf_bend_t's rule, for any normal: the
@@ -1154,7 +1188,7 @@ INLINE BsdfLayerAt bsdf_layer_at(const Bsdf *bs, V3 w, float side)
 		l.fc = bsdf_frame_about(bs, bs->cc_n, w);
 		BsdfTabAt a = bsdf_tab_at(bs->cc_alpha, side * v3_dot(w, l.fc.n));
 		l.e1c = bsdf_tab2(bsdf_tab_e1, a);
-		l.esc = BSDF_CC_F0 * l.e1c + (1.0f - BSDF_CC_F0) * bsdf_tab2(bsdf_tab_ew, a);
+		l.esc = bsdf_cc_albedo(bs, side * v3_dot(w, l.fc.n));
 		l.etc = l.esc + bs->cc_fms * (1.0f - l.e1c);
 	}
 	return l;
@@ -1245,7 +1279,7 @@ INLINE V3 bsdf_layer_lobes(const Bsdf *bs, V3 wo, V3 wi, float so, BsdfLayerAt l
 		float a = bs->cc_alpha;
 		if (lo.z > 0.0f && li.z > 0.0f) {
 			V3 h = v3_norm(v3_add(lo, li));
-			float fr0 = BSDF_CC_F0 + (1.0f - BSDF_CC_F0) * bsdf_schlick_w(v3_dot(lo, h));
+			float fr0 = bsdf_fresnel_dielectric(v3_dot(lo, h), BSDF_CC_IOR);
 			float spec = ggx_d(h, a) * ggx_g2(lo, li, a) * fr0 / (4.0f * lo.z * li.z);
 			float ms = bs->cc_fms * bsdf_kc_factor(lo_at.e1c, li_at.e1c, bs->cc_e1avg);
 			float w = bs->cc * (spec + ms) * bsdf_bend_ratio(bs, fr->n, wl);
@@ -1343,6 +1377,27 @@ INLINE BsdfFrame bsdf_frame_for(const Bsdf *bs, V3 wo, int *bent)
 	float tn = bsdf_tilt(bs, &x), t = bsdf_bend_t(bs, x, tn, wo);
 	*bent = t != tn;
 	return bsdf_frame_t(bs, x, tn, t);
+}
+
+/* Keeps the lobes for world direction wo in bs (bsdf_lobes): the vertex's
+ * own direction toward its predecessor, from which it is sampled and
+ * connected. */
+INLINE void bsdf_cache_wo(Bsdf *bs, V3 wo)
+{
+	float so = bsdf_side(bs, wo);
+	int bent;
+	if (bsdf_lambert(bs) || so == 0.0f)
+		return;
+	BsdfFrame fr = bsdf_frame_for(bs, wo, &bent);
+	V3 lo = bsdf_local(&fr, wo, so);
+	if (!(lo.z > 0.0f))
+		return;
+	float eta = bsdf_eta(bs, so);
+	bs->lc = bsdf_lobes_calc(bs, lo, eta);
+	bs->lc_x = lo.x;
+	bs->lc_y = lo.y;
+	bs->lc_z = lo.z;
+	bs->lc_eta = eta;
 }
 
 /* Only the solid-angle density of sampling wi given wo (non-delta lobes):

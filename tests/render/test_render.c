@@ -398,6 +398,11 @@ static void test_kernel_features(void **state)
 	assert_int_equal(nmap & (KERNEL_OMIT_BENT_NORMALS | KERNEL_OMIT_TEXTURES | KERNEL_OMIT_TRI_EXTRA), 0);
 	unsigned colour = scene_omit(SCENE("khronos/VertexColorTest/VertexColorTest.gltf"));
 	assert_int_equal(colour & KERNEL_OMIT_TRI_EXTRA, 0);
+	/* Layers and anisotropy keep their code where a material has them. */
+	assert_int_equal(scene_omit(SCENE("sofa-room/sofa-room.gltf")) & (KERNEL_OMIT_LAYERS | KERNEL_OMIT_ANISOTROPY),
+			 KERNEL_OMIT_ANISOTROPY);
+	assert_int_equal(scene_omit(SCENE("sofa-room/sofa-room-table.gltf")) & (KERNEL_OMIT_LAYERS | KERNEL_OMIT_ANISOTROPY),
+			 0);
 
 	ajar_scene *s;
 	assert_int_equal(ajar_scene_load(SCENE("cornell/cornell.gltf"), &s), AJAR_OK);
