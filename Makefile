@@ -73,7 +73,7 @@ DEPS_test_exr := $(call obj,core/error image/exr image/exr_read image/png)
 DEPS_test_confine := $(SCENE_DEPS) $(call obj,image/png)
 # The kernels' integrators run on the host (tests/support/kernel_host.c) on
 # scenes as prepare_scene makes them; the MIS tests add the oracle.
-HOST_DEPS := $(BUILD)/tests/kernel_host.o $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_read image/hdr prepare/bvh_build prepare/light_tables prepare/prepare prepare/policy prepare/portal_flux prepare/sky_tables render/render_options)
+HOST_DEPS := $(BUILD)/tests/kernel_host.o $(call obj,core/error scene/scene scene/scene_api scene/gltf scene/tangents image/exr image/exr_read image/hdr prepare/bvh_build prepare/light_tables prepare/prepare prepare/policy prepare/portal_flux prepare/sky_tables prepare/portal_find prepare/found_portals render/render_options)
 DEPS_test_bdpt := $(BUILD)/tests/mis_oracle.o $(HOST_DEPS)
 DEPS_test_punctual := $(HOST_DEPS)
 PORTAL_DEPS := $(BUILD)/tests/portal_scenes.o $(HOST_DEPS)
@@ -81,6 +81,8 @@ DEPS_test_portal_mis := $(BUILD)/tests/mis_oracle.o $(PORTAL_DEPS)
 DEPS_test_portal_groups := $(PORTAL_DEPS)
 DEPS_test_portal_sampling := $(PORTAL_DEPS)
 DEPS_test_portal_policy := $(PORTAL_DEPS)
+# The portal search on the host: scenes, the BVH, prepare_scene for the portals a render takes.
+DEPS_test_portal_find := $(HOST_DEPS)
 # Tests that render need the whole library.
 DEPS_test_layout := $(BUILD)/libajar.a
 DEPS_test_render := $(BUILD)/libajar.a
@@ -94,9 +96,12 @@ DEPS_test_checkpoint := $(BUILD)/libajar.a
 DEPS_test_aov := $(BUILD)/libajar.a
 DEPS_test_subpaths := $(BUILD)/libajar.a
 DEPS_test_mpi := $(BUILD)/libajar.a
+DEPS_test_found_portals := $(BUILD)/libajar.a
+DEPS_test_cli_scene := $(BUILD)/libajar.a
+DEPS_test_noise := $(BUILD)/libajar.a
 DEPS_test_glass := $(BUILD)/libajar.a
 
-.PHONY: FORCE all lib cli tests test test-unit asan demo bench bench-peers install uninstall clean deps help
+.PHONY: FORCE all lib cli tests test test-unit asan demo bench bench-portals bench-peers install uninstall clean deps help
 all: lib cli
 
 help:
@@ -104,6 +109,7 @@ help:
 	@echo "make test       install missing packages, build and run every test (cmocka)"
 	@echo "make asan       host unit tests under AddressSanitizer + UBSan"
 	@echo "make bench      BVH, traversal, samples/s, start-up figures"
+	@echo "make bench-portals  found portals vs marked ones at equal time, every portal scene"
 	@echo "make bench-peers  Cycles, Mitsuba 3, LuxCore vs Ajar at equal time (installs them; slow)"
 	@echo "make install    PREFIX=$(PREFIX): ajar, libajar.{a,so}, ajar.h, ajar.pc"
 	@echo "make all        library and CLI (MODE=release|debug|asan, V=1 for commands)"
@@ -225,6 +231,10 @@ $(BUILD)/tests/bench: $(BUILD)/tests/bench.o $(BUILD)/tests/testutil.o $(BUILD)/
 	@echo "  LD      $@"
 	$(Q)$(CXX) $(LDFLAGS) -o $@ $^ $(LDLIBS) -lcmocka
 
+$(BUILD)/tests/bench_portals: $(BUILD)/tests/bench_portals.o $(BUILD)/libajar.a
+	@echo "  LD      $@"
+	$(Q)$(CXX) $(LDFLAGS) -o $@ $^ $(LDLIBS)
+
 tests: $(TESTS:%=$(BUILD)/tests/%) build/ajar $(BUILD)/tests/ajar_faults
 
 test:
@@ -254,6 +264,12 @@ bench:
 	$(Q)$(MAKE) --no-print-directory deps
 	$(Q)$(MAKE) --no-print-directory all $(BUILD)/tests/bench
 	$(BUILD)/tests/bench
+
+# Found portals against marked ones at equal time (tests/bench/bench_portals.c).
+bench-portals:
+	$(Q)$(MAKE) --no-print-directory deps
+	$(Q)$(MAKE) --no-print-directory all $(BUILD)/tests/bench_portals
+	$(BUILD)/tests/bench_portals
 
 # The shared library is installed under its full version with the soname
 # (libajar.so.0, as the link rule sets it) and the development name as links.

@@ -162,6 +162,24 @@ typedef struct {
 } ajar_scene_info;
 ajar_status ajar_scene_info_get(const ajar_scene *s, ajar_scene_info *info);
 
+/* A portal found without markup: a rectangle over an opening (a window, a
+ * door ajar, a roof opening) through which light from outside the camera's
+ * space (a sky, a sun, emitters or lamps beyond it) reaches it. */
+typedef struct {
+	float center[3];
+	float normal[3];            /* unit, facing into the camera's space */
+	float half_u[3], half_v[3]; /* half sides: corners center +- half_u +- half_v */
+	float width, height;        /* 2 |half_u|, 2 |half_v| */
+	float share;                /* its share of the light-carrying rays the search found */
+} ajar_portal;
+/* Searches the scene's openings from its camera, as a render does where
+ * the scene marks no portals (ajar_options.portals): the same scene gives
+ * the same portals. Up to `capacity` of them, largest share first, go to
+ * out; *count gets how many were found, *seconds (may be NULL) the
+ * search's time. Marked portals are not listed. */
+ajar_status ajar_scene_find_portals(const ajar_scene *s, ajar_portal *out, uint32_t capacity, uint32_t *count,
+				    double *seconds);
+
 /* ---- Render options ---------------------------------------------------- */
 
 typedef enum { AJAR_INTEGRATOR_PT = 0, AJAR_INTEGRATOR_BDPT = 1, AJAR_INTEGRATOR_PORTAL = 2 } ajar_integrator;
@@ -169,6 +187,14 @@ typedef enum { AJAR_INTEGRATOR_PT = 0, AJAR_INTEGRATOR_BDPT = 1, AJAR_INTEGRATOR
  * the balance heuristic where a sky image's sun shining in through the
  * portals is the only light, the power heuristic elsewhere. */
 typedef enum { AJAR_MIS_POWER = 0, AJAR_MIS_BALANCE = 1, AJAR_MIS_AUTO = 2 } ajar_mis;
+/* Which portals a render samples through. A portal only steers samples:
+ * every choice gives the same image on average, with more or less noise. */
+typedef enum {
+	AJAR_PORTALS_DEFAULT = 0, /* the scene's marked portals if it marks any, else found ones */
+	AJAR_PORTALS_MARKED = 1,  /* the marked ones only (none where none is marked) */
+	AJAR_PORTALS_FOUND = 2,   /* found ones (ajar_scene_find_portals); marked ones are ignored */
+	AJAR_PORTALS_NONE = 3     /* none */
+} ajar_portals;
 /* Longest path (segments) the bidirectional integrators take. */
 #define AJAR_BIDIR_MAX_DEPTH 32
 
@@ -185,13 +211,16 @@ typedef enum { AJAR_MIS_POWER = 0, AJAR_MIS_BALANCE = 1, AJAR_MIS_AUTO = 2 } aja
 
 typedef struct {
 	uint32_t width, height;  /* 0: scene's suggestion, else 512 x 512/aspect */
-	uint32_t spp;            /* samples per pixel; 0 = until time_limit */
+	uint32_t spp;            /* samples per pixel; 0 = until time_limit or noise */
 	double time_limit;       /* seconds; 0 = none */
+	double noise;            /* stop once the image's estimated relative error (ajar_renderer_noise)
+				  * is below this, e.g. 0.05 for 5%; spp and time_limit bound it; 0 = none */
 	ajar_integrator integrator;
 	uint32_t max_depth;      /* maximum path segments (camera segment included) */
 	uint32_t min_depth;      /* paths of fewer segments are left out (0: none) */
 	uint32_t seed;
 	ajar_mis mis;            /* bidirectional integrators' MIS heuristic */
+	ajar_portals portals;    /* which portals: marked, found or none (default: marked, else found) */
 	uint32_t strategy_len;   /* bdpt, portal: keep one image per strategy for paths
 				  * of up to this many segments (1..8), 0 = none */
 	int strategy_unweighted; /* those images without MIS weights */
@@ -212,6 +241,8 @@ typedef struct {
 	double samples_per_second; /* pixel samples per second */
 	double eta;              /* seconds, < 0 if unknown */
 	double fraction;         /* 0..1 */
+	double noise;            /* with ajar_options.noise: the image's estimated relative
+				  * error (ajar_renderer_noise), < 0 until known */
 } ajar_progress;
 /* Called after each pass; return non-zero to stop after that pass. */
 typedef int (*ajar_progress_fn)(const ajar_progress *p, void *user);
@@ -234,6 +265,13 @@ void ajar_renderer_cancel(ajar_renderer *r);
  * estimates cost no set-up. Not while a render runs. */
 ajar_status ajar_renderer_restart(ajar_renderer *r, uint32_t seed);
 uint32_t ajar_renderer_spp(const ajar_renderer *r);
+/* With ajar_options.noise, the image's estimated relative error when it was
+ * last estimated (< 0 before): sqrt of the mean over pixels and channels of
+ * var(I) / (I^2 + (0.1 mean I)^2), var(I) from the difference of two
+ * disjoint halves of the samples (src/render/README.md, "Stopping at a
+ * noise level"); light-traced splats included, the same for every
+ * integrator. */
+double ajar_renderer_noise(const ajar_renderer *r);
 /* The current estimate: width * height RGBA floats, row-major, top row first.
  * Not while ajar_renderer_render runs (call it before or after). */
 ajar_status ajar_renderer_image(ajar_renderer *r, float *rgba, uint32_t *width, uint32_t *height);
@@ -251,6 +289,12 @@ ajar_status ajar_renderer_aovs(ajar_renderer *r, float *px);
 ajar_status ajar_renderer_write_strategies(ajar_renderer *r, const char *path);
 /* The device(s) used, for reports. */
 const char *ajar_renderer_device_name(const ajar_renderer *r);
+/* The portals the renderer found over the scene's openings
+ * (ajar_options.portals): up to `capacity` into out, *count how many (0
+ * where it samples through marked portals or none), *seconds (may be
+ * NULL) the search's time. */
+ajar_status ajar_renderer_found_portals(const ajar_renderer *r, ajar_portal *out, uint32_t capacity, uint32_t *count,
+					double *seconds);
 
 /* Per-device figures of a renderer with several devices (ajar_options.device
  * "all" or a comma-separated list), for progress reports. Safe to call during

@@ -73,17 +73,23 @@ INLINE V3 segment_transmittance(const SceneView *sc, V3 a, V3 na, V3 b, V3 nb)
 	return ray_transmittance(sc, o, v3_scale(od, 1.0f / len), len * (1.0f - 1e-4f));
 }
 
-/* Beer-Lambert over a segment of length `dist` leaving a surface of
- * `material` (geometric normal ng, front outward) along d: inside the
- * solid when the material has a volume and d enters its back side. */
+/* Whether a segment leaving a surface of `material` (geometric normal ng,
+ * front outward) along d runs inside an absorbing solid: the material has
+ * a volume that absorbs and d enters its back side. */
+INLINE int volume_inside(const SceneView *sc, int material, V3 ng, V3 d)
+{
+	if (material < 0)
+		return 0;
+	GLOBAL const Material *m = &sc->materials[material];
+	return (m->flags & MATERIAL_VOLUME) && !v3_is_zero(m->sigma) && v3_dot(d, ng) < 0.0f;
+}
+
+/* Beer-Lambert over such a segment of length `dist` (1 outside a solid). */
 INLINE V3 volume_attenuation(const SceneView *sc, int material, V3 ng, V3 d, float dist)
 {
-	V3 one = v3(1.0f, 1.0f, 1.0f);
-	if (material < 0)
-		return one;
-	GLOBAL const Material *m = &sc->materials[material];
-	if (!(m->flags & MATERIAL_VOLUME) || v3_is_zero(m->sigma) || !(v3_dot(d, ng) < 0.0f))
-		return one;
-	return v3(fast_exp(-m->sigma.x * dist), fast_exp(-m->sigma.y * dist), fast_exp(-m->sigma.z * dist));
+	if (!volume_inside(sc, material, ng, d))
+		return v3(1.0f, 1.0f, 1.0f);
+	V3 s = sc->materials[material].sigma;
+	return v3(fast_exp(-s.x * dist), fast_exp(-s.y * dist), fast_exp(-s.z * dist));
 }
 #endif

@@ -276,7 +276,7 @@ INLINE V3 bdpt_absorption(const SceneView *sc, const PathVertex *a, const PathVe
 {
 	V3 d = v3_sub(b->p, a->p);
 	float len = v3_len(d);
-	if (a->type == VERTEX_SURFACE && volume_attenuation(sc, a->material, a->ng, d, 1.0f).x < 1.0f)
+	if (a->type == VERTEX_SURFACE && volume_inside(sc, a->material, a->ng, d))
 		return volume_attenuation(sc, a->material, a->ng, d, len);
 	if (b->type == VERTEX_SURFACE)
 		return volume_attenuation(sc, b->material, b->ng, v3_neg(d), len);

@@ -18,6 +18,23 @@ enum {
 	EXIT_NO_MEMORY = 6
 };
 
+/* What the command line changes in a scene before it renders or is
+ * described: the sky and a sun (exporters write none), and which portals
+ * (--portals; in RenderArgs.opt for a render). */
+typedef struct {
+	const char *sky;          /* --sky FILE.exr|.hdr, or NULL */
+	int sky_color_given;      /* --sky-color R,G,B */
+	float sky_color[3];
+	int sky_strength_given;   /* --sky-strength S */
+	float sky_strength;
+	int sky_rotation_given;   /* --sky-rotation DEG */
+	float sky_rotation;
+	int sun_given;            /* --sun ELEVATION,AZIMUTH,LUX */
+	float sun[3];
+	ajar_portals portals;     /* --portals */
+	const char *portals_out;  /* --portals-out FILE.gltf, or NULL */
+} SceneArgs;
+
 typedef struct {
 	const char *scene;
 	const char *exr;   /* -o */
@@ -32,7 +49,17 @@ typedef struct {
 	double checkpoint_every; /* --checkpoint-every SECONDS (default 60) */
 	const char *resume;      /* --resume FILE, or NULL */
 	unsigned given;          /* GIVEN_* bits: options set on the command line */
+	SceneArgs sc;            /* --sky, --sun, --portals, --portals-out (portals also in opt) */
 } RenderArgs;
+
+/* `ajar info`'s arguments. */
+typedef struct {
+	const char *scene;
+	int allow_outside_files;
+	int help;
+	int search;              /* --portals auto: search even where portals are marked */
+	SceneArgs sc;
+} InfoArgs;
 
 /* Options a resumed render takes from its checkpoint (RenderArgs.given). */
 enum {
@@ -46,12 +73,20 @@ enum {
 	GIVEN_UNWEIGHTED = 1 << 7,
 	GIVEN_SPP = 1 << 8,
 	GIVEN_TIME = 1 << 9,
-	GIVEN_AOV = 1 << 10
+	GIVEN_AOV = 1 << 10,
+	GIVEN_PORTALS = 1 << 11,
+	GIVEN_NOISE = 1 << 12
 };
 
 /* Parses the arguments after `render`. Returns EXIT_OK or EXIT_USAGE
  * (after printing the error). */
 int args_parse_render(int argc, char **argv, RenderArgs *a);
+
+/* Parses the arguments after `info`. Returns EXIT_OK or EXIT_USAGE. */
+int args_parse_info(int argc, char **argv, InfoArgs *a);
+
+/* --portals' names: marked, auto, none (and default). */
+const char *args_portals_name(ajar_portals p);
 
 /* Prints a usage error (printf-style) and returns EXIT_USAGE. */
 int args_usage_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));

@@ -22,6 +22,7 @@
 #include "ajar.h"
 #include "cli/args.h"
 #include "cli/commands.h"
+#include "cli/portals_gltf.h"
 #include "cli/progress.h"
 
 /* Under mpirun (ajar_mpi_init): "ajar: " on rank 0, "ajar: rank N (host): "
@@ -39,7 +40,8 @@ static const char usage_main[] =
 	"\n"
 	"commands:\n"
 	"  render SCENE -o OUT.exr [options]  render a .gltf/.glb scene to OpenEXR (see 'ajar render --help')\n"
-	"  info SCENE                         what the scene holds: triangles, lights, portals, camera\n"
+	"  info SCENE [options]               what the scene holds: triangles, lights, portals (marked\n"
+	"                                     and found), camera (see 'ajar info --help')\n"
 	"  devices                            list OpenCL devices and how to select one\n"
 	"  help [render]                      this text, or the render options\n"
 	"  --version                          print the version\n"
@@ -59,9 +61,14 @@ static const char usage_render[] =
 	"\n"
 	"  -o, --output OUT.exr   linear HDR result (float RGBA, ZIP); the header records\n"
 	"                         the samples per pixel done as \"ajar:spp\"\n"
-	"  --spp N                samples per pixel (default 64 unless --time is given)\n"
+	"  --spp N                samples per pixel (default 64 unless --time or --noise\n"
+	"                         is given)\n"
 	"  --time SECONDS         render until this time has passed (with --spp: whichever\n"
 	"                         comes first)\n"
+	"  --noise PCT            render until the image's estimated relative error is\n"
+	"                         below PCT percent (--spp and --time bound it); the\n"
+	"                         estimate, from two halves of the samples, shows in\n"
+	"                         the progress\n"
 	"  --size WxH             image size (default: the scene's suggestion, else 512 wide)\n"
 	"  --integrator NAME      pt (default): path tracing; bdpt: bidirectional path\n"
 	"                         tracing; portal: bdpt plus intermediate subpaths\n"
@@ -89,10 +96,24 @@ static const char usage_render[] =
 	"                         --checkpoint-every SECONDS (default 60), when a device\n"
 	"                         fails and when the render stops (also on Ctrl-C)\n"
 	"  --resume FILE          continue the render FILE holds (with its options; only\n"
-	"                         --spp, --time and --device may change, to extend it); the\n"
+	"                         --spp, --time, --noise and --device may change); the\n"
 	"                         result equals an uninterrupted render bit for bit. FILE\n"
 	"                         is updated as the render goes on unless --checkpoint\n"
 	"                         names another\n"
+	"  --portals WHICH        the portals to sample through: marked (the scene's),\n"
+	"                         auto (found over the openings from the camera, the\n"
+	"                         marked ones ignored) or none; default: the marked\n"
+	"                         ones if the scene marks any, else found ones\n"
+	"  --portals-out FILE.gltf  write the found portals as translucent red quads\n"
+	"                         (extras \"portal\": true) to view over the scene\n"
+	"  --sky FILE.exr|.hdr    an equirectangular sky in place of the scene's\n"
+	"                         environment (+Y up, the centre looking down -Z)\n"
+	"  --sky-color R,G,B      a constant sky (radiance) in its place\n"
+	"  --sky-strength S       scale --sky or --sky-color (default 1)\n"
+	"  --sky-rotation DEG     turn the sky about +Y, counter-clockwise from above\n"
+	"  --sun ELEV,AZIM,LUX    add a sun: elevation and azimuth in degrees (azimuth\n"
+	"                         from -Z toward +X, as a sky image's), illuminance\n"
+	"                         in lux (clear noon about 100000)\n"
 	"  --allow-outside-files  let the scene read files outside its folder (by default\n"
 	"                         every URI and the environment image must resolve, after\n"
 	"                         '..' and symbolic links, inside the scene file's folder)\n"
@@ -111,6 +132,22 @@ static const char usage_render[] =
 	"Under mpirun (Open MPI), every rank renders the same image on its own devices\n"
 	"(--device applies per rank); rank 0 deals the samples, prints the progress and\n"
 	"alone writes the files; the image is the same bits as one process.\n";
+
+static const char usage_info[] =
+	"usage: ajar info SCENE.gltf|SCENE.glb [options]\n"
+	"\n"
+	"Prints what the scene holds: triangles, materials, lights, marked portals,\n"
+	"the portals a render finds over its openings where it marks none, the\n"
+	"environment, bounds and camera.\n"
+	"\n"
+	"  --portals WHICH          auto: search the openings even where portals are\n"
+	"                           marked; marked or none: no search\n"
+	"  --portals-out FILE.gltf  write the found portals as a glTF file\n"
+	"  --sky, --sky-color, --sky-strength, --sky-rotation, --sun\n"
+	"                           as for 'ajar render' (the search looks for light\n"
+	"                           from them)\n"
+	"  --allow-outside-files    let the scene read files outside its folder\n"
+	"  -h, --help               this text\n";
 
 /* ---- Errors ---------------------------------------------------------------- */
 
@@ -181,6 +218,59 @@ static int check_output(const char *opt, const char *path)
 	}
 	free(copy);
 	return rc;
+}
+
+/* ---- Scene options ---------------------------------------------------------- */
+
+/* The command line's sky and sun (SceneArgs) into the loaded scene. A
+ * file named there is the user's choice: not confined to the scene's
+ * folder. */
+static int apply_scene_args(ajar_scene *scene, const SceneArgs *sc)
+{
+	ajar_status st = AJAR_OK;
+	float k = sc->sky_strength_given ? sc->sky_strength : 1.0f;
+	if (sc->sky) {
+		st = ajar_scene_set_environment_image(scene, sc->sky, k);
+		if (st != AJAR_OK) {
+			report(st, sc->sky);
+			return st == AJAR_ERROR_IO ? EXIT_BAD_INPUT : exit_code(st);
+		}
+	} else if (sc->sky_color_given) {
+		float c[3] = {k * sc->sky_color[0], k * sc->sky_color[1], k * sc->sky_color[2]};
+		st = ajar_scene_set_environment_color(scene, c);
+	}
+	if (st == AJAR_OK && sc->sky_rotation_given)
+		st = ajar_scene_set_environment_rotation(scene, sc->sky_rotation);
+	if (st == AJAR_OK && sc->sun_given) {
+		/* Toward the sun: elevation above the horizon, azimuth from -Z
+		 * toward +X (as a sky image's, README "Environment"); the light
+		 * travels the other way. */
+		double e = sc->sun[0] * M_PI / 180.0, az = sc->sun[1] * M_PI / 180.0;
+		ajar_light l;
+		ajar_light_default(&l);
+		l.type = AJAR_LIGHT_DIRECTIONAL;
+		l.direction[0] = (float)(-cos(e) * sin(az));
+		l.direction[1] = (float)-sin(e);
+		l.direction[2] = (float)(cos(e) * cos(az));
+		l.intensity = sc->sun[2];
+		st = ajar_scene_add_light(scene, &l);
+	}
+	if (st != AJAR_OK) {
+		report(st, NULL);
+		return EXIT_BAD_INPUT;
+	}
+	return EXIT_OK;
+}
+
+/* The portals found, up to FOUND_MAX of them. */
+#define FOUND_MAX 64
+
+static void print_found(const ajar_portal *p, uint32_t n)
+{
+	for (uint32_t i = 0; i < n && i < FOUND_MAX; i++)
+		printf("  [%u] centre (%.3f, %.3f, %.3f), %.3f x %.3f, normal (%.3f, %.3f, %.3f), share %.1f%%\n", i,
+		       p[i].center[0], p[i].center[1], p[i].center[2], p[i].width, p[i].height, p[i].normal[0],
+		       p[i].normal[1], p[i].normal[2], 100.0 * p[i].share);
 }
 
 /* ---- Signals --------------------------------------------------------------- */
@@ -330,6 +420,8 @@ static int resume_options(RenderArgs *a)
 	CONFLICT(GIVEN_SEED, "--seed", o->seed != ck.seed, "%u", o->seed, ck.seed);
 	CONFLICT(GIVEN_MIS, "--mis", o->mis != ck.mis, "%s", mis_name(o->mis), mis_name(ck.mis));
 	CONFLICT(GIVEN_AOV, "--aov", o->aov != ck.aov, "(0x%x)", o->aov, ck.aov);
+	CONFLICT(GIVEN_PORTALS, "--portals", o->portals != ck.portals, "%s", args_portals_name(o->portals),
+		 args_portals_name(ck.portals));
 	CONFLICT(GIVEN_STRATEGY_LEN, "--strategy-len", o->strategy_len != ck.strategy_len, "%u", o->strategy_len,
 		 ck.strategy_len);
 #undef CONFLICT
@@ -343,9 +435,11 @@ static int resume_options(RenderArgs *a)
 		return args_usage_error("--strategies: the checkpoint %s keeps no strategy layers", a->resume);
 	const char *device = o->device;
 	uint32_t spp = o->spp;
-	double time_limit = o->time_limit;
+	double time_limit = o->time_limit, noise = o->noise;
 	a->opt = ck;
 	a->opt.device = device;
+	if (a->given & GIVEN_NOISE)
+		a->opt.noise = noise;
 	if (a->given & GIVEN_SPP)
 		a->opt.spp = spp;
 	if (a->given & GIVEN_TIME)
@@ -377,6 +471,23 @@ static void print_device_shares(const ajar_renderer *r)
 				ds.selector, 100.0 * ds.share, ds.samples_per_second * 1e-6,
 				ds.failed ? ", dropped after a failure" : "");
 	}
+}
+
+/* A render that found its portals says how many and how long the search
+ * took, and writes them with --portals-out. */
+static int found_portals(ajar_renderer *r, const RenderArgs *a)
+{
+	ajar_portal found[FOUND_MAX];
+	uint32_t n = 0;
+	double seconds = 0.0;
+	if (ajar_renderer_found_portals(r, found, FOUND_MAX, &n, &seconds) != AJAR_OK)
+		return EXIT_OK;
+	if (n > FOUND_MAX)
+		n = FOUND_MAX;
+	if (!a->quiet && (n || seconds > 0.0))
+		fprintf(stderr, "ajar: found %u portal%s over openings in %.2f s%s\n", n, n == 1 ? "" : "s", seconds,
+			n ? " ('ajar info' lists them)" : "");
+	return a->sc.portals_out ? portals_write_gltf(a->sc.portals_out, found, n) : EXIT_OK;
 }
 
 /* Under mpirun every rank runs this with the same arguments: rank 0 checks
@@ -425,6 +536,8 @@ static int cmd_render(int argc, char **argv)
 			rc = check_output("--png", a.png);
 		if (rc == EXIT_OK && a.strategies)
 			rc = check_output("--strategies", a.strategies);
+		if (rc == EXIT_OK && a.sc.portals_out)
+			rc = check_output("--portals-out", a.sc.portals_out);
 		if (rc == EXIT_OK && ckpt)
 			rc = check_output(a.checkpoint ? "--checkpoint" : "--resume", ckpt);
 		if (rc == EXIT_OK && a.resume)
@@ -434,7 +547,7 @@ static int cmd_render(int argc, char **argv)
 		return rc;
 
 	Progress progress;
-	progress_init(&progress, stderr, a.quiet);
+	progress_init(&progress, stderr, a.quiet, a.opt.noise > 0.0);
 	ajar_set_log_callback(on_log, &progress);
 	install_signals();
 
@@ -442,6 +555,8 @@ static int cmd_render(int argc, char **argv)
 	ajar_renderer *r = NULL;
 	if (rc == EXIT_OK)
 		rc = load_scene(a.scene, a.allow_outside_files, &scene);
+	if (rc == EXIT_OK)
+		rc = apply_scene_args(scene, &a.sc);
 	if (rc == EXIT_OK && g_interrupted)
 		rc = interrupted_early();
 	if (size > 1)
@@ -479,6 +594,9 @@ static int cmd_render(int argc, char **argv)
 		if (a.opt.time_limit > 0)
 			snprintf(budget + strlen(budget), sizeof budget - strlen(budget), "%s%g s",
 				 a.opt.spp ? ", at most " : "", a.opt.time_limit);
+		if (a.opt.noise > 0)
+			snprintf(budget + strlen(budget), sizeof budget - strlen(budget), "%suntil noise %g%%",
+				 budget[0] ? ", " : "", 100.0 * a.opt.noise);
 		const char *device = ajar_renderer_device_name(r);
 		char from[64] = "";
 		if (a.resume)
@@ -489,6 +607,8 @@ static int cmd_render(int argc, char **argv)
 		fprintf(stderr, "ajar: %s %s with %s (%s%s) on %s%s\n", a.resume ? "resuming" : "rendering", a.scene,
 			args_integrator_name(a.opt.integrator), budget, from, ranks, device ? device : "?");
 	}
+	if ((rc = found_portals(r, &a)) != EXIT_OK)
+		goto done;
 
 	st = ajar_renderer_render(r, on_progress, &progress);
 	progress_break_line(&progress);
@@ -529,8 +649,11 @@ static int cmd_render(int argc, char **argv)
 			ckpt ? ckpt : "");
 		rc = EXIT_INTERRUPTED;
 	} else if (!a.quiet) {
-		fprintf(stderr, "ajar: done: %u spp in %s (%.3g Msamples/s); wrote %s%s%s\n", spp, elapsed,
-			last->samples_per_second * 1e-6, a.exr, a.png ? " and " : "", a.png ? a.png : "");
+		char noise[64] = "";
+		if (a.opt.noise > 0 && ajar_renderer_noise(r) >= 0)
+			snprintf(noise, sizeof noise, ", estimated error %.2g%%", 100.0 * ajar_renderer_noise(r));
+		fprintf(stderr, "ajar: done: %u spp in %s (%.3g Msamples/s%s); wrote %s%s%s\n", spp, elapsed,
+			last->samples_per_second * 1e-6, noise, a.exr, a.png ? " and " : "", a.png ? a.png : "");
 		print_device_shares(r);
 	}
 done:
@@ -594,34 +717,56 @@ static int cmd_devices(int argc, char **argv)
 
 static int cmd_info(int argc, char **argv)
 {
-	if (argc == 1 && (!strcmp(argv[0], "-h") || !strcmp(argv[0], "--help"))) {
-		fputs("usage: ajar info [--allow-outside-files] SCENE.gltf|SCENE.glb\n", stdout);
-		return EXIT_OK;
-	}
-	int allow_outside_files = argc == 2 && !strcmp(argv[0], "--allow-outside-files");
-	argc -= allow_outside_files;
-	argv += allow_outside_files;
-	if (argc != 1)
-		return args_usage_error("info: expects one scene, got %d arguments", argc);
-	if (argv[0][0] == '-')
-		return args_usage_error("info: unknown option '%s'", argv[0]);
-	ajar_scene *scene = NULL;
-	int rc = load_scene(argv[0], allow_outside_files, &scene);
+	InfoArgs ia;
+	int rc = args_parse_info(argc, argv, &ia);
 	if (rc != EXIT_OK)
 		return rc;
+	if (ia.help) {
+		fputs(usage_info, stdout);
+		return EXIT_OK;
+	}
+	if (ia.sc.portals_out && (rc = check_output("--portals-out", ia.sc.portals_out)) != EXIT_OK)
+		return rc;
+	ajar_scene *scene = NULL;
+	rc = load_scene(ia.scene, ia.allow_outside_files, &scene);
+	if (rc == EXIT_OK)
+		rc = apply_scene_args(scene, &ia.sc);
+	if (rc != EXIT_OK) {
+		ajar_scene_destroy(&scene);
+		return rc;
+	}
 	ajar_scene_info in;
 	ajar_status st = ajar_scene_info_get(scene, &in);
 	if (st != AJAR_OK) {
-		report(st, argv[0]);
+		report(st, ia.scene);
 		ajar_scene_destroy(&scene);
 		return exit_code(st);
 	}
 	static const char *const env[] = {"none", "colour", "image"};
-	printf("scene:        %s\n", argv[0]);
+	printf("scene:        %s\n", ia.scene);
 	printf("triangles:    %llu\n", (unsigned long long)in.triangles);
 	printf("materials:    %u\n", in.materials);
 	printf("emissive:     %u triangles\n", in.emissive_triangles);
-	printf("portals:      %u objects, %u triangles\n", in.portals, in.portal_triangles);
+	printf("portals:      %u objects, %u triangles (marked)\n", in.portals, in.portal_triangles);
+	/* The portals a render would find: where none is marked, or asked for. */
+	ajar_portal found[FOUND_MAX];
+	uint32_t nfound = 0;
+	double seconds = 0.0;
+	int search = (in.portal_triangles == 0 && ia.sc.portals == AJAR_PORTALS_DEFAULT) || ia.search ||
+		     ia.sc.portals_out;
+	if (search && ia.sc.portals != AJAR_PORTALS_NONE && ia.sc.portals != AJAR_PORTALS_MARKED) {
+		st = ajar_scene_find_portals(scene, found, FOUND_MAX, &nfound, &seconds);
+		if (st != AJAR_OK) {
+			report(st, ia.scene);
+			ajar_scene_destroy(&scene);
+			return exit_code(st);
+		}
+		printf("found:        %u portal%s over openings (search %.2f s)%s\n", nfound, nfound == 1 ? "" : "s",
+		       seconds, in.portal_triangles && !ia.search ? "; a render uses the marked ones" : "");
+		print_found(found, nfound);
+	} else if (in.portal_triangles) {
+		printf("found:        not searched (the scene marks portals; --portals auto searches)\n");
+	}
 	printf("lights:       %u (KHR_lights_punctual)\n", in.lights);
 	for (uint32_t i = 0; i < in.lights; i++) {
 		ajar_light l;
@@ -663,6 +808,8 @@ static int cmd_info(int argc, char **argv)
 	else
 		printf("resolution:   none suggested (renders 512 wide at the camera's aspect)\n");
 	ajar_scene_destroy(&scene);
+	if (ia.sc.portals_out)
+		return portals_write_gltf(ia.sc.portals_out, found, nfound > FOUND_MAX ? FOUND_MAX : nfound);
 	return EXIT_OK;
 }
 

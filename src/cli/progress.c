@@ -10,11 +10,12 @@
 #define PLAIN_INTERVAL 5.0
 #define BAR_WIDTH 24
 
-void progress_init(Progress *p, FILE *out, int quiet)
+void progress_init(Progress *p, FILE *out, int quiet, int noise)
 {
 	memset(p, 0, sizeof *p);
 	p->out = out;
 	p->quiet = quiet;
+	p->noise = noise;
 	p->tty = isatty(fileno(out));
 }
 
@@ -30,13 +31,20 @@ void progress_format_time(double s, char *buf, size_t cap)
 		snprintf(buf, cap, "%dh%02dm", (int)(s / 3600), (int)(s / 60) % 60);
 }
 
-/* "12/32 spp" with a target, "12 spp" for a time-limited render. */
-static void format_spp(const ajar_progress *now, char *buf, size_t cap)
+/* "12/32 spp" with a target, "12 spp" for a time-limited render; and
+ * the estimated error under a noise target ("noise 3.2%", "noise ?"
+ * before the first estimate). */
+static void format_spp(const ajar_progress *now, int noise, char *buf, size_t cap)
 {
 	if (now->spp_target)
 		snprintf(buf, cap, "%u/%u spp", now->spp_done, now->spp_target);
 	else
 		snprintf(buf, cap, "%u spp", now->spp_done);
+	size_t n = strlen(buf);
+	if (noise && now->noise >= 0)
+		snprintf(buf + n, cap - n, "  noise %.2g%%", 100.0 * now->noise);
+	else if (noise)
+		snprintf(buf + n, cap - n, "  noise ?");
 }
 
 void progress_update(Progress *p, const ajar_progress *now)
@@ -45,8 +53,8 @@ void progress_update(Progress *p, const ajar_progress *now)
 	if (p->quiet)
 		return;
 	double frac = now->fraction < 0 ? 0 : (now->fraction > 1 ? 1 : now->fraction);
-	char spp[48], elapsed[24], eta[24];
-	format_spp(now, spp, sizeof spp);
+	char spp[80], elapsed[24], eta[24];
+	format_spp(now, p->noise, spp, sizeof spp);
 	progress_format_time(now->elapsed, elapsed, sizeof elapsed);
 	progress_format_time(now->eta, eta, sizeof eta);
 	if (p->tty) {

@@ -10,13 +10,14 @@
 typedef struct {
 	FILE *out;
 	int quiet;
+	int noise;         /* a noise target: show the estimated error */
 	int tty;           /* redraw one line with \r */
 	int line_open;     /* a bar is on screen without its newline */
 	double last_print; /* elapsed seconds at the last plain line */
 	ajar_progress last;
 } Progress;
 
-void progress_init(Progress *p, FILE *out, int quiet);
+void progress_init(Progress *p, FILE *out, int quiet, int noise);
 /* Shows one update (called from the renderer's progress callback). */
 void progress_update(Progress *p, const ajar_progress *now);
 /* Ends the bar's line so that other messages start on a fresh one. */

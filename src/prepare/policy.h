@@ -61,6 +61,12 @@ typedef struct {
  * window-room-sunset and -forest; 1 was 1.24x worse on window-room-forest. */
 #define POLICY_PORTAL_BDPT_CONN 2
 
+/* Where a render's portals come from (policy_portals). */
+enum { POLICY_PORTALS_NONE, POLICY_PORTALS_MARKED, POLICY_PORTALS_FOUND };
+/* The portals a render uses, from the option (ajar_portals) and the number
+ * of portal triangles the scene marks. */
+int policy_portals(int option, uint32_t marked);
+
 /* Decides *out from in (and over, which may be NULL); `source` names the
  * scene in the informational messages it logs. */
 void policy_choose(const PolicyInput *in, const PolicyOverrides *over, const char *source, Policy *out);

@@ -11,6 +11,7 @@
 #include <time.h>
 
 #include "core/error.h"
+#include "prepare/found_portals.h"
 #include "prepare/policy.h"
 #include "prepare/portal_flux.h"
 #include "prepare/sky_tables.h"
@@ -116,17 +117,24 @@ static ajar_status setup_camera(const Scene *s, uint32_t width, uint32_t height,
  * it: on the other side of some portal triangle's plane, within its range
  * of the triangle. Its light then reaches the camera's side through the
  * opening, as an emitter's in door-ajar does, and the intermediate
- * subpaths carry it (kernels/integrator/README.md, "A lamp behind a portal counts as an emitter"). A plane test, not a visibility test: it
- * only chooses the strategies, never the image's expectation. */
+ * subpaths carry it (kernels/integrator/README.md, "Where light subpaths
+ * come in, portal is bdpt"). The camera's side is the side the camera is
+ * on for marked portals, and the side a found portal faces (it faces where
+ * the room's rays through it came from: a door's gap found in the jamb's
+ * plane has the camera and the lamp on one geometric side). A plane test,
+ * not a visibility test: it only chooses the strategies, never the
+ * image's expectation. */
 static int lamp_behind_portal(const SceneData *d, V3 camera)
 {
+	int found = d->portal_source == POLICY_PORTALS_FOUND;
 	for (uint32_t i = 0; i < d->lights.nlights; i++) {
 		const PunctualLight *l = &d->lights.lights[i];
 		if (l->type == LIGHT_DIRECTIONAL)
 			continue;
 		for (size_t k = 0; k < d->n_portals; k++) {
 			const PortalTri *t = &d->portals[k];
-			float side_cam = v3_dot(t->n, v3_sub(camera, t->p0)), side_l = v3_dot(t->n, v3_sub(l->pos, t->p0));
+			float side_cam = found ? 1.0f : v3_dot(t->n, v3_sub(camera, t->p0)),
+			      side_l = v3_dot(t->n, v3_sub(l->pos, t->p0));
 			if (!(side_cam * side_l < 0.0f))
 				continue;
 			float near = fminf(v3_len(v3_sub(l->pos, t->p0)),
@@ -136,6 +144,66 @@ static int lamp_behind_portal(const SceneData *d, V3 camera)
 		}
 	}
 	return 0;
+}
+
+/* The portals the render uses (policy_portals): the scene's marked ones,
+ * those the search finds from the camera (portal_find.c, on the BVH just
+ * built), or none. d's triangles, shading and materials must be set. */
+static ajar_status choose_portals(const Scene *s, const ajar_options *o, SceneData *d)
+{
+	d->portal_source = policy_portals((int)o->portals, s->nportal_tris);
+	uint32_t n = 0;
+	if (d->portal_source == POLICY_PORTALS_MARKED) {
+		n = s->nportal_tris;
+	} else if (d->portal_source == POLICY_PORTALS_FOUND) {
+		SceneView v;
+		memset(&v, 0, sizeof v);
+		v.nodes = d->bvh.nodes;
+		v.tris = d->tris;
+		v.shade = d->shade;
+		v.extra = d->extra;
+		v.materials = s->materials;
+		v.textures = s->textures;
+		v.texels = s->texels;
+		v.params = d->params;
+		PortalFindInput in;
+		portal_find_input(s, &in);
+		ajar_status st = portal_find(&v, s->ntris, &in, &d->found);
+		if (st != AJAR_OK)
+			return st;
+		n = 2 * d->found.count;
+		log_msg(AJAR_LOG_INFO, "%s: %s; found %u portal%s over openings in %.2f s (%llu rays)", s->source,
+			s->nportal_tris ? "marked portals ignored" : "no portals marked", d->found.count,
+			d->found.count == 1 ? "" : "s", d->found.seconds, (unsigned long long)d->found.rays);
+	}
+	d->portals = malloc(sizeof *d->portals * (n ? n : 1));
+	if (!d->portals)
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory for %u portal triangles", s->source, n);
+	if (d->portal_source == POLICY_PORTALS_MARKED)
+		memcpy(d->portals, s->portals, sizeof *d->portals * n);
+	for (uint32_t i = 0; d->portal_source == POLICY_PORTALS_FOUND && i < d->found.count; i++)
+		portal_found_tris(&d->found.portals[i], d->portals + 2 * i);
+	d->n_portals = n;
+	return AJAR_OK;
+}
+
+/* Bounds of the prepared triangles and portals (the portals in use, not
+ * those the scene marks). */
+static void prepared_bounds(const SceneData *d, V3 *bmin, V3 *bmax)
+{
+	V3 lo = v3(AJAR_INF, AJAR_INF, AJAR_INF), hi = v3(-AJAR_INF, -AJAR_INF, -AJAR_INF);
+	for (size_t i = 0; i < d->n_tris; i++) {
+		const Tri *t = &d->tris[i];
+		lo = v3_min(lo, v3_min(t->p0, v3_min(t->p1, t->p2)));
+		hi = v3_max(hi, v3_max(t->p0, v3_max(t->p1, t->p2)));
+	}
+	for (size_t i = 0; i < d->n_portals; i++) {
+		const PortalTri *t = &d->portals[i];
+		lo = v3_min(lo, v3_min(t->p0, v3_min(t->p1, t->p2)));
+		hi = v3_max(hi, v3_max(t->p0, v3_max(t->p1, t->p2)));
+	}
+	*bmin = lo;
+	*bmax = hi;
 }
 
 ajar_status prepare_scene(const Scene *s, const ajar_options *o, uint32_t width, uint32_t height,
@@ -161,8 +229,7 @@ ajar_status prepare_scene(const Scene *s, const ajar_options *o, uint32_t width,
 	d->n_extra = s->extra ? n : 1; /* one unused entry, so a device buffer exists */
 	d->extra = calloc(d->n_extra, sizeof *d->extra);
 	d->params = calloc(1, sizeof *d->params);
-	d->portals = malloc(sizeof *d->portals * (s->nportal_tris ? s->nportal_tris : 1));
-	if (!d->tris || !d->shade || !d->params || !d->portals || !d->extra) {
+	if (!d->tris || !d->shade || !d->params || !d->extra) {
 		prepare_free(d);
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory preparing %u triangles", s->source, n);
 	}
@@ -176,21 +243,22 @@ ajar_status prepare_scene(const Scene *s, const ajar_options *o, uint32_t width,
 	if (over && over->panes_opaque) /* a test's brute force: smooth thin glass is a delta surface */
 		for (uint32_t i = 0; i < n; i++)
 			d->tris[i].flags &= ~TRI_PANE;
-	if (s->nportal_tris)
-		memcpy(d->portals, s->portals, sizeof *d->portals * s->nportal_tris);
-	d->n_portals = s->nportal_tris;
 	d->materials = s->materials;
 	d->n_materials = s->nmaterials;
 	d->textures = s->textures;
 	d->n_textures = s->ntextures;
 	d->texels = s->texels;
 	d->n_texels = s->ntexels;
+	if ((st = choose_portals(s, o, d)) != AJAR_OK) {
+		prepare_free(d);
+		return st;
+	}
 	d->kernel_omit = kernel_omit(d);
 
-	scene_bounds(s, &d->bmin, &d->bmax);
+	prepared_bounds(d, &d->bmin, &d->bmax);
 	V3 center = v3_scale(v3_add(d->bmin, d->bmax), 0.5f);
 	float radius = 0.5f * v3_len(v3_sub(d->bmax, d->bmin)) * 1.001f + 1e-4f;
-	if ((st = lights_build(s, d->tris, d->shade, d->extra, n, s->materials, d->portals, s->nportal_tris, center, radius,
+	if ((st = lights_build(s, d->tris, d->shade, d->extra, n, s->materials, d->portals, (uint32_t)d->n_portals, center, radius,
 			       &d->lights)) != AJAR_OK) {
 		prepare_free(d);
 		return st;
@@ -218,7 +286,7 @@ ajar_status prepare_scene(const Scene *s, const ajar_options *o, uint32_t width,
 	p->num_emitters = (int)d->lights.nemitters;
 	p->num_lights = (int)d->lights.nlights;
 	p->light_power = d->lights.light_power;
-	p->num_portals = (int)s->nportal_tris;
+	p->num_portals = (int)d->n_portals;
 	p->num_textures = (int)s->ntextures;
 	p->env_type = s->env_type;
 	p->env_width = (int)s->env_width;
@@ -249,7 +317,7 @@ ajar_status prepare_scene(const Scene *s, const ajar_options *o, uint32_t width,
 	 * (kernels/light/lights.h, line_sample); their directions follow the
 	 * light that comes in through them (portal_sky_lines_build). */
 	p->env_lines = 0;
-	if (s->env_type == ENV_IMAGE && s->nportal_tris > 0) {
+	if (s->env_type == ENV_IMAGE && d->n_portals > 0) {
 		if ((st = portal_sky_lines_build(p, d->portals, (uint32_t)d->n_portals, &d->lights.env,
 						 &d->lights.nenv)) != AJAR_OK) {
 			prepare_free(d);
@@ -274,7 +342,7 @@ ajar_status prepare_scene(const Scene *s, const ajar_options *o, uint32_t width,
 		.integrator = (int)o->integrator,
 		.mis = (int)o->mis,
 		.strategy_unweighted = o->strategy_unweighted,
-		.portals = s->nportal_tris,
+		.portals = (uint32_t)d->n_portals,
 		.env_type = s->env_type,
 		.env_width = s->env_width,
 		.emitters = d->lights.nemitters,
@@ -321,5 +389,6 @@ void prepare_free(SceneData *d)
 	free(d->portal_sky);
 	bvh_free(&d->bvh);
 	lights_free(&d->lights);
+	portal_search_free(&d->found);
 	memset(d, 0, sizeof *d);
 }

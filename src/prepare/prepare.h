@@ -5,6 +5,7 @@
 #include "prepare/bvh_build.h"
 #include "prepare/light_tables.h"
 #include "prepare/policy.h"
+#include "prepare/portal_find.h"
 #include "scene/scene.h"
 
 /* Scene features render_pass can be built without (kernel specialisation,
@@ -28,6 +29,8 @@ typedef struct {
 	float sun_share_portals; /* a sky image's sun's share of the sky light through the portals (portal_flux.c) */
 	int sky_res;             /* cells a side of the planes' sky tables: the program's PORTAL_SKY_RES (kernels/light/portal_sky.h) */
 	double bvh_seconds;
+	int portal_source;       /* POLICY_PORTALS_*: where the portals came from */
+	PortalSearch found;      /* the search's portals and cost, where they were found */
 	V3 bmin, bmax;
 	unsigned kernel_omit; /* KERNEL_OMIT_*: features no triangle or material uses */
 } SceneData;

@@ -3,7 +3,7 @@
  * Layout, native byte order (little-endian on every host Ajar runs on):
  *   "AJARCKPT", u32 format, char version[16], u64 scene_hash, params_hash,
  *   char scene[256], u32 width height integrator max_depth min_depth seed
- *   mis strategy_len strategy_unweighted spp aov, f64 time_limit elapsed,
+ *   mis strategy_len strategy_unweighted spp aov portals, f64 time_limit noise elapsed,
  *   u32 nranges, u32 sections, u64 nfilm[sections], u64 file size,
  *   then nranges (u32 first, u32 count), the films as i64, and a CRC-32 of
  *   everything before it. The size in the header tells a truncated file
@@ -22,9 +22,9 @@
 #include "image/exr.h"
 
 #define CKPT_MAGIC "AJARCKPT"
-#define CKPT_FORMAT 1u
-#define CKPT_OPTIONS 11
-#define HEADER_BYTES (8 + 4 + 16 + 16 + 256 + 4 * CKPT_OPTIONS + 16 + 8 + 8 * CKPT_SECTIONS + 8)
+#define CKPT_FORMAT 2u
+#define CKPT_OPTIONS 12
+#define HEADER_BYTES (8 + 4 + 16 + 16 + 256 + 4 * CKPT_OPTIONS + 24 + 8 + 8 * CKPT_SECTIONS + 8)
 
 uint64_t checkpoint_hash(uint64_t h, const void *data, size_t n)
 {
@@ -115,10 +115,11 @@ ajar_status checkpoint_write(const char *path, const Checkpoint *c)
 	w_put(w, scene, sizeof scene);
 	const uint32_t opts[CKPT_OPTIONS] = {c->width,	  c->height, c->integrator,	    c->max_depth,
 					     c->min_depth, c->seed,	 c->mis,		    c->strategy_len,
-					     c->strategy_unweighted, c->spp, c->aov};
+					     c->strategy_unweighted, c->spp, c->aov, c->portals};
 	for (int i = 0; i < CKPT_OPTIONS; i++)
 		w_u32(w, opts[i]);
 	w_f64(w, c->time_limit);
+	w_f64(w, c->noise);
 	w_f64(w, c->elapsed);
 	w_u32(w, c->nranges);
 	w_u32(w, CKPT_SECTIONS);
@@ -286,7 +287,9 @@ ajar_status checkpoint_read(const char *path, Checkpoint *c, int header_only)
 	c->strategy_unweighted = opts[8];
 	c->spp = opts[9];
 	c->aov = opts[10];
+	c->portals = opts[11];
 	c->time_limit = r_f64(&r);
+	c->noise = r_f64(&r);
 	c->elapsed = r_f64(&r);
 	c->nranges = r_u32(&r);
 	sections = r_u32(&r);

@@ -30,7 +30,8 @@ typedef struct {
 	uint32_t width, height, integrator, max_depth, min_depth, seed, mis, strategy_len, strategy_unweighted;
 	uint32_t spp;            /* the sample target, 0 = until the time limit */
 	uint32_t aov;            /* AJAR_AOV_* bits */
-	double time_limit, elapsed;
+	uint32_t portals;        /* ajar_portals */
+	double time_limit, noise, elapsed; /* the budget: seconds, a noise target (ajar_options.noise) */
 	SampleRange *ranges;     /* sorted, merged */
 	uint32_t nranges;
 	long *film[CKPT_SECTIONS];

@@ -25,6 +25,7 @@
 #include "render/render_info.h"
 #include "render/render_job.h"
 #include "render/render_loop.h"
+#include "render/render_noise.h"
 #include "render/render_options.h"
 #include "render/render_overrides.h"
 #include "render/render_state.h"
@@ -75,6 +76,7 @@ static ajar_status renderer_new(const ajar_scene *scene, const ajar_options *opt
 	image_size(scene, opt, &r->width, &r->height);
 	r->spp_target = opt->spp;
 	r->time_limit = opt->time_limit;
+	noise_reset(r);
 	r->integrator = opt->integrator;
 	r->seed = opt->seed;
 	r->max_depth = opt->max_depth;
@@ -161,6 +163,7 @@ void ajar_renderer_destroy(ajar_renderer **rp)
 	free(r->holes.r);
 	free(r->base.r);
 	free(r->ckpt_path);
+	noise_reset(r);
 	pthread_cond_destroy(&r->cond);
 	pthread_mutex_destroy(&r->lock);
 	free(r);
@@ -202,6 +205,7 @@ ajar_status ajar_renderer_restart(ajar_renderer *r, uint32_t seed)
 	r->hashed = 0;
 	r->spp_done = r->next_first = 0;
 	r->elapsed = 0;
+	noise_reset(r);
 	atomic_store(&r->cancel, 0);
 	return AJAR_OK;
 }

@@ -51,7 +51,9 @@ static ajar_status checkpoint_gather(ajar_renderer *r, Checkpoint *c)
 	c->strategy_unweighted = (uint32_t)o->strategy_unweighted;
 	c->spp = r->spp_target;
 	c->aov = o->aov;
+	c->portals = (uint32_t)o->portals;
 	c->time_limit = r->time_limit;
+	c->noise = r->opt.noise;
 	c->elapsed = r->elapsed;
 	size_t n = r->base.n;
 	for (uint32_t i = 0; i < r->ndev; i++)
@@ -161,6 +163,7 @@ static void options_from_checkpoint(const Checkpoint *c, ajar_options *o)
 	o->height = c->height;
 	o->spp = c->spp;
 	o->time_limit = c->time_limit;
+	o->noise = c->noise;
 	o->integrator = (ajar_integrator)c->integrator;
 	o->max_depth = c->max_depth;
 	o->min_depth = c->min_depth;
@@ -169,6 +172,7 @@ static void options_from_checkpoint(const Checkpoint *c, ajar_options *o)
 	o->strategy_len = c->strategy_len;
 	o->strategy_unweighted = (int)c->strategy_unweighted;
 	o->aov = c->aov;
+	o->portals = (ajar_portals)c->portals;
 }
 
 ajar_status ajar_checkpoint_options(const char *path, ajar_options *o, uint32_t *spp_done)
@@ -257,14 +261,16 @@ static ajar_status resume_options(ajar_options *want, const ajar_options *o, con
 				      : o->strategy_len != want->strategy_len		 ? "strategy_len"
 				      : o->strategy_unweighted != want->strategy_unweighted ? "strategy_unweighted"
 				      : o->aov != want->aov				 ? "aov"
+				      : o->portals != want->portals			 ? "portals"
 											   : NULL;
 		if (differs)
 			return err_set(AJAR_ERROR_INVALID_ARGUMENT,
-				       "%s: options.%s differs from the checkpoint's (only spp, time_limit and device "
+				       "%s: options.%s differs from the checkpoint's (only spp, time_limit, noise and device "
 				       "may change when resuming)",
 				       path, differs);
 		want->spp = o->spp;
 		want->time_limit = o->time_limit;
+		want->noise = o->noise;
 		want->device = o->device;
 	}
 	return AJAR_OK;

@@ -15,11 +15,13 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "render/cluster.h"
 #include "render/render_checkpoint.h"
 #include "render/render_device.h"
 #include "render/render_film.h"
 #include "render/render_info.h"
 #include "render/render_job.h"
+#include "render/render_noise.h"
 #include "render/render_scheduler.h"
 
 static void *device_thread(void *arg)
@@ -80,7 +82,13 @@ static void fill_progress(const ajar_renderer *r, ajar_progress *p)
 	p->samples_done = (uint64_t)r->spp_done * r->width * r->height;
 	p->elapsed = elapsed;
 	p->samples_per_second = elapsed > 0 ? p->samples_done / elapsed : 0;
-	if (r->spp_target) {
+	p->noise = r->opt.noise > 0.0 ? r->noise : -1.0;
+	if (!r->spp_target && !(r->time_limit > 0)) {
+		/* Only a noise target: the error falls as 1/sqrt(samples). */
+		double q = r->noise > 0 ? r->opt.noise / r->noise : 0.0;
+		p->fraction = fmin(1.0, q * q);
+		p->eta = q > 0 && rate > 0 ? fmax(0.0, r->spp_done * (1.0 / (q * q) - 1.0) / rate) : -1.0;
+	} else if (r->spp_target) {
 		p->fraction = (double)r->spp_done / r->spp_target;
 		p->eta = rate > 0 ? (r->spp_target - r->spp_done) / rate : -1.0;
 	} else {
@@ -138,6 +146,10 @@ static void wait_passes(ajar_renderer *r, ajar_progress_fn fn, void *user)
 		if (r->ckpt_path && !scheduler_stopping(r) && scheduler_work_left(r) > 0 &&
 		    (dropped || render_seconds() - r->ckpt_last >= r->ckpt_every))
 			render_checkpoint_during(r);
+		/* A noise target: an estimate as the samples grow. */
+		if (r->opt.noise > 0.0 && !scheduler_stopping(r) && scheduler_work_left(r) > 0 &&
+		    r->spp_done >= r->noise_next)
+			noise_during(r);
 		pthread_cond_broadcast(&r->cond); /* wakes idle devices after a cancel */
 	}
 }
@@ -158,6 +170,8 @@ static ajar_status outcome(ajar_renderer *r)
 			       "rendered before",
 			       rd->dev.name, rd->dev.selector, rd->error, r->spp_done);
 	}
+	if (r->noise_reached)
+		return AJAR_OK; /* stopped at the noise target */
 	if (left > 0 && scheduler_time_left(r) > 0 && atomic_load(&r->cancel))
 		return err_set(AJAR_ERROR_CANCELLED, "render cancelled after %u samples per pixel", r->spp_done);
 	return AJAR_OK;
@@ -192,6 +206,12 @@ ajar_status render_loop(ajar_renderer *r, ajar_progress_fn fn, void *user)
 			r->devs[i].started = 0;
 		}
 	r->elapsed = render_seconds() - r->t0;
+	/* Under a noise target, the estimate of the image as it ends (a job's
+	 * other ranks' films are summed later, in job_end: there the last
+	 * estimate of the render stands). */
+	if (r->opt.noise > 0.0 && cluster_size() == 1 && r->spp_done > r->noise_snap_spp[0] &&
+	    r->spp_done > r->noise_snap_spp[1])
+		noise_update(r);
 	report_drops(r);
 	if (r->ndev > 1) {
 		char shares[2048];

@@ -42,10 +42,15 @@ ajar_status options_resolve(const ajar_options *in, ajar_options *out)
 	if (o->strategy_len && (o->integrator == AJAR_INTEGRATOR_PT || o->strategy_len > 8))
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT,
 			       "strategy images need a bidirectional integrator and a length of 1..8");
-	if (o->spp == 0 && !(o->time_limit > 0))
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "set a sample count or a time limit");
+	if (!(o->noise >= 0.0 && o->noise < 1.0))
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "noise target %g: must be in [0, 1)", o->noise);
+	if (o->spp == 0 && !(o->time_limit > 0) && !(o->noise > 0))
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "set a sample count, a time limit or a noise target");
 	if (o->time_limit < 0 || o->time_limit != o->time_limit)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "time limit must be positive");
+	if (o->portals != AJAR_PORTALS_DEFAULT && o->portals != AJAR_PORTALS_MARKED && o->portals != AJAR_PORTALS_FOUND &&
+	    o->portals != AJAR_PORTALS_NONE)
+		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "unknown portals choice %d", (int)o->portals);
 	if (o->aov & ~AJAR_AOV_ALL)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "aov: unknown bits 0x%x", o->aov & ~AJAR_AOV_ALL);
 	return AJAR_OK;

@@ -58,6 +58,13 @@ int scheduler_take_range(ajar_renderer *r, RenderDevice *rd, Range *g)
 				count = (uint32_t)share;
 		}
 	}
+	/* Under a noise target a pass ends by the next estimate, so the render
+	 * stops within a few percent of the samples the target needs. */
+	if (r->opt.noise > 0.0) {
+		uint32_t room = r->noise_next > r->next_first ? r->noise_next - r->next_first : 1;
+		if (count > room)
+			count = room;
+	}
 	if (render_faults.pass_spp && count > render_faults.pass_spp)
 		count = render_faults.pass_spp;
 	if (r->holes.n) {

@@ -96,6 +96,13 @@ struct ajar_renderer {
 	char *ckpt_path; /* written during ajar_renderer_render, or NULL */
 	double ckpt_every, ckpt_last;
 	int pausing; /* under the lock: no device takes a new range */
+	/* The noise estimate (render_noise.c), by the calling thread: */
+	long *noise_snap[2];         /* image sums at earlier estimates (own pixels + splats) */
+	uint32_t noise_snap_spp[2];  /* their sample counts */
+	int noise_nsnap;
+	double noise;                /* the last estimate, < 0 unknown */
+	uint32_t noise_next;         /* samples per pixel at which to estimate next */
+	int noise_reached;           /* the render stopped at the target */
 	/* Several machines (Open MPI, render_job.c): */
 	long *remote, *remote_splat; /* rank 0: the other ranks' films, summed at the last gather */
 	int job_lost;                /* rank 0: a rank that stopped answering, or 0 */

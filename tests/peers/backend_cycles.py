@@ -20,6 +20,18 @@ importer's "Standard" units: sun strength = lux / 683 W/m^2, point and
 spot power = candela x 4 pi / 683 W, spot size = 2 x outer cone angle,
 blend = 1 - inner / outer, and no soft radius or sun disk
 (shadow_soft_size = 0, angle = 0).
+A smooth thin-walled pane (scene.py, is_pane) is glTF's thin model exactly:
+a Mix Shader of a Transparent BSDF (colour = base colour x transmission:
+straight through, weight (1 - F) base) and a sharp Glossy BSDF (white, GGX,
+roughness 0: a mirror of weight F), the factor a Fresnel node. That node
+takes 1 / IOR on back faces (an interface into the denser side, with total
+reflection past 41.8 degrees), so its IOR input is ior on front faces and
+1 / ior on back faces (Backfacing): both sides then see F(ior) of the same
+|cos|, as Ajar does. Transparent surfaces pass shadow rays multiplied by
+their transparency (Cycles' transparent shadows), so next-event estimation
+through the pane carries (1 - F) base as Ajar's connections do; transparent
+bounces are counted apart from max_bounces (transparent_max_bounces = the
+same D - 2) and the pane's mirror is a glossy bounce.
 With --integrator noportal the scene has no portal; otherwise every Ajar
 portal quad becomes a Cycles portal: an area light with is_portal set, of
 the quad's size, emitting into the room. With --integrator principled
@@ -57,6 +69,37 @@ def make_mesh(bpy, name, v, f):
 	me.polygons.foreach_set("use_smooth", np.zeros(len(f), dtype=bool))
 	me.update()
 	return me
+
+
+def make_pane(bpy, name, tint, ior):
+	"""The thin pane (see the module comment)."""
+	mat = bpy.data.materials.new(name)
+	mat.use_nodes = True
+	nt = mat.node_tree
+	for n in list(nt.nodes):
+		nt.nodes.remove(n)
+	out = nt.nodes.new("ShaderNodeOutputMaterial")
+	tr = nt.nodes.new("ShaderNodeBsdfTransparent")
+	tr.inputs["Color"].default_value = (*[float(x) for x in tint], 1.0)
+	gl = nt.nodes.new("ShaderNodeBsdfGlossy")
+	gl.distribution = "GGX"
+	gl.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+	gl.inputs["Roughness"].default_value = 0.0
+	geo = nt.nodes.new("ShaderNodeNewGeometry")
+	eta = nt.nodes.new("ShaderNodeMath")
+	eta.operation = "MULTIPLY_ADD"  # backfacing x (1/ior - ior) + ior
+	nt.links.new(geo.outputs["Backfacing"], eta.inputs[0])
+	eta.inputs[1].default_value = 1.0 / ior - ior
+	eta.inputs[2].default_value = ior
+	fr = nt.nodes.new("ShaderNodeFresnel")
+	nt.links.new(eta.outputs["Value"], fr.inputs["IOR"])
+	mix = nt.nodes.new("ShaderNodeMixShader")
+	nt.links.new(fr.outputs["Fac"], mix.inputs["Fac"])
+	nt.links.new(tr.outputs["BSDF"], mix.inputs[1])
+	nt.links.new(gl.outputs["BSDF"], mix.inputs[2])
+	nt.links.new(mix.outputs["Shader"], out.inputs["Surface"])
+	mat.cycles.emission_sampling = "NONE"
+	return mat
 
 
 def make_material(bpy, name, base, emission, pbr=None):
@@ -168,7 +211,10 @@ def build(bpy, mathutils, scene, a):
 		m = scene.materials[mi_index]
 		me = make_mesh(bpy, f"mesh{mi_index}", v, f)
 		pbr = m if a.integrator == "principled" and not m["lambertian"] else None
-		me.materials.append(make_material(bpy, m["name"], m["base"], m["emission"], pbr))
+		if m["pane"]:
+			me.materials.append(make_pane(bpy, m["name"], m["base"] * m["transmission"], m["ior"]))
+		else:
+			me.materials.append(make_material(bpy, m["name"], m["base"], m["emission"], pbr))
 		sc.collection.objects.link(bpy.data.objects.new(f"mesh{mi_index}", me))
 	world = bpy.data.worlds.new("world")
 	world.use_nodes = True
@@ -230,6 +276,8 @@ def build(bpy, mathutils, scene, a):
 	cy.sample_clamp_indirect = 0.0
 	cy.light_sampling_threshold = 0.0
 	cy.blur_glossy = 0.0
+	cy.caustics_reflective = True  # the defaults; off, they would drop light reflected by a pane
+	cy.caustics_refractive = True
 	bounces = max(0, a.depth - 2)
 	cy.max_bounces = bounces
 	cy.diffuse_bounces = bounces

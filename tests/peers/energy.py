@@ -7,8 +7,9 @@ materials (specular layers on), the check of Ajar's energy compensation
 For each scene (ENERGY_SCENES, default "living-room bathroom"), two
 variants written by scene.write_lambert_variant into build/peers/: `-pbr`
 keeps every material's metallic, roughness, specular and ior (textures
-become their mean colour, transmissive meshes are removed: both renderers
-see the same opaque materials), and `-lambert`, the control, makes every
+become their mean colour, transmissive meshes are removed except smooth
+thin panes, which both renderers build exactly: both see the same
+materials), and `-lambert`, the control, makes every
 material Lambertian. Ajar's `pt` and Cycles (Principled BSDF for the pbr
 variant, Diffuse BSDF for the control) each render every variant with two
 seeds at ENERGY_SPP (128) samples per pixel, ENERGY_SIZE (128) wide, depth

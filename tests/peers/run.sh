@@ -11,7 +11,8 @@
 # PEERS_REF_SECONDS, PEERS_DEPTH, PEERS_THREADS, PEERS_RENDERERS (driver.py).
 # `run.sh rays` instead compares Ajar's ray queries with Embree's (rays.py);
 # after driver.py, assets.py compares textured Khronos assets with Cycles
-# through Blender's glTF importer (`run.sh assets`: only that).
+# through Blender's glTF importer (`run.sh assets`: only that). `run.sh pane`
+# checks each renderer's thin glass pane against the analytic Fresnel (pane.py).
 set -eu
 cd "$(dirname "$0")/../.."
 
@@ -54,6 +55,10 @@ export PYTHONDONTWRITEBYTECODE=1
 # `run.sh rays`: the ray queries alone against Embree's (rays.py).
 if [ "${1:-}" = rays ]; then
 	exec "$VENV/bin/python" tests/peers/rays.py
+fi
+# `run.sh pane`: each renderer's thin glass pane against the analytic Fresnel (pane.py).
+if [ "${1:-}" = pane ]; then
+	exec "$VENV/bin/python" tests/peers/pane.py
 fi
 # `run.sh assets`: only the textured Khronos assets against Blender's importer (assets.py).
 if [ "${1:-}" = assets ]; then

@@ -28,9 +28,20 @@ matched variant without normals, see lambert_variant).
 
 It also writes that matched variant: every material Lambertian with its base
 colour (a base colour texture replaced by the mean of its texels decoded from
-sRGB to linear, times the factor, as Ajar samples it), transmissive meshes
-removed, geometry flattened to world space without normals. Ajar renders the
-variant too, so all renderers see the same scene.
+sRGB to linear, times the factor, as Ajar samples it), solid glass removed,
+geometry flattened to world space without normals. Ajar renders the variant
+too, so all renderers see the same scene.
+
+One non-Lambertian material is kept as it is: the smooth thin-walled pane
+(is_pane: KHR_materials_transmission 1 without KHR_materials_volume or with
+thickness 0, roughness 0, metallic 0, no texture, specular layer untouched).
+glTF makes it one interface that does not bend light: specular reflection
+with weight F and straight-through transmission (wi = -wo) with weight
+(1 - F) baseColor, F the exact unpolarised dielectric Fresnel at ior for
+|cos| to the surface, the same from both sides. Every peer builds exactly
+that (backend_mitsuba.py, backend_cycles.py); LuxCore is not given such
+scenes (driver.supports). Any other transmissive material (a volume, a
+rough or partly transmissive surface) has its meshes removed.
 """
 import base64
 import json
@@ -152,10 +163,21 @@ class Scene:
 		specular = ext.get("KHR_materials_specular", {}).get("specularFactor", 1.0)
 		roughness = pbr.get("roughnessFactor", 1.0)
 		ior = ext.get("KHR_materials_ior", {}).get("ior", 1.5)
+		# glTF: a volume only with a thickness; without one the surface is thin-walled.
+		volume = ext.get("KHR_materials_volume", {}).get("thicknessFactor", 0.0) > 0
+		spec_ext = ext.get("KHR_materials_specular", {})
+		plain_spec = (spec_ext.get("specularFactor", 1.0) == 1.0 and
+			      list(spec_ext.get("specularColorFactor", [1, 1, 1])) == [1, 1, 1] and
+			      "specularTexture" not in spec_ext and "specularColorTexture" not in spec_ext)
+		pane = (transmission == 1.0 and not volume and roughness == 0 and metallic == 0 and tex is None and
+			plain_spec and emission.max() == 0 and
+			"transmissionTexture" not in ext.get("KHR_materials_transmission", {}) and
+			"metallicRoughnessTexture" not in pbr)
 		return {
 			"name": m.get("name", f"material{i}"), "base": base, "texture": tex["index"] if tex else None,
 			"emission": emission, "metallic": metallic, "transmission": transmission,
 			"specular": specular, "roughness": roughness, "ior": ior, "double_sided": m.get("doubleSided", False),
+			"volume": volume, "pane": pane,
 			"lambertian": metallic == 0 and transmission == 0 and specular == 0 and tex is None,
 			"portal_material": bool(m.get("extras", {}).get("portal_material", False)),
 		}
@@ -166,7 +188,7 @@ class Scene:
 			self.materials.append({
 				"name": "default", "base": np.ones(3), "texture": None, "emission": np.zeros(3),
 				"metallic": 1.0, "transmission": 0.0, "specular": 1.0, "roughness": 1.0, "ior": 1.5, "double_sided": False,
-				"lambertian": False, "portal_material": False})
+				"volume": False, "pane": False, "lambertian": False, "portal_material": False})
 			self.default_material = len(self.materials) - 1
 		return self.default_material
 
@@ -238,11 +260,16 @@ class Scene:
 		"""A uniform environment or a sky image: light enters through openings."""
 		return self.environment is not None or self.sky is not None
 
+	def has_panes(self):
+		"""Whether a mesh is a smooth thin-walled pane (see the module comment)."""
+		return any(self.materials[mi]["pane"] for mi, _, _ in self.meshes)
+
 	def check_lambertian(self):
-		"""Raise unless every used material is exactly Lambertian."""
+		"""Raise unless every used material is exactly Lambertian or a smooth
+		thin-walled pane, the two every peer builds exactly."""
 		for mi, _, _ in self.meshes:
 			m = self.materials[mi]
-			if not m["lambertian"]:
+			if not (m["lambertian"] or m["pane"]):
 				raise ValueError(f"{self.path}: material {m['name']} is not Lambertian (metallic {m['metallic']}, "
 						 f"transmission {m['transmission']}, specular {m['specular']}, texture {m['texture']}); "
 						 "render the Lambertian variant")
@@ -292,14 +319,28 @@ def write_lambert_variant(scene, out_path, pbr=False):
 	out_path (+ .bin beside it). Returns a list of lines saying what changed.
 	With pbr, materials keep their metallic, roughness, specular and ior
 	(glTF's specular layers stay on: the energy comparison, energy.py); only
-	textures become their mean and transmissive meshes are removed."""
+	textures become their mean and transmissive meshes are removed. Smooth
+	thin-walled panes are kept as they are in both."""
 	notes = []
 	mats, remap = [], {}
 	used = sorted({mi for mi, _, _ in scene.meshes})
+	panes = False
 	for mi in used:
 		m = scene.materials[mi]
+		if m["pane"]:
+			notes.append(f"material {m['name']}: smooth thin-walled pane (ior {m['ior']:g}, "
+				     f"base colour {np.round(m['base'], 4).tolist()}): kept")
+			remap[mi] = len(mats)
+			mats.append({"name": m["name"], "pbrMetallicRoughness": {
+				"baseColorFactor": [float(x) for x in m["base"]] + [1.0], "metallicFactor": 0.0,
+				"roughnessFactor": 0.0}, "doubleSided": True, "extensions": {
+				"KHR_materials_transmission": {"transmissionFactor": 1.0},
+				"KHR_materials_ior": {"ior": float(m["ior"])}}})
+			panes = True
+			continue
 		if m["transmission"] > 0:
-			notes.append(f"material {m['name']}: transmission {m['transmission']}: its meshes removed")
+			kind = "with a volume" if m["volume"] else "not a smooth thin pane"
+			notes.append(f"material {m['name']}: transmission {m['transmission']} ({kind}): its meshes removed")
 			continue
 		base = m["base"].copy()
 		was = []
@@ -397,7 +438,8 @@ def write_lambert_variant(scene, out_path, pbr=False):
 			      "extensions": {"KHR_lights_punctual": {"light": len(light_defs) - 1}}})
 	base = os.path.splitext(os.path.basename(out_path))[0]
 	g = {"asset": {"version": "2.0", "generator": "Ajar tests/peers/scene.py (Lambertian variant)"},
-	     "extensionsUsed": used + (["KHR_materials_ior"] if pbr else []) + (["KHR_lights_punctual"] if light_defs else []),
+	     "extensionsUsed": used + (["KHR_materials_ior"] if pbr or panes else []) +
+			       (["KHR_materials_transmission"] if panes else []) + (["KHR_lights_punctual"] if light_defs else []),
 	     "scene": 0, "scenes": [{"nodes": list(range(len(nodes))), "extras": scene_extras}],
 	     "nodes": nodes, "meshes": meshes, "materials": mats, "cameras": [cam],
 	     "accessors": accessors, "bufferViews": views,

@@ -205,12 +205,57 @@ static void test_pane_brute_force(void **state)
 	ajar_scene_destroy(&s);
 }
 
+/* More panes on a shadow ray than the traversal's list holds (eight): a
+ * diffuse floor under ten tinted panes, lit by a white sky through them,
+ * seen from below the panes: next-event rays cross ten panes (the list's
+ * fallback, one closest hit a pane), the camera's none. Against the brute
+ * force, where only BSDF sampling crosses them as delta surfaces. */
+static void test_many_panes(void **state)
+{
+	(void)state;
+	ajar_scene *s;
+	assert_int_equal(ajar_scene_create(&s), AJAR_OK);
+	ajar_camera cam = {{0, 0.5f, 0}, {0, -1, 0}, {0, 0, -1}, 0.8f, 0};
+	assert_int_equal(ajar_scene_set_camera(s, &cam), AJAR_OK);
+	const float white[3] = {1, 1, 1};
+	assert_int_equal(ajar_scene_set_environment_color(s, white), AJAR_OK);
+	ajar_material m;
+	ajar_material_default(&m);
+	uint32_t floor, glass;
+	assert_int_equal(ajar_scene_add_material(s, &m, &floor), AJAR_OK);
+	m.base_color[0] = 1.0f;
+	m.base_color[1] = 0.95f;
+	m.base_color[2] = 0.9f;
+	m.roughness = 0.0f;
+	m.specular = 1.0f;
+	m.transmission = 1.0f;
+	assert_int_equal(ajar_scene_add_material(s, &m, &glass), AJAR_OK);
+	const float h = 20.0f;
+	float fp[12] = {-h, 0, h, h, 0, h, h, 0, -h, -h, 0, -h};
+	uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+	ajar_mesh fm = {fp, NULL, NULL, 4, idx, 2, floor, NULL};
+	assert_int_equal(ajar_scene_add_mesh(s, &fm), AJAR_OK);
+	for (int k = 0; k < 10; k++) {
+		float y = 1.0f + 0.1f * (float)k;
+		float gp[12] = {-h, y, h, h, y, h, h, y, -h, -h, y, -h};
+		ajar_mesh gm = {gp, NULL, NULL, 4, idx, 2, glass, NULL};
+		assert_int_equal(ajar_scene_add_mesh(s, &gm), AJAR_OK);
+	}
+	const PolicyOverrides brute = {.panes_opaque = 1};
+	Estimate b, p;
+	estimate(s, AJAR_INTEGRATOR_PT, 16, 512, 64, &brute, &b);
+	estimate(s, AJAR_INTEGRATOR_PT, 16, 64, 64, NULL, &p);
+	agree("ten panes over a floor", "pt, panes opaque to connections", &b, "pt", &p);
+	ajar_scene_destroy(&s);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_pane_transmittance),
 		cmocka_unit_test(test_slab_absorption),
 		cmocka_unit_test(test_pane_brute_force),
+		cmocka_unit_test(test_many_panes),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -126,3 +126,13 @@ Scene *sun_room(int low, float sun_l)
 	assert_int_equal(scene_set_env_image(s, 256, 128, sky, 1.0f), AJAR_OK);
 	return s;
 }
+
+Scene *without_portals(const char *path)
+{
+	Scene *s;
+	if (ajar_scene_load(path, &s) != AJAR_OK)
+		fail_msg("%s", ajar_last_error());
+	s->nportal_tris = 0;
+	s->nportals = 0;
+	return s;
+}

@@ -23,6 +23,10 @@ Scene *round_trip_scene(void);
  * low (on the far wall), its light through the window (which faces -z). */
 Scene *sun_room(int low, float sun_l);
 
+/* `path` as an exporter hands it over: its marked portals taken out, so a
+ * prepared scene finds its own (src/prepare/portal_find.c). */
+Scene *without_portals(const char *path);
+
 /* The sky's strategy set with light subpaths, the default where portal now
  * renders as bdpt: a forced set keeps the intermediate strategies. */
 extern const PolicyOverrides SKY_SET;

@@ -92,6 +92,19 @@ static void test_groups_unbiased_window_room(void **state)
 	host_scene_close(&ht);
 }
 
+/* The same with a pane 2 cm inside the window: the intermediate subpaths'
+ * -> halves and the next-event rays cross it by its null event and its
+ * transmittance; each group must still equal the filtered path tracer. */
+static void test_groups_unbiased_glazed(void **state)
+{
+	HostScene hp, ht;
+	host_scene_open(&hp, SCENE("window-room/window-room-glazed.gltf"), NULL, 8, 8, INTEGRATOR_PORTAL, 3);
+	host_scene_open(&ht, SCENE("window-room/window-room-glazed.gltf"), NULL, 8, 8, INTEGRATOR_PT, 3);
+	assert_true(check_groups(&hp, &ht, 3, GROUP_SPP, 64) >= 3);
+	host_scene_close(&hp);
+	host_scene_close(&ht);
+}
+
 /* The same under skies with a sun, high and low: next-event samples
  * through the portal by the sky's radiance (kernels/light/portal_sky.h), <-
  * halves guided toward the sun. The sun's light is noisier: 1024 spp
@@ -177,6 +190,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_groups_unbiased_window_room),
+		cmocka_unit_test(test_groups_unbiased_glazed),
 		cmocka_unit_test(test_groups_unbiased_window_room_sun),
 		cmocka_unit_test(test_groups_unbiased_round_trip),
 		cmocka_unit_test(test_groups_unbiased_punctual),

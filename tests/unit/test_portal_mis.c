@@ -405,6 +405,27 @@ static void test_mis_door_ajar(void **state)
 	host_scene_close(&h);
 }
 
+/* With the portals the search finds (the marked ones taken out): a
+ * window under a constant sky (every strategy as well) and a door's gap
+ * with an emitter behind it. */
+static void test_mis_found_portals(void **state)
+{
+	(void)state;
+	HostScene h;
+	host_scene_open(&h, NULL, without_portals(SCENE("window-room/window-room.gltf")), 24, 24, INTEGRATOR_PORTAL, 8);
+	assert_int_equal(h.data.portal_source, POLICY_PORTALS_FOUND);
+	assert_true(h.data.n_portals >= 2);
+	assert_true(check_scene_mis(&h, 200).portal_paths > 100);
+	use_all_portal_strategies(&h);
+	assert_true(check_scene_mis(&h, 300).portal_paths > 150);
+	host_scene_close(&h);
+	host_scene_open(&h, NULL, without_portals(SCENE("door-ajar/door-ajar.gltf")), 24, 24, INTEGRATOR_PORTAL, 8);
+	assert_int_equal(h.data.portal_source, POLICY_PORTALS_FOUND);
+	assert_true(h.data.n_portals >= 2);
+	assert_true(check_scene_mis(&h, 300).portal_paths > 50);
+	host_scene_close(&h);
+}
+
 /* Scenes lit only by the sky (no light subpaths, bdpt strategies s <= 1,
  * short eye parts, records within a horizon): the constant-sky window room
  * and window-room-forest (a sky image with a sun, portal planes), with the
@@ -587,6 +608,7 @@ int main(void)
 		cmocka_unit_test(test_mis_glazed), cmocka_unit_test(test_mis_living_room),
 		cmocka_unit_test(test_mis_bathroom),
 		cmocka_unit_test(test_mis_door_ajar),
+		cmocka_unit_test(test_mis_found_portals),
 		cmocka_unit_test(test_mis_portal_surface_portal),
 		cmocka_unit_test(test_mis_window_room_sun),
 		cmocka_unit_test(test_join_weights),
