@@ -6,7 +6,7 @@
 #include "base/types.h"
 
 #define AJAR_LAYOUT_TYPES(X) \
-	X(BvhNode, 256) X(Tri, 48) X(TriShade, 64) X(TriExtra, 128) X(Material, 96) X(Texture, 48) \
+	X(BvhNode, 256) X(Tri, 48) X(TriShade, 64) X(TriExtra, 128) X(Material, 176) X(Texture, 48) \
 	X(Emitter, 16) X(PortalTri, 64) X(Camera, 64) X(Params, 240) \
 	X(PortalPlane, 80) X(PunctualLight, 64) X(Instance, 112)
 
@@ -22,6 +22,9 @@
 	X(Material, ior) X(Material, specular) X(Material, flags)                      \
 	X(Material, alpha_cutoff) X(Material, mr_tex) X(Material, emissive_tex)         \
 	X(Material, base_alpha) X(Material, transmission_tex) X(Material, sigma)       \
+	X(Material, specular_tex) X(Material, specular_color) X(Material, sheen_color)  \
+	X(Material, sheen_rough_tex) X(Material, clearcoat) X(Material, clearcoat_normal_tex) \
+	X(Material, clearcoat_normal_scale) X(Material, anisotropy) X(Material, anisotropy_tex) \
 	X(Texture, offset) X(Texture, width) X(Texture, height) X(Texture, flags)      \
 	X(Texture, xf)                                                                  \
 	X(Emitter, tri) X(Emitter, area) X(Emitter, pdf_select) X(Emitter, cell)       \

@@ -74,8 +74,12 @@ typedef struct {
 #define MATERIAL_ALPHA_BLEND 4  /* stochastic transparency: rays meet the surface with probability alpha */
 #define MATERIAL_VOLUME 8       /* KHR_materials_volume with a thickness: transmission refracts into a solid
 				 * (absorbing by `sigma` inside); without it glTF's transmission is thin-walled */
+#define MATERIAL_TINTED 16      /* specular_color (or its texture) tints the dielectric F0; else it is unread */
 
-/* glTF metallic-roughness, with KHR_materials_specular/transmission/ior/volume. */
+/* glTF metallic-roughness, with KHR_materials_specular/transmission/ior/volume
+ * and the layers and anisotropy Blender writes: KHR_materials_sheen,
+ * _clearcoat, _anisotropy (material/bsdf.h). Texture fields hold a Texture
+ * index + 1 (0: none). */
 typedef struct {
 	V3 base_color;      /* linear RGB factor */
 	int base_tex;       /* Texture index or -1; multiplies base_color */
@@ -94,8 +98,24 @@ typedef struct {
 	float normal_scale; /* its x and y scale */
 	int transmission_tex; /* Texture index + 1 (0: none): R multiplies transmission */
 	V3 sigma;           /* MATERIAL_VOLUME: absorption per unit length inside (Beer-Lambert), 0 = clear */
+	int specular_tex;   /* A multiplies specular */
+	V3 specular_color;  /* KHR_materials_specular colour factor: tints the dielectric F0 (white: none) */
+	int specular_color_tex; /* RGB (sRGB) multiplies specular_color */
+	V3 sheen_color;     /* KHR_materials_sheen colour factor; black: no sheen */
+	float sheen_roughness;
+	int sheen_color_tex;  /* RGB (sRGB) multiplies sheen_color */
+	int sheen_rough_tex;  /* A multiplies sheen_roughness */
+	float clearcoat;      /* KHR_materials_clearcoat factor; 0: no clear coat */
+	float clearcoat_roughness;
+	int clearcoat_tex;    /* R multiplies clearcoat */
+	int clearcoat_rough_tex; /* G multiplies clearcoat_roughness */
+	int clearcoat_normal_tex; /* the clear coat's own normal map (else the unmapped normal) */
+	float clearcoat_normal_scale;
+	float anisotropy;     /* KHR_materials_anisotropy strength; 0: isotropic */
+	float anisotropy_rotation; /* radians in [-pi, pi], counter-clockwise from the tangent */
+	int anisotropy_tex;   /* RG: direction in tangent space (2c - 1), B multiplies the strength */
 	int pad0;
-} Material; /* 96 */
+} Material; /* 176 */
 
 /* A texture as a material uses it: an RGBA8 image in the shared texel
  * array (decoded from sRGB only where it holds colour, surface.h), the

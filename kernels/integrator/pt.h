@@ -116,6 +116,7 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 			break;
 		Bsdf bs;
 		surface_bsdf(sc, &s, surface_base_color(sc, &s), &bs);
+		bsdf_cache_wo(&bs, wo); /* next-event estimation and sampling both start from wo */
 		/* The normal next-event samples are weighed by (env_portal.h): turned
 		 * toward wo here; pt's two densities at a vertex both read n_nee. */
 		V3 n_nee = v3_dot(s.ns, wo) < 0.0f ? v3_neg(s.ns) : s.ns;

@@ -239,6 +239,7 @@ CALLED int vertex_trace(const SceneView *sc, VRef path, int n, V3 o, V3 d, V3 be
 		surface_from_hit(sc, &h, &s);
 		v->base = surface_base_color(sc, &s);
 		surface_bsdf(sc, &s, v->base, &v->bs);
+		bsdf_cache_wo(&v->bs, v->wo); /* its lobes from wo: sampled and connected from there */
 #ifndef AJAR_NO_PANES
 		if (sc->tris[s.tri].flags & TRI_PANE) {
 			float pn = bsdf_null_prob(&v->bs, v->wo);

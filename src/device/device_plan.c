@@ -106,7 +106,9 @@ void device_render_options(const Device *d, int integrator, const DevicePlan *p,
 		    {KERNEL_OMIT_TEXTURES, "-DAJAR_NO_TEXTURES "},
 		    {KERNEL_OMIT_TRI_EXTRA, "-DAJAR_NO_TRI_EXTRA "},
 		    {KERNEL_OMIT_PANES, "-DAJAR_NO_PANES "},
-		    {KERNEL_OMIT_INSTANCES, "-DAJAR_NO_INSTANCES "}};
+		    {KERNEL_OMIT_INSTANCES, "-DAJAR_NO_INSTANCES "},
+		    {KERNEL_OMIT_LAYERS, "-DAJAR_NO_LAYERS "},
+		    {KERNEL_OMIT_ANISOTROPY, "-DAJAR_NO_ANISOTROPY "}};
 	device_build_options(d, integrator, NULL, buf, cap);
 	size_t n = strlen(buf);
 	if (p->soa)

@@ -11,7 +11,7 @@
 /* PathVertex, as the host reserves room for it: at most
  * DEVICE_VERTEX_WORDS 32-bit words (kernels/integrator/vertex.h refuses to build
  * otherwise), SUBPATH_MAX vertices a subpath. */
-#define DEVICE_VERTEX_WORDS 72
+#define DEVICE_VERTEX_WORDS 116
 #define DEVICE_SUBPATH_MAX 33
 typedef struct {
 	int soa;           /* subpaths in a global scratch buffer (-DAJAR_SUBPATH_SOA), else private arrays */

@@ -52,10 +52,13 @@ static int tri_may_tilt(const Tri *t, const TriShade *sh)
 
 /* The KERNEL_OMIT_* features that no triangle or material of the prepared
  * scene uses: alpha tests, tilted shading normals (the bend), textures,
- * TriExtra data. Emitters with textures or alpha count as using them. */
+ * TriExtra data, panes, the BSDF's layers (sheen, clear coat, specular
+ * colour) and anisotropy. Emitters with textures or alpha count as using
+ * them. */
 static unsigned kernel_omit(const SceneData *d)
 {
-	unsigned omit = KERNEL_OMIT_ALPHA | KERNEL_OMIT_BENT_NORMALS | KERNEL_OMIT_TRI_EXTRA | KERNEL_OMIT_PANES;
+	unsigned omit = KERNEL_OMIT_ALPHA | KERNEL_OMIT_BENT_NORMALS | KERNEL_OMIT_TRI_EXTRA | KERNEL_OMIT_PANES |
+			KERNEL_OMIT_LAYERS | KERNEL_OMIT_ANISOTROPY;
 	if (!d->n_instances)
 		omit |= KERNEL_OMIT_INSTANCES;
 	for (size_t i = 0; i < d->n_tris; i++) {
@@ -71,7 +74,14 @@ static unsigned kernel_omit(const SceneData *d)
 	int textured = 0;
 	for (size_t i = 0; i < d->n_materials; i++) {
 		const Material *m = &d->materials[i];
-		textured |= m->base_tex >= 0 || m->mr_tex || m->emissive_tex || m->normal_tex || m->transmission_tex;
+		textured |= m->base_tex >= 0 || m->mr_tex || m->emissive_tex || m->normal_tex || m->transmission_tex ||
+			    m->specular_tex || m->specular_color_tex || m->sheen_color_tex || m->sheen_rough_tex ||
+			    m->clearcoat_tex || m->clearcoat_rough_tex || m->clearcoat_normal_tex || m->anisotropy_tex;
+		if ((m->flags & MATERIAL_TINTED) || m->sheen_color.x > 0.0f || m->sheen_color.y > 0.0f ||
+		    m->sheen_color.z > 0.0f || m->clearcoat > 0.0f)
+			omit &= ~KERNEL_OMIT_LAYERS;
+		if (m->anisotropy > 0.0f)
+			omit &= ~KERNEL_OMIT_ANISOTROPY;
 	}
 	if (!textured)
 		omit |= KERNEL_OMIT_TEXTURES;

@@ -18,6 +18,8 @@
 #define KERNEL_OMIT_TRI_EXTRA 8u    /* -DAJAR_NO_TRI_EXTRA: no TRI_EXTRA triangle (TEXCOORD_1, COLOR_0, tangents) */
 #define KERNEL_OMIT_PANES 16u       /* -DAJAR_NO_PANES: no TRI_PANE triangle (thin glass that rays cross) */
 #define KERNEL_OMIT_INSTANCES 32u   /* -DAJAR_NO_INSTANCES: no instance (a one-level BVH, kernels/geom/bvh.h) */
+#define KERNEL_OMIT_LAYERS 64u      /* -DAJAR_NO_LAYERS: no sheen, clear coat or specular colour */
+#define KERNEL_OMIT_ANISOTROPY 128u /* -DAJAR_NO_ANISOTROPY: no anisotropic material */
 
 /* nodes, tris, shade, extra and texels are the scene's share's (one copy
  * of the geometry, scene_share.h), the rest this SceneData's own. */

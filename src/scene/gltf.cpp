@@ -43,8 +43,9 @@ namespace tg = tinygltf;
  * other cannot be shown correctly and is refused. */
 const char *const supported_extensions[] = {
 	"KHR_materials_emissive_strength", "KHR_materials_ior", "KHR_materials_specular",
-	"KHR_materials_transmission", "KHR_materials_volume", "KHR_mesh_quantization", "KHR_lights_punctual",
-	"KHR_texture_transform", "EXT_mesh_gpu_instancing",
+	"KHR_materials_transmission", "KHR_materials_volume", "KHR_materials_sheen", "KHR_materials_clearcoat",
+	"KHR_materials_anisotropy", "KHR_mesh_quantization", "KHR_lights_punctual", "KHR_texture_transform",
+	"EXT_mesh_gpu_instancing",
 };
 
 struct Loader {
@@ -581,17 +582,27 @@ void ext_unread(const Loader &L, int mi, const tg::ExtensionMap &exts, const cha
 		log_msg(AJAR_LOG_WARNING, "%s: materials[%d]: %s.%s is not supported; %s", L.file, mi, ext, key, instead);
 }
 
-/* KHR_materials_specular's specularColorFactor, if it is not white. */
-bool specular_tinted(const tg::ExtensionMap &exts)
+/* extensions[ext][key] as a colour: 3 finite numbers in [0, hi], or `def`
+ * if absent. */
+ajar_status ext_color(const Loader &L, int mi, const tg::ExtensionMap &exts, const char *ext, const char *key,
+		      const V3 &def, double hi, V3 *out)
 {
-	auto it = exts.find("KHR_materials_specular");
-	const tg::Value *c = it == exts.end() ? nullptr : value_member(it->second, "specularColorFactor");
-	if (!c || !c->IsArray())
-		return false;
-	for (size_t i = 0; i < c->ArrayLen(); i++)
-		if (!c->Get((int)i).IsNumber() || c->Get((int)i).GetNumberAsDouble() != 1.0)
-			return true;
-	return false;
+	*out = def;
+	auto it = exts.find(ext);
+	const tg::Value *c = it == exts.end() ? nullptr : value_member(it->second, key);
+	if (!c)
+		return AJAR_OK;
+	double v[3];
+	bool ok = c->IsArray() && c->ArrayLen() == 3;
+	for (int k = 0; ok && k < 3; k++) {
+		ok = c->Get(k).IsNumber();
+		v[k] = ok ? c->Get(k).GetNumberAsDouble() : 0.0;
+		ok = ok && v[k] >= 0.0 && v[k] <= hi;
+	}
+	if (!ok)
+		return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d]: %s.%s must be 3 numbers in [0, %g]", mi, ext, key, hi);
+	*out = v3((float)v[0], (float)v[1], (float)v[2]);
+	return AJAR_OK;
 }
 
 /* "resolution": [w, h] in an extras object, if there. */
@@ -870,6 +881,80 @@ ajar_status load_volume(Loader &L, int mi, const tg::ExtensionMap &exts, ::Mater
 	return AJAR_OK;
 }
 
+/* The material extensions load_material reads; any other on a material is
+ * named in a warning (KHR_materials_dispersion and _iridescence among
+ * them: Blender writes both). */
+const char *const material_extensions[] = {
+	"KHR_materials_emissive_strength", "KHR_materials_ior",      "KHR_materials_specular",
+	"KHR_materials_transmission",      "KHR_materials_volume",   "KHR_materials_sheen",
+	"KHR_materials_clearcoat",         "KHR_materials_anisotropy",
+};
+
+/* KHR_materials_specular (factor and colour with their textures), _sheen,
+ * _clearcoat and _anisotropy (kernels/material/bsdf.h, "Layers"). */
+ajar_status load_material_layers(Loader &L, int mi, const tg::ExtensionMap &exts, ::Material *m)
+{
+	ajar_status st;
+	double sheen_r, cc, cc_r, aniso, rot;
+	V3 tint, sheen;
+	int spec_t, tint_t, sheen_t, sheen_rt, cc_t, cc_rt, cc_nt, aniso_t;
+	if ((st = ext_color(L, mi, exts, "KHR_materials_specular", "specularColorFactor", v3(1.0f, 1.0f, 1.0f), 1e30,
+			    &tint)) ||
+	    (st = ext_texture(L, mi, exts, "KHR_materials_specular", "specularTexture", &spec_t)) ||
+	    (st = ext_texture(L, mi, exts, "KHR_materials_specular", "specularColorTexture", &tint_t)) ||
+	    (st = ext_color(L, mi, exts, "KHR_materials_sheen", "sheenColorFactor", v3(0.0f, 0.0f, 0.0f), 1.0, &sheen)) ||
+	    (st = ext_number(L, mi, exts, "KHR_materials_sheen", "sheenRoughnessFactor", 0.0, 0.0, 1.0, &sheen_r)) ||
+	    (st = ext_texture(L, mi, exts, "KHR_materials_sheen", "sheenColorTexture", &sheen_t)) ||
+	    (st = ext_texture(L, mi, exts, "KHR_materials_sheen", "sheenRoughnessTexture", &sheen_rt)) ||
+	    (st = ext_number(L, mi, exts, "KHR_materials_clearcoat", "clearcoatFactor", 0.0, 0.0, 1.0, &cc)) ||
+	    (st = ext_number(L, mi, exts, "KHR_materials_clearcoat", "clearcoatRoughnessFactor", 0.0, 0.0, 1.0, &cc_r)) ||
+	    (st = ext_texture(L, mi, exts, "KHR_materials_clearcoat", "clearcoatTexture", &cc_t)) ||
+	    (st = ext_texture(L, mi, exts, "KHR_materials_clearcoat", "clearcoatRoughnessTexture", &cc_rt)) ||
+	    (st = ext_texture(L, mi, exts, "KHR_materials_clearcoat", "clearcoatNormalTexture", &cc_nt)) ||
+	    (st = ext_number(L, mi, exts, "KHR_materials_anisotropy", "anisotropyStrength", 0.0, 0.0, 1.0, &aniso)) ||
+	    (st = ext_number(L, mi, exts, "KHR_materials_anisotropy", "anisotropyRotation", 0.0, -1e6, 1e6, &rot)) ||
+	    (st = ext_texture(L, mi, exts, "KHR_materials_anisotropy", "anisotropyTexture", &aniso_t)))
+		return st;
+	m->specular_tex = spec_t + 1;
+	m->specular_color = tint;
+	m->specular_color_tex = tint_t + 1;
+	if (tint_t >= 0 || tint.x != 1.0f || tint.y != 1.0f || tint.z != 1.0f)
+		m->flags |= MATERIAL_TINTED;
+	m->sheen_color = sheen;
+	m->sheen_roughness = (float)sheen_r;
+	m->sheen_color_tex = sheen_t + 1;
+	m->sheen_rough_tex = sheen_rt + 1;
+	m->clearcoat = (float)cc;
+	m->clearcoat_roughness = (float)cc_r;
+	m->clearcoat_tex = cc_t + 1;
+	m->clearcoat_rough_tex = cc_rt + 1;
+	m->clearcoat_normal_tex = cc_nt + 1;
+	m->clearcoat_normal_scale = 1.0f;
+	auto it = exts.find("KHR_materials_clearcoat");
+	const tg::Value *info = it == exts.end() ? nullptr : value_member(it->second, "clearcoatNormalTexture");
+	const tg::Value *scale = info ? value_member(*info, "scale") : nullptr;
+	if (scale) {
+		if (!scale->IsNumber() || !std::isfinite(scale->GetNumberAsDouble()))
+			return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d]: clearcoatNormalTexture.scale is not a finite number",
+				    mi);
+		m->clearcoat_normal_scale = (float)scale->GetNumberAsDouble();
+	}
+	m->anisotropy = (float)aniso;
+	m->anisotropy_rotation = (float)std::remainder(rot, 2.0 * M_PI); /* [-pi, pi] */
+	m->anisotropy_tex = aniso_t + 1;
+	if (aniso_t >= 0 && !(aniso > 0.0))
+		m->anisotropy_tex = 0; /* the texture's B multiplies a strength of 0 */
+	for (const auto &e : exts) {
+		bool known = false;
+		for (const char *k : material_extensions)
+			known = known || e.first == k;
+		if (!known)
+			log_msg(AJAR_LOG_WARNING, "%s: materials[%d] (%s): %s is not supported; ignored", L.file, mi,
+				L.model.materials[(size_t)mi].name.c_str(), e.first.c_str());
+	}
+	return AJAR_OK;
+}
+
 ajar_status in_unit(const Loader &L, int mi, const char *name, double v)
 {
 	if (!(v >= 0.0 && v <= 1.0))
@@ -909,11 +994,6 @@ ajar_status load_material(Loader &L, int mi, uint32_t *id)
 	    (st = ext_number(L, mi, gm.extensions, "KHR_materials_specular", "specularFactor", 1.0, 0.0, 1.0,
 			     &specular)))
 		return st;
-	ext_unread(L, mi, gm.extensions, "KHR_materials_specular", "specularTexture", "specularFactor alone is used");
-	ext_unread(L, mi, gm.extensions, "KHR_materials_specular", "specularColorTexture", "ignored");
-	if (specular_tinted(gm.extensions))
-		log_msg(AJAR_LOG_WARNING, "%s: materials[%d]: KHR_materials_specular.specularColorFactor is not supported; white is used",
-			L.file, mi);
 	if (!gm.emissiveFactor.empty()) {
 		if (gm.emissiveFactor.size() != 3)
 			return fail(L, AJAR_ERROR_BAD_INPUT, "materials[%d]: emissiveFactor has %zu numbers, expected 3", mi,
@@ -961,6 +1041,8 @@ ajar_status load_material(Loader &L, int mi, uint32_t *id)
 	    (st = load_volume(L, mi, gm.extensions, &m)))
 		return st;
 	m.transmission_tex = tr + 1;
+	if ((st = load_material_layers(L, mi, gm.extensions, &m)))
+		return st;
 	return scene_add_material(L.s, &m, id);
 }
 
@@ -1197,9 +1279,11 @@ ajar_status load_primitive(Loader &L, int mi, int pi, const double world[16], co
 	 * map's coordinate set. */
 	std::vector<float> tan;
 	const ::Material &sm = L.s->materials[mat];
-	if (sm.normal_tex) {
+	if (sm.normal_tex || sm.clearcoat_normal_tex || sm.anisotropy > 0.0f) {
+		/* the set of the normal map, the clear coat's, or TEXCOORD_0 */
+		int tex = sm.normal_tex ? sm.normal_tex : sm.clearcoat_normal_tex;
 		auto tit = pr.attributes.find("TANGENT");
-		std::vector<float> &set = L.s->textures[sm.normal_tex - 1].flags & TEX_UV1 ? uv1 : uv;
+		std::vector<float> &set = tex && (L.s->textures[tex - 1].flags & TEX_UV1) ? uv1 : uv;
 		if (tit != pr.attributes.end()) {
 			Packed pt;
 			if ((st = accessor_read(L, what, "TANGENT", tit->second, 4, pt)))
@@ -1671,6 +1755,15 @@ ajar_status load(Loader &L)
 			known = known || ext == s;
 		if (!known)
 			return fail(L, AJAR_ERROR_BAD_INPUT, "extensionsRequired: %s is not supported", ext.c_str());
+	}
+	for (const std::string &ext : m.extensionsUsed) { /* one warning each: none is ignored silently */
+		bool known = false;
+		for (const char *s : supported_extensions)
+			known = known || ext == s;
+		for (const tg::Material &gm : m.materials) /* those load_material names per material */
+			known = known || gm.extensions.count(ext);
+		if (!known)
+			log_msg(AJAR_LOG_WARNING, "%s: extensionsUsed: %s is not supported; ignored", L.file, ext.c_str());
 	}
 
 	L.image_textures.assign(m.images.size(), -1);

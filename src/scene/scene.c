@@ -117,11 +117,13 @@ ajar_status scene_add_material(Scene *s, const Material *m, uint32_t *id)
 	if (m->base_tex >= (int)s->ntextures || m->base_tex < -1)
 		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: material %u: texture %d does not exist (%u textures)",
 			       s->source, s->nmaterials, m->base_tex, s->ntextures);
-	if (m->mr_tex < 0 || m->mr_tex > (int)s->ntextures || m->emissive_tex < 0 ||
-	    m->emissive_tex > (int)s->ntextures || m->normal_tex < 0 || m->normal_tex > (int)s->ntextures ||
-	    m->transmission_tex < 0 || m->transmission_tex > (int)s->ntextures)
-		return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: material %u: texture %d or %d does not exist (%u textures)",
-			       s->source, s->nmaterials, m->mr_tex - 1, m->emissive_tex - 1, s->ntextures);
+	const int tex[] = {m->mr_tex,	       m->emissive_tex,	      m->normal_tex,	      m->transmission_tex,
+			   m->specular_tex,    m->specular_color_tex, m->sheen_color_tex,     m->sheen_rough_tex,
+			   m->clearcoat_tex,   m->clearcoat_rough_tex, m->clearcoat_normal_tex, m->anisotropy_tex};
+	for (size_t k = 0; k < sizeof tex / sizeof tex[0]; k++)
+		if (tex[k] < 0 || tex[k] > (int)s->ntextures)
+			return err_set(AJAR_ERROR_INVALID_ARGUMENT, "%s: material %u: texture %d does not exist (%u textures)",
+				       s->source, s->nmaterials, tex[k] - 1, s->ntextures);
 	ajar_status st = grow32((void **)&s->materials, &s->cap_materials, (size_t)s->nmaterials + 1,
 				sizeof *s->materials);
 	if (st)
@@ -284,8 +286,9 @@ ajar_status scene_add_triangles_ex(Scene *s, const char *what, const float *pos,
 					       s->source, what, i / 4);
 	if (tangents && !all_finite(tangents, 4 * (size_t)nverts))
 		return err_set(AJAR_ERROR_BAD_INPUT, "%s: %s: a tangent is not finite", s->source, what);
-	if (material < s->nmaterials && !s->materials[material].normal_tex)
-		tangents = NULL; /* only normal maps read them */
+	if (material < s->nmaterials && !s->materials[material].normal_tex && !s->materials[material].clearcoat_normal_tex &&
+	    !(s->materials[material].anisotropy > 0.0f))
+		tangents = NULL; /* only normal maps and anisotropy read them */
 	if ((st = scene_private(s)) != AJAR_OK)
 		return st;
 	if ((uvs1 || colors || tangents || s->extra) && (st = extra_reserve(s, what, ntris)))

@@ -16,7 +16,10 @@ strength 1). Ajar's `pt` and Cycles (the importer's node tree untouched,
 the camera's vertical field of view set as Ajar reads it) render it at
 ASSETS_SPP (256) samples per pixel, ASSETS_SIZE (192) wide, depth
 ASSETS_DEPTH (16), box pixel filter, no denoising or clamping, seeds 1 and
-2 each. The images are cut into 16 x 16-pixel blocks; per block the mean
+2 each. An entry "scene:<path>" (a .gltf under scenes/, e.g.
+scene:sofa-room/sofa-room.gltf) renders that scene as it is, with its own
+camera and constant sky (Cycles: the importer's camera, the sky's colour as
+the world), ASSETS_SIZE wide at the camera's aspect. The images are cut into 16 x 16-pixel blocks; per block the mean
 over its pixels and channels; a block matches if Ajar's and Cycles' means
 differ by at most ASSETS_TOL (5%) of Cycles'. Printed per asset: the
 fraction of matching blocks (all, and "object" blocks: those where Cycles
@@ -179,6 +182,9 @@ def cycles_main(argv):
 	bpy.ops.wm.read_factory_settings(use_empty=True)
 	bpy.ops.import_scene.gltf(filepath=path)
 	sc = bpy.context.scene
+	for o in list(sc.objects):  # portals (extras "portal", a custom property after import) are no surfaces
+		if o.get("portal"):
+			bpy.data.objects.remove(o, do_unlink=True)
 	cams = [o for o in sc.objects if o.type == "CAMERA"]
 	if len(cams) != 1:
 		raise SystemExit(f"assets: {path}: {len(cams)} cameras after import")
@@ -269,7 +275,14 @@ def main():
 	driver.ensure_ajar()
 	report = []
 	for name in names:
-		if name.startswith("glass:"):
+		if name.startswith("scene:"):
+			path = os.path.join(driver.ROOT, "scenes", name[6:])
+			g = json.load(open(path))
+			persp = g["cameras"][0]["perspective"]
+			yfov = persp["yfov"]
+			height = int(round(width / persp.get("aspectRatio", 1.0) / BLOCK)) * BLOCK
+			name = os.path.splitext(os.path.basename(path))[0]
+		elif name.startswith("glass:"):
 			height = width
 			path, yfov = write_glass_view(float(name[6:]), os.path.join(base, name.replace(":", "-")), width, height)
 			name = name.replace(":", "-")
@@ -296,7 +309,7 @@ def main():
 					if p.returncode != 0:
 						raise SystemExit(f"assets: cycles failed on {path}: {(p.stderr or p.stdout)[-800:]}")
 					rgb = np.load(out + ".npy").astype(np.float64)
-					os.remove(out + ".npy")
+					# kept: build/peers/assets/<name>-cycles-<seed>.npy, for a closer look
 				imgs[r].append(rgb)
 		a = (imgs["ajar"][0] + imgs["ajar"][1]) / 2
 		c = (imgs["cycles"][0] + imgs["cycles"][1]) / 2

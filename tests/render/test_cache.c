@@ -318,15 +318,17 @@ static void test_render_options(void **state)
 	p.omit = KERNEL_OMIT_ALPHA | KERNEL_OMIT_TEXTURES;
 	device_render_options(&cpu, 0, &p, "-cl-opt-disable", buf, sizeof buf);
 	assert_string_equal(buf, KERNEL_OPTIONS "0 -DAJAR_NO_ALPHA -DAJAR_NO_TEXTURES -cl-opt-disable");
-	p.omit = KERNEL_OMIT_ALPHA | KERNEL_OMIT_BENT_NORMALS | KERNEL_OMIT_TEXTURES | KERNEL_OMIT_TRI_EXTRA;
+	p.omit = KERNEL_OMIT_ALPHA | KERNEL_OMIT_BENT_NORMALS | KERNEL_OMIT_TEXTURES | KERNEL_OMIT_TRI_EXTRA |
+		 KERNEL_OMIT_LAYERS | KERNEL_OMIT_ANISOTROPY;
 	p.soa = 1;
 	p.capacity = 128;
 	device_render_options(&gpu, 1, &p, NULL, buf, sizeof buf);
-	assert_string_equal(buf, KERNEL_OPTIONS "1 -DAJAR_CALLS -DAJAR_SUBPATH_SOA=128 -DAJAR_SUBPATH_WORDS=72 "
-					  "-DAJAR_NO_ALPHA -DAJAR_NO_BENT_NORMALS -DAJAR_NO_TEXTURES -DAJAR_NO_TRI_EXTRA ");
+	assert_string_equal(buf, KERNEL_OPTIONS "1 -DAJAR_CALLS -DAJAR_SUBPATH_SOA=128 -DAJAR_SUBPATH_WORDS=116 "
+					  "-DAJAR_NO_ALPHA -DAJAR_NO_BENT_NORMALS -DAJAR_NO_TEXTURES -DAJAR_NO_TRI_EXTRA "
+					  "-DAJAR_NO_LAYERS -DAJAR_NO_ANISOTROPY ");
 	p.general = 1;
 	device_render_options(&gpu, 1, &p, NULL, buf, sizeof buf);
-	assert_string_equal(buf, KERNEL_OPTIONS "1 -DAJAR_CALLS -DAJAR_SUBPATH_SOA=128 -DAJAR_SUBPATH_WORDS=72 ");
+	assert_string_equal(buf, KERNEL_OPTIONS "1 -DAJAR_CALLS -DAJAR_SUBPATH_SOA=128 -DAJAR_SUBPATH_WORDS=116 ");
 	/* The planes' sky tables: an option only where they are not the kernels' default size. */
 	DevicePlan q = {.sky_res = 128};
 	device_render_options(&cpu, 0, &q, NULL, buf, sizeof buf);

@@ -195,6 +195,10 @@ static void test_window_room_small_sun(void **state)
 	g_over = (PolicyOverrides){0};
 }
 static void test_door_ajar(void **state) { compare(SCENE("door-ajar/door-ajar.gltf"), 24, 24, 512, 128); }
+
+/* The materials of issue 44 (kernels/material/bsdf.h, "Layers"): a sheen
+ * sofa, a clear-coated floor and an anisotropic steel table under a sky. */
+static void test_sofa_room(void **state) { compare(SCENE("sofa-room/sofa-room-table.gltf"), 32, 18, 64, 16); }
 /* Glazed windows (scenes/skies/make_glazed.py): a thin pane 2 cm inside
  * each window, crossed by every strategy (kernels/geom/visibility.h). */
 static void test_window_room_glazed(void **state)
@@ -346,6 +350,7 @@ int main(void)
 		cmocka_unit_test(test_window_room_glazed), cmocka_unit_test(test_living_room_forest_glazed), cmocka_unit_test(test_door_ajar),
 		cmocka_unit_test(test_door_ajar_lamp),
 		cmocka_unit_test(test_atrium_forest),
+		cmocka_unit_test(test_sofa_room),
 		cmocka_unit_test(test_cornell_punctual),
 		cmocka_unit_test(test_window_room_punctual),
 		cmocka_unit_test(test_normal_alpha),

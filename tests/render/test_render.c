@@ -379,15 +379,16 @@ static unsigned scene_omit(const char *path)
 }
 
 /* Feature-specialised programs (kernels/material/README.md): the Cornell box
- * has no alpha, no tilted normals, no textures, no TriExtra, no panes and no
- * instances, so its program is built with all six -DAJAR_NO_* options, and renders the same bits as
+ * has no alpha, no tilted normals, no textures, no TriExtra, no panes, no
+ * instances, no layers and no anisotropy, so its program is built with all
+ * eight -DAJAR_NO_* options, and renders the same bits as
  * the general program (AJAR_KERNEL_FEATURES=all); scenes that have a
  * feature keep its code; a malformed AJAR_KERNEL_FEATURES is refused. */
 static void test_kernel_features(void **state)
 {
 	(void)state;
 	const unsigned all = KERNEL_OMIT_ALPHA | KERNEL_OMIT_BENT_NORMALS | KERNEL_OMIT_TEXTURES | KERNEL_OMIT_TRI_EXTRA |
-			     KERNEL_OMIT_PANES | KERNEL_OMIT_INSTANCES;
+			     KERNEL_OMIT_PANES | KERNEL_OMIT_INSTANCES | KERNEL_OMIT_LAYERS | KERNEL_OMIT_ANISOTROPY;
 	assert_int_equal(scene_omit(SCENE("cornell/cornell.gltf")), all);
 	/* A glazed room has panes. */
 	assert_int_equal(scene_omit(SCENE("window-room/window-room-glazed.gltf")) & KERNEL_OMIT_PANES, 0);
@@ -397,6 +398,11 @@ static void test_kernel_features(void **state)
 	assert_int_equal(nmap & (KERNEL_OMIT_BENT_NORMALS | KERNEL_OMIT_TEXTURES | KERNEL_OMIT_TRI_EXTRA), 0);
 	unsigned colour = scene_omit(SCENE("khronos/VertexColorTest/VertexColorTest.gltf"));
 	assert_int_equal(colour & KERNEL_OMIT_TRI_EXTRA, 0);
+	/* Layers and anisotropy keep their code where a material has them. */
+	assert_int_equal(scene_omit(SCENE("sofa-room/sofa-room.gltf")) & (KERNEL_OMIT_LAYERS | KERNEL_OMIT_ANISOTROPY),
+			 KERNEL_OMIT_ANISOTROPY);
+	assert_int_equal(scene_omit(SCENE("sofa-room/sofa-room-table.gltf")) & (KERNEL_OMIT_LAYERS | KERNEL_OMIT_ANISOTROPY),
+			 0);
 
 	ajar_scene *s;
 	assert_int_equal(ajar_scene_load(SCENE("cornell/cornell.gltf"), &s), AJAR_OK);

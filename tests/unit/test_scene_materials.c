@@ -14,6 +14,9 @@
 
 #include "geom/surface.h"
 
+/* A 4 x 4 PNG (the one of uv_gltf below), for texture slots. */
+#define UV_PNG_LAYERS "iVBORw0KGgoAAAANSUhEUgAAAAQAAAAECAYAAACp8Z5+AAAAK0lEQVR4nBXIMQEAMBACMWaEIQxhWGvvhyyRrRcUgxwCxXJRAsV6MQLF8AFZeRxxtxm5jwAAAABJRU5ErkJggg=="
+
 static void test_non_indexed_and_materials(void **state)
 {
 	/* Two non-indexed triangles, drawn twice: with a material using every
@@ -62,8 +65,9 @@ static void test_non_indexed_and_materials(void **state)
 static void test_unread_extension_members(void **state)
 {
 	(void)state;
-	/* Members of the extensions we read that we do not use: one warning
-	 * each, naming it; the factors still apply. */
+	/* Members of the extensions we read that we do not use, and material
+	 * extensions we do not read: one warning each, naming it; the factors
+	 * still apply. */
 	const float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
 	write_bytes("unread.bin", pos, sizeof pos);
 	const char *head = "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
@@ -79,10 +83,13 @@ static void test_unread_extension_members(void **state)
 		{"\"KHR_materials_transmission\":{\"transmissionFactor\":0.5},"
 		 "\"KHR_materials_volume\":{\"thicknessFactor\":0.1,\"thicknessTexture\":{\"index\":0}}",
 		 "KHR_materials_volume.thicknessTexture is not supported", 1},
-		{"\"KHR_materials_specular\":{\"specularFactor\":0.5,\"specularColorFactor\":[1,0.5,1],"
-		 "\"specularTexture\":{\"index\":0}}",
-		 "specularColorFactor is not supported", 2},
 		{"\"KHR_materials_specular\":{\"specularFactor\":0.5,\"specularColorFactor\":[1,1,1]}", "", 0},
+		/* extensions Blender writes that Ajar does not model: one warning
+		 * each, naming the material and the extension */
+		{"\"KHR_materials_specular\":{\"specularFactor\":0.5},\"KHR_materials_dispersion\":{\"dispersion\":0.1}",
+		 "KHR_materials_dispersion is not supported", 1},
+		{"\"KHR_materials_specular\":{\"specularFactor\":0.5},\"KHR_materials_iridescence\":{\"iridescenceFactor\":1}",
+		 "KHR_materials_iridescence is not supported", 1},
 	};
 	for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
 		char json[2048];
@@ -98,6 +105,79 @@ static void test_unread_extension_members(void **state)
 			fail_msg("case %zu: warning \"%s\"", k, last_warning);
 		assert_float_equal(k == 0 ? s->materials[0].transmission : s->materials[0].specular, 0.5f, 0.0);
 		ajar_scene_destroy(&s);
+	}
+}
+
+/* KHR_materials_sheen, _clearcoat, _anisotropy and _specular's colour and
+ * textures: every factor and texture arrives (textures + 1), the specular
+ * colour sets MATERIAL_TINTED only where it is not white, the rotation is
+ * kept in [-pi, pi], tangents are generated for an anisotropic material
+ * without a normal map; bad values are bad input naming the member. */
+static void test_layer_extensions(void **state)
+{
+	(void)state;
+	const float pos_uv[15] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 1};
+	write_bytes("layers.bin", pos_uv, 60);
+	const char *fmt =
+		"{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+		"\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"material\":0}]}],"
+		"\"materials\":[{\"extensions\":{%s}}],\"textures\":[{\"source\":0}],"
+		"\"images\":[{\"uri\":\"data:image/png;base64," UV_PNG_LAYERS "\"}],"
+		"\"buffers\":[{\"uri\":\"layers.bin\",\"byteLength\":60}],"
+		"\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24}],"
+		"\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+		"{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"}]}";
+	char json[4096];
+	snprintf(json, sizeof json, fmt,
+		 "\"KHR_materials_sheen\":{\"sheenColorFactor\":[0.9,0.5,0.25],\"sheenRoughnessFactor\":0.4,"
+		 "\"sheenColorTexture\":{\"index\":0},\"sheenRoughnessTexture\":{\"index\":0}},"
+		 "\"KHR_materials_clearcoat\":{\"clearcoatFactor\":0.75,\"clearcoatRoughnessFactor\":0.125,"
+		 "\"clearcoatTexture\":{\"index\":0},\"clearcoatRoughnessTexture\":{\"index\":0},"
+		 "\"clearcoatNormalTexture\":{\"index\":0,\"scale\":0.5}},"
+		 "\"KHR_materials_anisotropy\":{\"anisotropyStrength\":0.6,\"anisotropyRotation\":7.0,"
+		 "\"anisotropyTexture\":{\"index\":0}},"
+		 "\"KHR_materials_specular\":{\"specularFactor\":0.5,\"specularColorFactor\":[1,0.5,2],"
+		 "\"specularTexture\":{\"index\":0},\"specularColorTexture\":{\"index\":0}}");
+	write_text("layers.gltf", json);
+	warnings = 0;
+	ajar_set_log_callback(count_warnings, NULL);
+	Scene *s = load_ok("layers.gltf");
+	ajar_set_log_callback(NULL, NULL);
+	assert_int_equal(warnings, 0);
+	const Material *m = &s->materials[0];
+	assert_v3(m->sheen_color, 0.9f, 0.5f, 0.25f);
+	assert_float_equal(m->sheen_roughness, 0.4f, 1e-7);
+	assert_float_equal(m->clearcoat, 0.75f, 0.0);
+	assert_float_equal(m->clearcoat_roughness, 0.125f, 0.0);
+	assert_float_equal(m->clearcoat_normal_scale, 0.5f, 0.0);
+	assert_float_equal(m->anisotropy, 0.6f, 1e-7);
+	assert_float_equal(m->anisotropy_rotation, 7.0 - 2 * M_PI, 1e-6);
+	assert_float_equal(m->specular, 0.5f, 0.0);
+	assert_v3(m->specular_color, 1.0f, 0.5f, 2.0f);
+	assert_true(m->flags & MATERIAL_TINTED);
+	const int tex[] = {m->sheen_color_tex, m->sheen_rough_tex, m->clearcoat_tex, m->clearcoat_rough_tex,
+			   m->clearcoat_normal_tex, m->anisotropy_tex, m->specular_tex, m->specular_color_tex};
+	for (int k = 0; k < 8; k++)
+		assert_true(tex[k] >= 1 && tex[k] <= (int)s->ntextures);
+	assert_true(s->tris[0].flags & TRI_TANGENT); /* anisotropy: tangents generated from TEXCOORD_0 */
+	ajar_scene_destroy(&s);
+
+	/* White specular colour: no tint; out-of-range values refused. */
+	snprintf(json, sizeof json, fmt, "\"KHR_materials_specular\":{\"specularColorFactor\":[1,1,1]}");
+	write_text("layers.gltf", json);
+	s = load_ok("layers.gltf");
+	assert_false(s->materials[0].flags & MATERIAL_TINTED);
+	assert_int_equal(s->materials[0].anisotropy_tex, 0);
+	ajar_scene_destroy(&s);
+	const char *bad[] = {"\"KHR_materials_sheen\":{\"sheenColorFactor\":[2,0,0]}",
+			     "\"KHR_materials_clearcoat\":{\"clearcoatFactor\":-1}",
+			     "\"KHR_materials_anisotropy\":{\"anisotropyStrength\":1.5}",
+			     "\"KHR_materials_specular\":{\"specularColorFactor\":[1,1]}"};
+	const char *member[] = {"sheenColorFactor", "clearcoatFactor", "anisotropyStrength", "specularColorFactor"};
+	for (int k = 0; k < 4; k++) {
+		snprintf(json, sizeof json, fmt, bad[k]);
+		write_text("layers.gltf", json);
+		load_fails("layers.gltf", AJAR_ERROR_BAD_INPUT, member[k]);
 	}
 }
 
@@ -268,7 +348,7 @@ static void test_texture_coordinates(void **state)
 /* ---- The Khronos sample assets (scenes/khronos) ---------------------------
  * Each loads without a warning, and what it exercises arrives: required
  * KHR_texture_transform, clamp and mirror samplers, TEXCOORD_1, COLOR_0,
- * MASK and BLEND. */
+ * MASK and BLEND, sheen, clear coat and anisotropy. */
 typedef struct {
 	int warnings;
 	char last[512];
@@ -359,6 +439,36 @@ static void test_khronos_assets(void **state)
 
 	s = load_asset("EmissiveStrengthTest", &in);
 	assert_true(in.emissive_triangles > 0);
+	ajar_scene_destroy(&s);
+
+	/* The layers and anisotropy Blender writes (issue 44). */
+	s = load_asset("SheenCloth", &in);
+	assert_true(s->materials[0].sheen_color_tex && s->materials[0].sheen_rough_tex);
+	assert_float_equal(s->materials[0].sheen_roughness, 1.0f, 0.0);
+	ajar_scene_destroy(&s);
+	s = load_asset("ClearcoatWicker", &in);
+	assert_float_equal(s->materials[0].clearcoat, 1.0f, 0.0);
+	assert_float_equal(s->materials[0].clearcoat_roughness, 0.1f, 1e-7);
+	assert_true(s->materials[0].clearcoat_normal_tex && s->materials[0].normal_tex);
+	ajar_scene_destroy(&s);
+	s = load_asset("AnisotropyStrengthTest", &in);
+	int aniso = 0;
+	for (uint32_t i = 0; i < s->nmaterials; i++)
+		aniso += s->materials[i].anisotropy > 0.0f;
+	assert_int_equal(aniso, 42); /* 7 roughnesses x strengths 1/6 .. 1 */
+	ajar_scene_destroy(&s);
+	s = load_asset("AnisotropyRotationTest", &in);
+	int turned = 0, textured = 0;
+	for (uint32_t i = 0; i < s->nmaterials; i++) {
+		turned += s->materials[i].anisotropy_rotation != 0.0f;
+		textured += s->materials[i].anisotropy_tex != 0;
+	}
+	assert_int_equal(turned, 2);
+	assert_int_equal(textured, 2);
+	uint32_t tangents = 0;
+	for (uint32_t i = 0; i < s->ntris; i++)
+		tangents += (s->tris[i].flags & TRI_TANGENT) != 0;
+	assert_true(tangents > 0);
 	ajar_scene_destroy(&s);
 }
 
@@ -492,7 +602,7 @@ int main(void)
 		cmocka_unit_test(test_unread_extension_members),
 		cmocka_unit_test(test_volume_and_transmission),
 		cmocka_unit_test(test_texture_coordinates),
-		cmocka_unit_test(test_khronos_assets),
+		cmocka_unit_test(test_khronos_assets), cmocka_unit_test(test_layer_extensions),
 		cmocka_unit_test(test_generated_tangents),
 		cmocka_unit_test(test_normal_map),
 	};
