@@ -55,7 +55,11 @@ TESTS := $(UNIT_TESTS) $(notdir $(basename $(wildcard tests/render/test_*.c test
 
 # One test binary per module, linking only what it tests (plus error.o).
 obj = $(addprefix $(BUILD)/src/,$(addsuffix .o,$(1)))
-DEPS_test_bsdf := $(call obj,core/error)
+# The BSDF's tests share tests/support/bsdf_check.c (materials, chi-square, albedo).
+BSDF_DEPS := $(BUILD)/tests/bsdf_check.o $(call obj,core/error)
+DEPS_test_bsdf := $(BSDF_DEPS)
+DEPS_test_bsdf_bent := $(BSDF_DEPS)
+DEPS_test_bsdf_layers := $(BSDF_DEPS)
 DEPS_test_sampling := $(call obj,core/error)
 # The BVH build: its driver and threads, the node split, the wide collapse.
 BVH_OBJS := prepare/bvh_build prepare/bvh_split prepare/bvh_collapse core/workers
