@@ -38,7 +38,9 @@
  *     panes). Portals face the side their lines come from.
  *
  * A scene without openings (a closed box, a room lit only by a lamp in it)
- * gets none: nothing escapes, and lit points inside fail the ring test. */
+ * gets none: nothing escapes, and lit points inside fail the ring test.
+ * Here: the driver and light behind a rectangle; the steps' code is in
+ * portal_find_{rays,room,crossings,planes,cells}.c (portal_find_parts.h). */
 #include "prepare/portal_find_parts.h"
 
 #include <time.h>
