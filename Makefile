@@ -55,11 +55,18 @@ TESTS := $(UNIT_TESTS) $(notdir $(basename $(wildcard tests/render/test_*.c test
 
 # One test binary per module, linking only what it tests (plus error.o).
 obj = $(addprefix $(BUILD)/src/,$(addsuffix .o,$(1)))
-DEPS_test_bsdf := $(call obj,core/error)
+# The BSDF's tests share tests/support/bsdf_check.c (materials, chi-square, albedo).
+BSDF_DEPS := $(BUILD)/tests/bsdf_check.o $(call obj,core/error)
+DEPS_test_bsdf := $(BSDF_DEPS)
+DEPS_test_bsdf_bent := $(BSDF_DEPS)
+DEPS_test_bsdf_layers := $(BSDF_DEPS)
 DEPS_test_sampling := $(call obj,core/error)
+# The glTF loader: the C++ file on tinygltf and its parts in C (src/scene/gltf_parts.h).
+GLTF_OBJS := scene/gltf scene/gltf_transform scene/gltf_decode scene/gltf_instancing scene/gltf_confine \
+	scene/gltf_extensions
 # The BVH build: its driver and threads, the node split, the wide collapse.
 BVH_OBJS := prepare/bvh_build prepare/bvh_split prepare/bvh_collapse core/workers
-DEPS_test_bvh := $(call obj,core/error core/input_file scene/scene scene/emit_mask scene/scene_share core/big_array $(BVH_OBJS) scene/gltf scene/tangents image/texture_file image/exr image/exr_read image/hdr)
+DEPS_test_bvh := $(call obj,core/error core/input_file scene/scene scene/emit_mask scene/scene_share core/big_array $(BVH_OBJS) $(GLTF_OBJS) scene/tangents image/texture_file image/exr image/exr_read image/hdr)
 # The light tests share tests/support/lit.c (the kernels' light code inside).
 LIGHT_DEPS := $(BUILD)/tests/lit.o $(call obj,core/error core/input_file scene/scene scene/emit_mask scene/scene_share core/big_array prepare/light_tables image/exr image/exr_read image/hdr)
 DEPS_test_lights_env := $(LIGHT_DEPS) $(call obj,prepare/portal_flux)
@@ -68,7 +75,7 @@ DEPS_test_lights_sample := $(LIGHT_DEPS)
 DEPS_test_lights_sky_planes := $(LIGHT_DEPS) $(call obj,prepare/sky_tables)
 DEPS_test_lights_sky_planes_fine := $(patsubst %/lit.o,%/lit_fine.o,$(DEPS_test_lights_sky_planes))
 # The scene module: the loader, the API's scene calls, the images a scene reads.
-SCENE_DEPS := $(call obj,core/error core/input_file scene/scene scene/emit_mask scene/scene_share core/big_array scene/scene_api scene/gltf scene/tangents image/texture_file image/exr image/exr_read image/hdr)
+SCENE_DEPS := $(call obj,core/error core/input_file scene/scene scene/emit_mask scene/scene_share core/big_array scene/scene_api $(GLTF_OBJS) scene/tangents image/texture_file image/exr image/exr_read image/hdr)
 DEPS_test_scene_shipped := $(BUILD)/tests/scene_files.o $(SCENE_DEPS)
 DEPS_test_scene_api := $(BUILD)/tests/scene_files.o $(SCENE_DEPS)
 DEPS_test_scene_gltf := $(BUILD)/tests/scene_files.o $(SCENE_DEPS)
@@ -76,9 +83,12 @@ DEPS_test_scene_materials := $(BUILD)/tests/scene_files.o $(SCENE_DEPS)
 DEPS_test_scene_env := $(BUILD)/tests/scene_files.o $(SCENE_DEPS)
 DEPS_test_exr := $(call obj,core/error core/input_file image/exr image/exr_read image/png)
 DEPS_test_confine := $(SCENE_DEPS) $(call obj,image/png)
+# The portal search: its driver and its steps (src/prepare/portal_find_parts.h).
+PORTAL_FIND_OBJS := prepare/portal_find prepare/portal_find_rays prepare/portal_find_room prepare/portal_find_crossings \
+	prepare/portal_find_planes prepare/portal_find_cells
 # The kernels' integrators run on the host (tests/support/kernel_host.c) on
 # scenes as prepare_scene makes them; the MIS tests add the oracle.
-HOST_DEPS := $(BUILD)/tests/kernel_host.o $(call obj,core/error core/input_file scene/scene scene/emit_mask scene/scene_share core/big_array scene/scene_api scene/gltf scene/tangents image/texture_file image/exr image/exr_read image/hdr $(BVH_OBJS) prepare/light_tables prepare/prepare prepare/scene_bvh prepare/policy prepare/portal_flux prepare/sky_tables prepare/portal_find prepare/found_portals render/render_options)
+HOST_DEPS := $(BUILD)/tests/kernel_host.o $(call obj,core/error core/input_file scene/scene scene/emit_mask scene/scene_share core/big_array scene/scene_api $(GLTF_OBJS) scene/tangents image/texture_file image/exr image/exr_read image/hdr $(BVH_OBJS) prepare/light_tables prepare/prepare prepare/scene_bvh prepare/policy prepare/portal_flux prepare/sky_tables $(PORTAL_FIND_OBJS) prepare/found_portals render/render_options)
 DEPS_test_bdpt := $(BUILD)/tests/mis_oracle.o $(HOST_DEPS)
 DEPS_test_punctual := $(HOST_DEPS)
 DEPS_test_scene_share := $(HOST_DEPS)

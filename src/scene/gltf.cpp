@@ -11,7 +11,9 @@
  * read here is bounds-checked, and every message names the file and the
  * element (`room.gltf: meshes[2].primitives[0]: accessors[7] (NORMAL): ...`).
  * Geometry leaves in world space: positions by the node's world matrix,
- * normals by its inverse transpose, winding reversed where it mirrors. */
+ * normals by its inverse transpose, winding reversed where it mirrors.
+ * What needs no tinygltf type is C, declared in gltf_parts.h: matrices,
+ * decoding, the instancing rule, the scene-folder test, the extensions. */
 #include <tiny_gltf.h>
 
 #include <cerrno>
@@ -33,20 +35,22 @@
 #include "core/input_file.h"
 #include "image/texture_file.h"
 #include "scene/gltf.h"
+#include "scene/gltf_parts.h"
 #include "scene/tangents.h"
+
+/* gltf_parts.h's codes are glTF's, as tinygltf's are. */
+static_assert(GLTF_BYTE == TINYGLTF_COMPONENT_TYPE_BYTE && GLTF_UNSIGNED_BYTE == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+		      GLTF_SHORT == TINYGLTF_COMPONENT_TYPE_SHORT &&
+		      GLTF_UNSIGNED_SHORT == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+		      GLTF_UNSIGNED_INT == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT && GLTF_FLOAT == TINYGLTF_COMPONENT_TYPE_FLOAT &&
+		      GLTF_MODE_TRIANGLES == TINYGLTF_MODE_TRIANGLES &&
+		      GLTF_MODE_TRIANGLE_STRIP == TINYGLTF_MODE_TRIANGLE_STRIP &&
+		      GLTF_MODE_TRIANGLE_FAN == TINYGLTF_MODE_TRIANGLE_FAN,
+	      "glTF's codes");
 
 namespace {
 
 namespace tg = tinygltf;
-
-/* Extensions whose meaning the loader implements; a file that requires any
- * other cannot be shown correctly and is refused. */
-const char *const supported_extensions[] = {
-	"KHR_materials_emissive_strength", "KHR_materials_ior", "KHR_materials_specular",
-	"KHR_materials_transmission", "KHR_materials_volume", "KHR_materials_sheen", "KHR_materials_clearcoat",
-	"KHR_materials_anisotropy", "KHR_mesh_quantization", "KHR_lights_punctual", "KHR_texture_transform",
-	"EXT_mesh_gpu_instancing",
-};
 
 struct Loader {
 	const char *file;
@@ -101,10 +105,10 @@ bool confined(Loader &L, const std::string &path, const std::string &uri)
 	if (L.allow_outside)
 		return true;
 	char real[PATH_MAX];
-	if (!realpath(path.c_str(), real))
+	int r = gltf_path_inside(L.root.c_str(), path.c_str(), real);
+	if (r < 0)
 		return false;
-	size_t n = L.root.size();
-	bool inside = strncmp(real, L.root.c_str(), n) == 0 && (real[n] == '\0' || real[n] == '/' || L.root == "/");
+	bool inside = r > 0;
 	if (!inside && L.refused.empty())
 		L.refused = "'" + uri + "' resolves to " + real + ", outside the scene's folder " + L.root +
 			    " (allow it with --allow-outside-files or ajar_load_options.allow_outside_files)";
@@ -226,19 +230,6 @@ bool load_image(tg::Image *im, const int i, std::string *err, std::string *, int
 
 /* ---- Accessors ---------------------------------------------------------- */
 
-int component_size(int type)
-{
-	switch (type) {
-	case TINYGLTF_COMPONENT_TYPE_BYTE:
-	case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
-	case TINYGLTF_COMPONENT_TYPE_SHORT:
-	case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
-	case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-	case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
-	}
-	return 0;
-}
-
 int type_components(int type)
 {
 	switch (type) {
@@ -292,7 +283,7 @@ ajar_status accessor_read(const Loader &L, const std::string &ctx, const char *a
 	char what[512];
 	snprintf(what, sizeof what, "%s: accessors[%d] (%s)", ctx.c_str(), idx, attr);
 	const tg::Accessor &a = m.accessors[(size_t)idx];
-	int csize = component_size(a.componentType), nc = type_components(a.type);
+	int csize = gltf_component_size(a.componentType), nc = type_components(a.type);
 	if (!csize)
 		return fail(L, AJAR_ERROR_BAD_INPUT, "%s: unsupported componentType %d", what, a.componentType);
 	if (nc != ncomp)
@@ -335,7 +326,7 @@ ajar_status accessor_read(const Loader &L, const std::string &ctx, const char *a
 
 	if (a.sparse.isSparse) {
 		const auto &sp = a.sparse;
-		int isize = component_size(sp.indices.componentType);
+		int isize = gltf_component_size(sp.indices.componentType);
 		if (sp.count < 0 || (size_t)sp.count > a.count || sp.indices.byteOffset < 0 || sp.values.byteOffset < 0 ||
 		    isize == 0 || sp.indices.componentType == TINYGLTF_COMPONENT_TYPE_BYTE ||
 		    sp.indices.componentType == TINYGLTF_COMPONENT_TYPE_SHORT ||
@@ -374,46 +365,10 @@ ajar_status accessor_read(const Loader &L, const std::string &ctx, const char *a
 	return AJAR_OK;
 }
 
-/* One component as a float; normalized integers map to [0, 1] or [-1, 1]
- * as glTF specifies. */
-float component_float(const uint8_t *b, int ctype, bool normalized)
-{
-	switch (ctype) {
-	case TINYGLTF_COMPONENT_TYPE_FLOAT: {
-		float f;
-		memcpy(&f, b, 4);
-		return f;
-	}
-	case TINYGLTF_COMPONENT_TYPE_BYTE: {
-		int8_t v;
-		memcpy(&v, b, 1);
-		return normalized ? std::fmax(v / 127.0f, -1.0f) : (float)v;
-	}
-	case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? b[0] / 255.0f : (float)b[0];
-	case TINYGLTF_COMPONENT_TYPE_SHORT: {
-		int16_t v;
-		memcpy(&v, b, 2);
-		return normalized ? std::fmax(v / 32767.0f, -1.0f) : (float)v;
-	}
-	case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-		uint16_t v;
-		memcpy(&v, b, 2);
-		return normalized ? v / 65535.0f : (float)v;
-	}
-	default: { /* UNSIGNED_INT */
-		uint32_t v;
-		memcpy(&v, b, 4);
-		return normalized ? (float)(v / 4294967295.0) : (float)v;
-	}
-	}
-}
-
 std::vector<float> to_floats(const Packed &p)
 {
-	int cs = component_size(p.ctype);
 	std::vector<float> out(p.count * (size_t)p.ncomp);
-	for (size_t i = 0; i < out.size(); i++)
-		out[i] = component_float(&p.bytes[i * (size_t)cs], p.ctype, p.normalized);
+	gltf_to_floats(p.bytes.data(), out.size(), p.ctype, p.normalized, out.data());
 	return out;
 }
 
@@ -423,65 +378,20 @@ ajar_status to_indices(const Loader &L, const std::string &ctx, int acc, const P
 	    p.ctype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
 		return fail(L, AJAR_ERROR_BAD_INPUT, "%s: accessors[%d] (indices): componentType %d is not an unsigned integer",
 			    ctx.c_str(), acc, p.ctype);
-	int cs = component_size(p.ctype);
 	out.resize(p.count);
-	for (size_t i = 0; i < p.count; i++) {
-		const uint8_t *b = &p.bytes[i * (size_t)cs];
-		if (cs == 1) {
-			out[i] = b[0];
-		} else if (cs == 2) {
-			uint16_t v;
-			memcpy(&v, b, 2);
-			out[i] = v;
-		} else {
-			memcpy(&out[i], b, 4);
-		}
-	}
+	gltf_to_indices(p.bytes.data(), p.count, gltf_component_size(p.ctype), out.data());
 	return AJAR_OK;
 }
 
 /* ---- Transforms (column-major 4x4, element (r, c) at [4c + r]) --------- */
-
-void mat_identity(double m[16])
-{
-	for (int i = 0; i < 16; i++)
-		m[i] = (i % 5 == 0) ? 1.0 : 0.0;
-}
-
-void mat_mul(const double a[16], const double b[16], double r[16])
-{
-	for (int c = 0; c < 4; c++)
-		for (int row = 0; row < 4; row++) {
-			double sum = 0.0;
-			for (int k = 0; k < 4; k++)
-				sum += a[4 * k + row] * b[4 * c + k];
-			r[4 * c + row] = sum;
-		}
-}
 
 /* T * R * S (translation, rotation quaternion x y z w, scale) as a
  * matrix; `what` names the node for the message of a zero quaternion. */
 ajar_status trs_matrix(const Loader &L, const char *what, const double t[3], const double q[4], const double s[3],
 		       double m[16])
 {
-	double ql = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-	if (!(ql > 0.0) || !std::isfinite(ql))
+	if (!gltf_trs_matrix(t, q, s, m))
 		return fail(L, AJAR_ERROR_BAD_INPUT, "%s: rotation is a zero quaternion", what);
-	double x = q[0] / ql, y = q[1] / ql, z = q[2] / ql, w = q[3] / ql;
-	double r[3][3] = {
-		{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
-		{2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
-		{2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)},
-	};
-	for (int c = 0; c < 3; c++) {
-		for (int row = 0; row < 3; row++)
-			m[4 * c + row] = r[row][c] * s[c];
-		m[4 * c + 3] = 0.0;
-	}
-	m[12] = t[0];
-	m[13] = t[1];
-	m[14] = t[2];
-	m[15] = 1.0;
 	return AJAR_OK;
 }
 
@@ -510,27 +420,6 @@ ajar_status node_local(const Loader &L, int i, double m[16])
 	char ctx[32];
 	snprintf(ctx, sizeof ctx, "nodes[%d]", i);
 	return trs_matrix(L, ctx, t, q, s, m);
-}
-
-/* Inverse transpose of the upper 3x3 (cofactors over the determinant),
- * row-major nm[r][c]; returns the determinant. */
-double normal_matrix(const double m[16], double nm[3][3])
-{
-	double a[3][3];
-	for (int r = 0; r < 3; r++)
-		for (int c = 0; c < 3; c++)
-			a[r][c] = m[4 * c + r];
-	for (int r = 0; r < 3; r++)
-		for (int c = 0; c < 3; c++) {
-			int r1 = (r + 1) % 3, r2 = (r + 2) % 3, c1 = (c + 1) % 3, c2 = (c + 2) % 3;
-			nm[r][c] = a[r1][c1] * a[r2][c2] - a[r1][c2] * a[r2][c1];
-		}
-	double det = a[0][0] * nm[0][0] + a[0][1] * nm[0][1] + a[0][2] * nm[0][2];
-	if (det != 0.0)
-		for (int r = 0; r < 3; r++)
-			for (int c = 0; c < 3; c++)
-				nm[r][c] /= det;
-	return det;
 }
 
 /* ---- Extras and extensions ----------------------------------------------- */
@@ -689,25 +578,7 @@ ajar_status image_texture(Loader &L, int i, int *id)
 		return fail(L, AJAR_ERROR_BAD_INPUT, "images[%d]: %zu bytes of pixels, expected %zu", i, im.image.size(),
 			    n * comp * (size_t)bytes);
 	std::vector<uint8_t> rgba(n * 4);
-	for (size_t p = 0; p < n; p++) {
-		uint8_t v[4] = {0, 0, 0, 255};
-		for (size_t c = 0; c < comp; c++) {
-			if (bytes == 1) {
-				v[c] = im.image[p * comp + c];
-			} else {
-				uint16_t w;
-				memcpy(&w, &im.image[2 * (p * comp + c)], 2);
-				v[c] = (uint8_t)(w >> 8);
-			}
-		}
-		uint8_t *d = &rgba[4 * p];
-		if (comp <= 2) { /* grey, grey + alpha */
-			d[0] = d[1] = d[2] = v[0];
-			d[3] = comp == 2 ? v[1] : 255;
-		} else {
-			memcpy(d, v, 4);
-		}
-	}
+	gltf_rgba8(im.image.data(), n, comp, bytes, rgba.data());
 	uint32_t tid;
 	ajar_status st = scene_add_texture(L.s, (uint32_t)im.width, (uint32_t)im.height, rgba.data(), &tid);
 	if (st)
@@ -881,15 +752,6 @@ ajar_status load_volume(Loader &L, int mi, const tg::ExtensionMap &exts, ::Mater
 	return AJAR_OK;
 }
 
-/* The material extensions load_material reads; any other on a material is
- * named in a warning (KHR_materials_dispersion and _iridescence among
- * them: Blender writes both). */
-const char *const material_extensions[] = {
-	"KHR_materials_emissive_strength", "KHR_materials_ior",      "KHR_materials_specular",
-	"KHR_materials_transmission",      "KHR_materials_volume",   "KHR_materials_sheen",
-	"KHR_materials_clearcoat",         "KHR_materials_anisotropy",
-};
-
 /* KHR_materials_specular (factor and colour with their textures), _sheen,
  * _clearcoat and _anisotropy (kernels/material/bsdf.h, "Layers"). */
 ajar_status load_material_layers(Loader &L, int mi, const tg::ExtensionMap &exts, ::Material *m)
@@ -945,10 +807,7 @@ ajar_status load_material_layers(Loader &L, int mi, const tg::ExtensionMap &exts
 	if (aniso_t >= 0 && !(aniso > 0.0))
 		m->anisotropy_tex = 0; /* the texture's B multiplies a strength of 0 */
 	for (const auto &e : exts) {
-		bool known = false;
-		for (const char *k : material_extensions)
-			known = known || e.first == k;
-		if (!known)
+		if (!gltf_material_extension_read(e.first.data(), e.first.size()))
 			log_msg(AJAR_LOG_WARNING, "%s: materials[%d] (%s): %s is not supported; ignored", L.file, mi,
 				L.model.materials[(size_t)mi].name.c_str(), e.first.c_str());
 	}
@@ -1090,25 +949,8 @@ ajar_status triangle_list(const Loader &L, const std::string &what, int mode, co
 		out = in;
 		return AJAR_OK;
 	}
-	out.clear();
-	for (size_t i = 0; i + 2 < n; i++) {
-		uint32_t a, b, c;
-		if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
-			/* glTF 3.7.2.1: triangle i is (i, i + 1 + i%2, i + 2 - i%2). */
-			a = in[i];
-			b = in[i + 1 + i % 2];
-			c = in[i + 2 - i % 2];
-		} else {
-			a = in[i + 1];
-			b = in[i + 2];
-			c = in[0];
-		}
-		if (a == b || b == c || a == c)
-			continue;
-		out.push_back(a);
-		out.push_back(b);
-		out.push_back(c);
-	}
+	out.assign(n > 2 ? 3 * (n - 2) : 0, 0);
+	out.resize(gltf_unroll(mode == TINYGLTF_MODE_TRIANGLE_STRIP, in.data(), n, out.data()));
 	return AJAR_OK;
 }
 
@@ -1195,12 +1037,7 @@ ajar_status load_primitive(Loader &L, int mi, int pi, const double world[16], co
 	if (flip)
 		for (size_t t = 0; t < tri.size(); t += 3)
 			std::swap(tri[t + 1], tri[t + 2]);
-	for (size_t v = 0; v < nv; v++) {
-		double p[3] = {pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]};
-		for (int r = 0; r < 3; r++)
-			pos[3 * v + (size_t)r] =
-				(float)(world[r] * p[0] + world[4 + r] * p[1] + world[8 + r] * p[2] + world[12 + r]);
-	}
+	gltf_transform_points(world, pos.data(), nv);
 	uint32_t ntris = (uint32_t)(tri.size() / 3);
 
 	if (portal) {
@@ -1221,11 +1058,7 @@ ajar_status load_primitive(Loader &L, int mi, int pi, const double world[16], co
 			return fail(L, AJAR_ERROR_BAD_INPUT, "%s: NORMAL has %zu elements, POSITION %zu", what.c_str(),
 				    pn.count, nv);
 		nrm = to_floats(pn);
-		for (size_t v = 0; v < nv; v++) {
-			double n[3] = {nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2]};
-			for (int r = 0; r < 3; r++)
-				nrm[3 * v + (size_t)r] = (float)(nm[r][0] * n[0] + nm[r][1] * n[1] + nm[r][2] * n[2]);
-		}
+		gltf_transform_normals(nm, nrm.data(), nv);
 	}
 	std::vector<float> uv1, col;
 	const char *sets[2] = {"TEXCOORD_0", "TEXCOORD_1"};
@@ -1292,13 +1125,7 @@ ajar_status load_primitive(Loader &L, int mi, int pi, const double world[16], co
 				return fail(L, AJAR_ERROR_BAD_INPUT, "%s: TANGENT has %zu elements, POSITION %zu", what.c_str(),
 					    pt.count, nv);
 			tan = to_floats(pt);
-			for (size_t v = 0; v < nv; v++) {
-				double t[3] = {tan[4 * v], tan[4 * v + 1], tan[4 * v + 2]};
-				for (int r = 0; r < 3; r++)
-					tan[4 * v + (size_t)r] = (float)(world[r] * t[0] + world[4 + r] * t[1] + world[8 + r] * t[2]);
-				if (flip)
-					tan[4 * v + 3] = -tan[4 * v + 3];
-			}
+			gltf_transform_tangents(world, tan.data(), nv, flip);
 		} else if (!set.empty()) {
 			std::vector<VertexArray> more;
 			std::vector<float> *other = &set == &uv ? &uv1 : &uv;
@@ -1319,21 +1146,6 @@ ajar_status load_primitive(Loader &L, int mi, int pi, const double world[16], co
 
 /* ---- Instances ------------------------------------------------------------ */
 
-/* The rule that keeps a mesh used more than once as instances (one copy
- * of its triangles, transformed per ray) rather than flattened into world
- * space (a copy per use): when its copies would add at least
- * INSTANCE_MIN_EXTRA triangles. Measured (AJAR_BENCH_RULE=1 make bench,
- * one thread): instances trace 0.64-0.82x as fast as flattened copies up
- * to 17k triangles in all, 0.94x (and once 1.59x) at 65k, 1.14x at 260k
- * and 2.07x at 4M (src/scene/README.md, "Instances"); 65k flat triangles
- * cost 10 MiB. */
-#define INSTANCE_MIN_EXTRA 65536
-
-bool mesh_instanced(uint64_t triangles, uint64_t uses)
-{
-	return uses >= 2 && triangles * (uses - 1) >= INSTANCE_MIN_EXTRA;
-}
-
 /* Triangles the mesh's primitives make (strips and fans counted as drawn,
  * points and lines none), from their accessors' counts. */
 uint64_t mesh_triangles(const Loader &L, int mi)
@@ -1348,11 +1160,7 @@ uint64_t mesh_triangles(const Loader &L, int mi)
 		}
 		if (acc < 0 || (size_t)acc >= L.model.accessors.size())
 			continue;
-		uint64_t c = L.model.accessors[(size_t)acc].count;
-		if (mode == TINYGLTF_MODE_TRIANGLES)
-			n += c / 3;
-		else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP || mode == TINYGLTF_MODE_TRIANGLE_FAN)
-			n += c > 2 ? c - 2 : 0;
+		n += gltf_mode_triangles(mode, L.model.accessors[(size_t)acc].count);
 	}
 	return n;
 }
@@ -1419,7 +1227,7 @@ ajar_status node_copies(Loader &L, int ni, const double world[16], std::vector<d
 		ajar_status st = trs_matrix(L, ctx, t, q, sc, local);
 		if (st)
 			return st;
-		mat_mul(world, local, &out[16 * i]);
+		gltf_mat_mul(world, local, &out[16 * i]);
 	}
 	return AJAR_OK;
 }
@@ -1439,7 +1247,7 @@ bool primitive_emits(const Loader &L, int mi, int pi)
 ajar_status load_instanced_mesh(Loader &L, int mi)
 {
 	double id[16], nm[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-	mat_identity(id);
+	gltf_mat_identity(id);
 	uint32_t first = L.s->ntris;
 	const tg::Mesh &mesh = L.model.meshes[(size_t)mi];
 	for (size_t p = 0; p < mesh.primitives.size(); p++) {
@@ -1468,7 +1276,7 @@ ajar_status load_mesh_copy(Loader &L, int ni, const double world[16], bool is_po
 {
 	const tg::Node &n = L.model.nodes[(size_t)ni];
 	double nm[3][3];
-	double det = normal_matrix(world, nm);
+	double det = gltf_normal_matrix(world, nm);
 	if (!(std::fabs(det) > 0.0) || !std::isfinite(det)) {
 		log_msg(AJAR_LOG_WARNING, "%s: nodes[%d]: transform is singular (zero scale), mesh skipped", L.file, ni);
 		return AJAR_OK;
@@ -1555,7 +1363,7 @@ void count_mesh_uses(Loader &L, const std::vector<int> &roots)
 	for (size_t k = 0; k < m.meshes.size(); k++)
 		L.mesh_inst[k] = L.instancing == GLTF_INSTANCING_ALL    ? L.mesh_uses[k] >= 1
 				 : L.instancing == GLTF_INSTANCING_NONE ? 0
-									: mesh_instanced(mesh_triangles(L, (int)k), L.mesh_uses[k]);
+									: gltf_mesh_instanced(mesh_triangles(L, (int)k), L.mesh_uses[k]);
 }
 
 /* The first perspective camera of the traversal sets the scene's camera. */
@@ -1652,7 +1460,7 @@ ajar_status walk_nodes(Loader &L, const std::vector<int> &roots, const char *roo
 				    nn);
 		Item it;
 		it.node = roots[r];
-		mat_identity(it.parent);
+		gltf_mat_identity(it.parent);
 		stack.push_back(it);
 	}
 	while (!stack.empty()) {
@@ -1667,7 +1475,7 @@ ajar_status walk_nodes(Loader &L, const std::vector<int> &roots, const char *roo
 		ajar_status st = node_local(L, ni, local);
 		if (st)
 			return st;
-		mat_mul(it.parent, local, world);
+		gltf_mat_mul(it.parent, local, world);
 		if (n.mesh >= 0 && (st = load_mesh_node(L, ni, world)))
 			return st;
 		if (n.camera >= 0 && !L.s->has_camera && (st = load_camera_node(L, ni, world)))
@@ -1750,16 +1558,11 @@ ajar_status load(Loader &L)
 
 	const tg::Model &m = L.model;
 	for (const std::string &ext : m.extensionsRequired) {
-		bool known = false;
-		for (const char *s : supported_extensions)
-			known = known || ext == s;
-		if (!known)
+		if (!gltf_extension_supported(ext.data(), ext.size()))
 			return fail(L, AJAR_ERROR_BAD_INPUT, "extensionsRequired: %s is not supported", ext.c_str());
 	}
 	for (const std::string &ext : m.extensionsUsed) { /* one warning each: none is ignored silently */
-		bool known = false;
-		for (const char *s : supported_extensions)
-			known = known || ext == s;
+		bool known = gltf_extension_supported(ext.data(), ext.size());
 		for (const tg::Material &gm : m.materials) /* those load_material names per material */
 			known = known || gm.extensions.count(ext);
 		if (!known)

@@ -24,9 +24,9 @@ ajar_status gltf_load(const char *path, Scene **out);
 ajar_status gltf_load_with(const char *path, int allow_outside_files, Scene **out);
 
 /* Which meshes used by several nodes (or EXT_mesh_gpu_instancing copies)
- * are kept once, as instances: by the rule of gltf.cpp (mesh_instanced),
- * none (every copy flattened into world space), or every mesh used at all
- * (tests: instanced against flattened). */
+ * are kept once, as instances: by the rule of gltf_instancing.c
+ * (gltf_mesh_instanced), none (every copy flattened into world space), or
+ * every mesh used at all (tests: instanced against flattened). */
 enum { GLTF_INSTANCING_AUTO = 0, GLTF_INSTANCING_NONE = 1, GLTF_INSTANCING_ALL = 2 };
 ajar_status gltf_load_instancing(const char *path, int allow_outside_files, int instancing, Scene **out);
 

@@ -265,7 +265,7 @@ static void scale_row(const char *dir, const char *name, int quiet)
 		       WEXITSTATUS(status) == 6 ? "out of memory" : "failed");
 		return;
 	}
-	/* The render log's counts and times (src/cli/commands.c). */
+	/* The render log's counts and times (src/cli/cmd_render.c). */
 	double load = -1, bvh = -1;
 	unsigned long long tris = 0, unique = 0, inst = 0;
 	FILE *f = fopen(log, "r");

@@ -371,7 +371,7 @@ static void test_loader_counts(void **state)
 	/* the room (1), the ball (8 copies: five nodes, three GPU instances), the lamps' shade (2) */
 	assert_int_equal(ii.instances, 11);
 	assert_int_equal(fi.instances, 0);
-	assert_int_equal(ai.instances, 0); /* a 168-triangle ball 8 times: flat (mesh_instanced) */
+	assert_int_equal(ai.instances, 0); /* a 168-triangle ball 8 times: flat (gltf_mesh_instanced) */
 	assert_int_equal(ii.emissive_triangles, 4);
 	assert_int_equal(fi.emissive_triangles, 4);
 	for (int c = 0; c < 3; c++) {
