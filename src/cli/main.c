@@ -1,5 +1,5 @@
 /* main.c — the `ajar` program (commands.c does the work; tests run the same
- * commands with faults injected, tests/ajar_faults.c). */
+ * commands with faults injected, tests/support/ajar_faults.c). */
 #include "cli/commands.h"
 
 int main(int argc, char **argv) { return cli_main(argc, argv); }
