@@ -1,4 +1,4 @@
-/* commands_shared.h — what the command files share (commands.c): the
+/* commands_shared.h — what the command files share (cli_common.c): the
  * message prefix, exit codes from statuses, error reports, loading a
  * scene, checking an output, the scene options, the found portals' lines;
  * and each command's entry (cmd_render.c, cmd_info.c, cmd_devices.c). */

@@ -15,6 +15,23 @@
 #include "material/texture.h"
 #include "scene/scene.h"
 
+/* Triangle i's texture coordinates under tex's transform, in texels. */
+void scene_tri_texel_coords(const SceneView *v, uint32_t i, int tex, double x[3], double y[3])
+{
+	const TriShade *sh = &v->shade[i];
+	const Texture *t = &v->textures[tex];
+	float u[3] = {sh->u0, sh->u1, sh->u2}, w[3] = {sh->v0, sh->v1, sh->v2};
+	if (t->flags & TEX_UV1) {
+		const TriExtra *e = v->tris[i].flags & TRI_EXTRA ? &v->extra[i] : NULL;
+		u[0] = e ? e->u0 : 0.0f, u[1] = e ? e->u1 : 0.0f, u[2] = e ? e->u2 : 0.0f;
+		w[0] = e ? e->v0 : 0.0f, w[1] = e ? e->v1 : 0.0f, w[2] = e ? e->v2 : 0.0f;
+	}
+	for (int k = 0; k < 3; k++) {
+		x[k] = ((double)t->xf[0] * u[k] + (double)t->xf[1] * w[k] + t->xf[2]) * t->width;
+		y[k] = ((double)t->xf[3] * u[k] + (double)t->xf[4] * w[k] + t->xf[5]) * t->height;
+	}
+}
+
 static int lit(uint32_t texel) { return (texel & 0xffffffu) != 0; }
 
 void emit_mask_free(EmitMask *m)

@@ -37,4 +37,8 @@ int emit_mask_can_emit(const EmitMask *m, const SceneView *v, uint32_t i, int te
 #ifdef __cplusplus
 }
 #endif
+/* Triangle i of v (tris, shade, extra and textures set): its texture
+ * coordinates for texture `tex` (its set and transform) in texels. */
+void scene_tri_texel_coords(const SceneView *v, uint32_t i, int tex, double x[3], double y[3]);
+
 #endif

@@ -155,10 +155,6 @@ void scene_instance_bounds(const SceneInstance *in, V3 mlo, V3 mhi, V3 *lo, V3 *
  * the kernels' surface code reads them; the other arrays are NULL. */
 SceneView scene_surface_view(const Scene *s);
 uint32_t scene_count_emissive(const Scene *s);
-/* Triangle i of v (tris, shade, extra and textures set): its texture
- * coordinates for texture `tex` (its set and transform) in texels. Whether
- * it can emit with an emissive texture: scene/emit_mask.h. */
-void scene_tri_texel_coords(const SceneView *v, uint32_t i, int tex, double x[3], double y[3]);
 /* The camera to render with: the scene's, or, if it has none, a view along
  * -Z framing the bounding sphere (yfov 45 degrees). */
 void scene_camera(const Scene *s, V3 *pos, V3 *forward, V3 *up, float *yfov);
