@@ -294,7 +294,7 @@ build/fuzz/fuzzers/%.o: tests/fuzz/%.c
 build/fuzz/fuzzers/fuzz_stb.o: tests/fuzz/fuzz_stb.c
 	@mkdir -p $(@D)
 	@echo "  CC      $< (fuzz)"
-	$(Q)clang -std=c11 -w $(MODE_FLAGS_fuzz) -fno-sanitize=pointer-overflow,nonnull-attribute,shift $(PKG_CFLAGS) -c -o $@ $<
+	$(Q)clang -std=c11 -w $(MODE_FLAGS_fuzz) -fno-sanitize=pointer-overflow,nonnull-attribute,shift,signed-integer-overflow $(PKG_CFLAGS) -c -o $@ $<
 
 build/fuzz/fuzzers/fuzz_tinygltf.o: tests/fuzz/fuzz_tinygltf.cpp
 	@mkdir -p $(@D)
