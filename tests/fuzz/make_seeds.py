@@ -184,6 +184,29 @@ def scenes():
     doc["bufferViews"].append({"buffer": 0, "byteOffset": len(b), "byteLength": len(img)})
     doc.update({"images": [{"bufferView": 6, "mimeType": "image/png"}], "textures": [{"source": 0}]})
     put("gltf", "embedded.glb", glb(doc, b + img))
+    # Blender's materials (issue 44): sheen, clear coat, anisotropy, specular colour, each with a texture.
+    t = {"index": 0}
+    layers = [{"pbrMetallicRoughness": {"metallicFactor": 0.5, "roughnessFactor": 0.4}, "normalTexture": t,
+               "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [0.8, 0.7, 0.6], "sheenRoughnessFactor": 0.4,
+                                                      "sheenColorTexture": t, "sheenRoughnessTexture": t},
+                              "KHR_materials_clearcoat": {"clearcoatFactor": 1, "clearcoatRoughnessFactor": 0.1,
+                                                          "clearcoatTexture": t, "clearcoatRoughnessTexture": t,
+                                                          "clearcoatNormalTexture": {"index": 0, "scale": 0.7}},
+                              "KHR_materials_anisotropy": {"anisotropyStrength": 0.6, "anisotropyRotation": 0.8,
+                                                           "anisotropyTexture": t},
+                              "KHR_materials_specular": {"specularColorFactor": [1, 0.8, 0.6], "specularTexture": t,
+                                                         "specularColorTexture": t}}}]
+    put("gltf", "layers.gltf", dump(gltf({"images": [{"uri": "tex.png"}], "textures": [{"source": 0}],
+        "extensionsUsed": ["KHR_materials_sheen", "KHR_materials_clearcoat", "KHR_materials_anisotropy",
+                           "KHR_materials_specular"]},
+        {"material": 0, "attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2, "TANGENT": 3}}, materials=layers)))
+    # Instances (issue 42): the quad drawn by two nodes and by 40,000 EXT_mesh_gpu_instancing copies (an
+    # accessor without a buffer view is zeros), past the loader's rule, so the two-level BVH is built.
+    d = gltf({"extensionsUsed": ["EXT_mesh_gpu_instancing"]}, nodes=[
+        {"mesh": 0, "children": [1, 2]}, {"mesh": 0, "translation": [2, 0, 0], "scale": [1, -1, 2]},
+        {"mesh": 0, "extensions": {"EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": 6}}}}])
+    d["accessors"].append({"componentType": 5126, "count": 40000, "type": "VEC3"})
+    put("gltf", "instanced.gltf", dump(d))
 
 
 if __name__ == "__main__":
