@@ -100,6 +100,11 @@ static void same_surfaces(const char *what, const SceneView *a, const SceneView 
 		worst_ns = fmin(worst_ns, v3_dot(sa.ns, sb.ns));
 		if (v3_dot(sa.ns, sb.ns) < 0.999f)
 			differ++;
+#if !defined(AJAR_NO_LAYERS) || !defined(AJAR_NO_ANISOTROPY)
+		/* The tangent frame anisotropy and the clear coat's map read. */
+		else if (sa.tsign != sb.tsign || (sa.tsign != 0.0f && v3_dot(sa.tan, sb.tan) < 0.999f))
+			differ++;
+#endif
 		/* The same occlusion a little before the hit and past it. */
 		assert_int_equal(bvh_occluded(a, o, d, ha.t * 0.99f), bvh_occluded(b, o, d, ha.t * 0.99f));
 	}
