@@ -20,7 +20,10 @@
 #define AJAR_QMC_H
 #include "base/compat.h"
 
-INLINE uint qmc_reverse_bits(uint x)
+/* All inlined: rng_qmc_table unrolls qmc_pair over every pair into one
+ * branch-free block, which PoCL vectorises across work-items only without
+ * calls in it. */
+HOT_INLINE uint qmc_reverse_bits(uint x)
 {
 	x = (x << 16) | (x >> 16);
 	x = ((x & 0x00ff00ffu) << 8) | ((x & 0xff00ff00u) >> 8);
@@ -30,7 +33,7 @@ INLINE uint qmc_reverse_bits(uint x)
 }
 
 /* 32-bit integer hash (Wellons' lowbias32): seeds from seeds. */
-INLINE uint qmc_hash(uint x)
+HOT_INLINE uint qmc_hash(uint x)
 {
 	x ^= x >> 16;
 	x *= 0x7feb352du;
@@ -43,7 +46,7 @@ INLINE uint qmc_hash(uint x)
  * (its most significant bit in bit 0): every bit is flipped by a hash of
  * the bits above it, and each step only carries bits upward (Burley's
  * constants). */
-INLINE uint qmc_lk_reversed(uint x, uint seed)
+HOT_INLINE uint qmc_lk_reversed(uint x, uint seed)
 {
 	x += seed;
 	x ^= x * 0x6c50b47cu;
@@ -55,7 +58,7 @@ INLINE uint qmc_lk_reversed(uint x, uint seed)
 
 /* Owen scrambling of x read as a binary fraction (most significant bit
  * first). */
-INLINE uint qmc_owen(uint x, uint seed) { return qmc_reverse_bits(qmc_lk_reversed(qmc_reverse_bits(x), seed)); }
+HOT_INLINE uint qmc_owen(uint x, uint seed) { return qmc_reverse_bits(qmc_lk_reversed(qmc_reverse_bits(x), seed)); }
 
 /* Second Sobol dimension of point i, bit-reversed: its generator matrix is
  * Pascal's triangle mod 2, so bit m is the parity of the bits j of i with
@@ -64,7 +67,7 @@ INLINE uint qmc_owen(uint x, uint seed) { return qmc_reverse_bits(qmc_lk_reverse
  * one shift per digit. (The forward fraction, bit-reversed, is what the
  * scrambling wants; the loop over the 32 direction numbers it replaces
  * cost a twentieth of a living-room render.) */
-INLINE uint qmc_sobol1_reversed(uint i)
+HOT_INLINE uint qmc_sobol1_reversed(uint i)
 {
 	i ^= (i >> 1) & 0x55555555u;
 	i ^= (i >> 2) & 0x33333333u;
@@ -73,10 +76,10 @@ INLINE uint qmc_sobol1_reversed(uint i)
 	return i ^ ((i >> 16) & 0x0000ffffu);
 }
 
-INLINE float qmc_to_float(uint x) { return (float)(x >> 8) * (1.0f / 16777216.0f); }
+HOT_INLINE float qmc_to_float(uint x) { return (float)(x >> 8) * (1.0f / 16777216.0f); }
 
 /* The pair's seed, and sample `index` shuffled for it. */
-INLINE uint qmc_pair_index(uint index, uint pair, uint seed, uint *pair_seed)
+HOT_INLINE uint qmc_pair_index(uint index, uint pair, uint seed, uint *pair_seed)
 {
 	*pair_seed = qmc_hash(seed ^ qmc_hash(pair + 0x9e3779b9u));
 	return qmc_owen(index, *pair_seed);
@@ -84,7 +87,7 @@ INLINE uint qmc_pair_index(uint index, uint pair, uint seed, uint *pair_seed)
 
 /* Both coordinates of pair `pair` of sample `index` of the pixel whose seed
  * is `seed`, in [0, 1) with 24 bits (exact in a float, never 1). */
-INLINE void qmc_pair(uint index, uint pair, uint seed, float *x, float *y)
+HOT_INLINE void qmc_pair(uint index, uint pair, uint seed, float *x, float *y)
 {
 	uint ps, i = qmc_pair_index(index, pair, seed, &ps);
 	/* van der Corput's fraction is i bit-reversed, so reversed it is i. */
@@ -93,7 +96,7 @@ INLINE void qmc_pair(uint index, uint pair, uint seed, float *x, float *y)
 }
 
 /* Dimension `dim` alone: coordinate dim & 1 of pair dim >> 1. */
-INLINE float qmc_f(uint index, uint dim, uint seed)
+HOT_INLINE float qmc_f(uint index, uint dim, uint seed)
 {
 	uint ps, i = qmc_pair_index(index, dim >> 1, seed, &ps);
 	uint x = (dim & 1u) ? qmc_sobol1_reversed(i) : i;
