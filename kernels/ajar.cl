@@ -30,10 +30,9 @@ __kernel void render_pass(AJAR_SCENE_BUFFERS(AJAR_KERNEL_ARG) __global long *acc
 	GLOBAL const Camera *cam = &params->camera;
 	uint npix = (uint)(cam->width * cam->height);
 	uint unit = unit_first + (uint)get_global_id(0);
-	/* Work units past the last one (the group's excess) render nothing,
-	 * but pass every barrier below with the others. */
-	int live = unit < npix * lanes;
-	uint pixel = unit % npix, lane = live ? unit / npix : 0u;
+	if (unit >= npix * lanes)
+		return;
+	uint pixel = unit % npix, lane = unit / npix;
 	float x = (float)(pixel % (uint)cam->width), y = (float)(pixel / (uint)cam->width);
 	long sum[3] = {0, 0, 0};
 	long aov_sum[AOV_CHANNELS];
@@ -47,25 +46,10 @@ __kernel void render_pass(AJAR_SCENE_BUFFERS(AJAR_KERNEL_ARG) __global long *acc
 #else
 	PathVertex light[SUBPATH_MAX], eye[SUBPATH_MAX], back[SUBPATH_MAX], fwd[SUBPATH_MAX];
 #endif
-	/* The group's low-discrepancy numbers, number by number, each
-	 * work-item's side by side: one store of a vector of them per number. */
-	__local float qmc_group[RNG_QMC_FLOATS * AJAR_GROUP_MAX];
-	LOCAL float *qmc = qmc_group + get_local_id(0);
-	/* The same count for every work-item, so each meets the barrier as
-	 * often as the others. */
-	uint rounds = (sample_count + lanes - 1u) / lanes;
-	for (uint k = 0; k < rounds; k++) {
-		uint i = lane + k * lanes;
-		/* First, apart from the walk, the sample's low-discrepancy numbers
-		 * (rng_qmc_table): code without branches, which PoCL's work-group
-		 * loop, ended by the barrier, runs for several work-items at once
-		 * in vector lanes. The walk that follows diverges and runs one
-		 * work-item at a time. */
-		rng_qmc_table(params->seed, pixel, sample_first + i, qmc, AJAR_GROUP_MAX);
-		barrier(CLK_LOCAL_MEM_FENCE);
-		if (!live || i >= sample_count)
-			continue;
-		Rng rng = rng_init_pixel(params->seed, pixel, sample_first + i, qmc, AJAR_GROUP_MAX);
+	for (uint i = lane; i < sample_count; i += lanes) {
+		float qmc[RNG_QMC_FLOATS];
+		rng_qmc_table(params->seed, pixel, sample_first + i, qmc);
+		Rng rng = rng_init_pixel(params->seed, pixel, sample_first + i, qmc);
 		float jx, jy;
 		rng_pixel(&rng, &jx, &jy);
 		V3 L;
@@ -87,8 +71,6 @@ __kernel void render_pass(AJAR_SCENE_BUFFERS(AJAR_KERNEL_ARG) __global long *acc
 			aov_sample(&sc, cam->pos, camera_ray_dir(cam, x + jx, y + jy), L, pixel, sample_first + i,
 				   aov_sum);
 	}
-	if (!live)
-		return;
 	if (lanes > 1) {
 		for (int c = 0; c < 3; c++)
 			atom_add(&accum[3 * pixel + c], sum[c]);

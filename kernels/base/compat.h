@@ -10,7 +10,6 @@
 #ifdef __OPENCL_C_VERSION__
 #define AJAR_DEVICE 1
 #define GLOBAL __global
-#define LOCAL __local
 /* Light paths splat into the image with 64-bit atomic adds (bdpt.h). */
 #pragma OPENCL EXTENSION cl_khr_int64_base_atomics : enable
 #define u2f(u) as_float(u)
@@ -22,7 +21,6 @@
 typedef unsigned int uint;
 typedef unsigned long ulong;
 #define GLOBAL
-#define LOCAL
 static inline float u2f(uint u) { float f; memcpy(&f, &u, 4); return f; }
 static inline uint f2u(float f) { uint u; memcpy(&u, &f, 4); return u; }
 static inline int max(int a, int b) { return a > b ? a : b; }

@@ -16,10 +16,6 @@
  * BVH_EMPTY an unused slot, whose box is the point (+inf, +inf, +inf), which
  * no ray from a finite origin enters. Node 0 is the root. */
 #define BVH_WIDTH 8
-
-/* The most work-items a group of render_pass (src/render/render_device.c):
- * the kernel keeps the group's low-discrepancy numbers in local memory. */
-#define AJAR_GROUP_MAX 64
 typedef struct {
 	float lo_x[BVH_WIDTH], lo_y[BVH_WIDTH], lo_z[BVH_WIDTH];
 	float hi_x[BVH_WIDTH], hi_y[BVH_WIDTH], hi_z[BVH_WIDTH];

@@ -20,10 +20,7 @@
 #define AJAR_QMC_H
 #include "base/compat.h"
 
-/* All inlined: rng_qmc_table unrolls qmc_pair over every pair into one
- * branch-free block, which PoCL vectorises across work-items only without
- * calls in it. */
-HOT_INLINE uint qmc_reverse_bits(uint x)
+INLINE uint qmc_reverse_bits(uint x)
 {
 	x = (x << 16) | (x >> 16);
 	x = ((x & 0x00ff00ffu) << 8) | ((x & 0xff00ff00u) >> 8);
@@ -33,7 +30,7 @@ HOT_INLINE uint qmc_reverse_bits(uint x)
 }
 
 /* 32-bit integer hash (Wellons' lowbias32): seeds from seeds. */
-HOT_INLINE uint qmc_hash(uint x)
+INLINE uint qmc_hash(uint x)
 {
 	x ^= x >> 16;
 	x *= 0x7feb352du;
@@ -46,7 +43,7 @@ HOT_INLINE uint qmc_hash(uint x)
  * (its most significant bit in bit 0): every bit is flipped by a hash of
  * the bits above it, and each step only carries bits upward (Burley's
  * constants). */
-HOT_INLINE uint qmc_lk_reversed(uint x, uint seed)
+INLINE uint qmc_lk_reversed(uint x, uint seed)
 {
 	x += seed;
 	x ^= x * 0x6c50b47cu;
@@ -58,7 +55,7 @@ HOT_INLINE uint qmc_lk_reversed(uint x, uint seed)
 
 /* Owen scrambling of x read as a binary fraction (most significant bit
  * first). */
-HOT_INLINE uint qmc_owen(uint x, uint seed) { return qmc_reverse_bits(qmc_lk_reversed(qmc_reverse_bits(x), seed)); }
+INLINE uint qmc_owen(uint x, uint seed) { return qmc_reverse_bits(qmc_lk_reversed(qmc_reverse_bits(x), seed)); }
 
 /* Second Sobol dimension of point i, bit-reversed: its generator matrix is
  * Pascal's triangle mod 2, so bit m is the parity of the bits j of i with
@@ -67,7 +64,7 @@ HOT_INLINE uint qmc_owen(uint x, uint seed) { return qmc_reverse_bits(qmc_lk_rev
  * one shift per digit. (The forward fraction, bit-reversed, is what the
  * scrambling wants; the loop over the 32 direction numbers it replaces
  * cost a twentieth of a living-room render.) */
-HOT_INLINE uint qmc_sobol1_reversed(uint i)
+INLINE uint qmc_sobol1_reversed(uint i)
 {
 	i ^= (i >> 1) & 0x55555555u;
 	i ^= (i >> 2) & 0x33333333u;
@@ -76,10 +73,10 @@ HOT_INLINE uint qmc_sobol1_reversed(uint i)
 	return i ^ ((i >> 16) & 0x0000ffffu);
 }
 
-HOT_INLINE float qmc_to_float(uint x) { return (float)(x >> 8) * (1.0f / 16777216.0f); }
+INLINE float qmc_to_float(uint x) { return (float)(x >> 8) * (1.0f / 16777216.0f); }
 
 /* The pair's seed, and sample `index` shuffled for it. */
-HOT_INLINE uint qmc_pair_index(uint index, uint pair, uint seed, uint *pair_seed)
+INLINE uint qmc_pair_index(uint index, uint pair, uint seed, uint *pair_seed)
 {
 	*pair_seed = qmc_hash(seed ^ qmc_hash(pair + 0x9e3779b9u));
 	return qmc_owen(index, *pair_seed);
@@ -87,7 +84,7 @@ HOT_INLINE uint qmc_pair_index(uint index, uint pair, uint seed, uint *pair_seed
 
 /* Both coordinates of pair `pair` of sample `index` of the pixel whose seed
  * is `seed`, in [0, 1) with 24 bits (exact in a float, never 1). */
-HOT_INLINE void qmc_pair(uint index, uint pair, uint seed, float *x, float *y)
+INLINE void qmc_pair(uint index, uint pair, uint seed, float *x, float *y)
 {
 	uint ps, i = qmc_pair_index(index, pair, seed, &ps);
 	/* van der Corput's fraction is i bit-reversed, so reversed it is i. */
@@ -96,11 +93,65 @@ HOT_INLINE void qmc_pair(uint index, uint pair, uint seed, float *x, float *y)
 }
 
 /* Dimension `dim` alone: coordinate dim & 1 of pair dim >> 1. */
-HOT_INLINE float qmc_f(uint index, uint dim, uint seed)
+INLINE float qmc_f(uint index, uint dim, uint seed)
 {
 	uint ps, i = qmc_pair_index(index, dim >> 1, seed, &ps);
 	uint x = (dim & 1u) ? qmc_sobol1_reversed(i) : i;
 	return qmc_to_float(qmc_reverse_bits(qmc_lk_reversed(x, qmc_hash(ps + 1u + (dim & 1u)))));
 }
+
+#ifdef AJAR_DEVICE
+/* The functions above for 16 pairs at once, one a lane of a uint16: the
+ * same operations, so the same bits (qmc_pairs16; AVX-512 takes a uint16
+ * in one register, AVX2 in two). */
+HOT_INLINE uint16 qmc_reverse_bits16(uint16 x)
+{
+	x = (x << 16) | (x >> 16);
+	x = ((x & 0x00ff00ffu) << 8) | ((x & 0xff00ff00u) >> 8);
+	x = ((x & 0x0f0f0f0fu) << 4) | ((x & 0xf0f0f0f0u) >> 4);
+	x = ((x & 0x33333333u) << 2) | ((x & 0xccccccccu) >> 2);
+	return ((x & 0x55555555u) << 1) | ((x & 0xaaaaaaaau) >> 1);
+}
+
+HOT_INLINE uint16 qmc_hash16(uint16 x)
+{
+	x ^= x >> 16;
+	x *= 0x7feb352du;
+	x ^= x >> 15;
+	x *= 0x846ca68bu;
+	return x ^ (x >> 16);
+}
+
+HOT_INLINE uint16 qmc_lk_reversed16(uint16 x, uint16 seed)
+{
+	x += seed;
+	x ^= x * 0x6c50b47cu;
+	x ^= x * 0xb82f1e52u;
+	x ^= x * 0xc7afe638u;
+	x ^= x * 0x8d22f6e6u;
+	return x;
+}
+
+HOT_INLINE uint16 qmc_sobol1_reversed16(uint16 i)
+{
+	i ^= (i >> 1) & 0x55555555u;
+	i ^= (i >> 2) & 0x33333333u;
+	i ^= (i >> 4) & 0x0f0f0f0fu;
+	i ^= (i >> 8) & 0x00ff00ffu;
+	return i ^ ((i >> 16) & 0x0000ffffu);
+}
+
+/* qmc_pair(index, p, seed, x, y) of pairs p = 0 to 15: lane p of *x and *y. */
+HOT_INLINE void qmc_pairs16(uint index, uint seed, float16 *x, float16 *y)
+{
+	uint16 pair = (uint16)(0u, 1u, 2u, 3u, 4u, 5u, 6u, 7u, 8u, 9u, 10u, 11u, 12u, 13u, 14u, 15u);
+	uint16 ps = qmc_hash16(seed ^ qmc_hash16(pair + 0x9e3779b9u));
+	uint16 i = qmc_reverse_bits16(qmc_lk_reversed16(qmc_reverse_bits16((uint16)(index)), ps));
+	uint16 xi = qmc_reverse_bits16(qmc_lk_reversed16(i, qmc_hash16(ps + 1u)));
+	uint16 yi = qmc_reverse_bits16(qmc_lk_reversed16(qmc_sobol1_reversed16(i), qmc_hash16(ps + 2u)));
+	*x = convert_float16(xi >> 8) * (1.0f / 16777216.0f);
+	*y = convert_float16(yi >> 8) * (1.0f / 16777216.0f);
+}
+#endif
 
 #endif

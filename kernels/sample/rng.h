@@ -34,8 +34,7 @@
 typedef struct {
 	ulong state;
 	ulong inc;              /* odd: selects one of 2^63 PCG streams */
-	LOCAL const float *qmc; /* the sample's low-discrepancy numbers (rng_qmc_table); unread by PCG-only streams */
-	uint qmc_stride;        /* floats from one of them to the next */
+	const float *qmc;       /* the sample's low-discrepancy numbers (rng_qmc_table); unread by PCG-only streams */
 	uint dim;               /* main sequence: numbers drawn; PCG's from RNG_QMC_DIMS on */
 	uint nee_dim;           /* next-event sequence: the same */
 } Rng;
@@ -67,7 +66,6 @@ INLINE Rng rng_init(uint seed, uint pixel, uint sample_index, uint stream)
 	ulong b = rng_mix64(a ^ ((((ulong)sample_index << 32) | (ulong)stream) + 0x6a09e667f3bcc909UL));
 	Rng r;
 	r.qmc = 0;
-	r.qmc_stride = 0u;
 	r.dim = r.nee_dim = RNG_QMC_DIMS; /* PCG only */
 	r.state = 0UL;
 	r.inc = (rng_mix64(b + 0x9e3779b97f4a7c15UL) << 1) | 1UL;
@@ -84,37 +82,39 @@ INLINE uint rng_qmc_seed(uint seed, uint pixel)
 	return (uint)rng_mix64((((ulong)seed << 32) | (ulong)pixel) + 0x3c6ef372fe94f82bUL);
 }
 
-/* The low-discrepancy numbers of sample `index` of `pixel`, stride floats
- * apart from q on: pair p of the sequences (the main one's pairs 0 to
- * RNG_QMC_DIMS / 2 - 1, then the next-event one's) at 2p and 2p + 1.
- * Straight-line integer code without branches: the render kernel makes
- * them for a whole work-group before the walks begin, where a CPU compiler
- * runs them for many work-items at once in vector lanes (kernels/ajar.cl;
- * inside the walk each work-item made its own, one at a time: a tenth of a
- * Cornell `pt` sample). */
-HOT_INLINE void rng_qmc_table(uint seed, uint pixel, uint index, LOCAL float *q, uint stride)
+/* The low-discrepancy numbers of sample `index` of `pixel` into q: pair p
+ * of the sequences (the main one's pairs 0 to RNG_QMC_DIMS / 2 - 1, then
+ * the next-event one's) at q[2p] and q[2p + 1]. Made all at once before the
+ * walk, on the device in the 16 lanes of qmc_pairs16: PoCL runs the walk
+ * one work-item at a time, and inside it each pair was made alone, a
+ * tenth of a Cornell `pt` sample (kernels/README.md, "By part, on PoCL"). */
+INLINE void rng_qmc_table(uint seed, uint pixel, uint index, float q[RNG_QMC_FLOATS])
 {
 	uint qseed = rng_qmc_seed(seed, pixel);
 #ifdef AJAR_DEVICE
-#pragma unroll
-#endif
+	float16 x, y;
+	qmc_pairs16(index, qseed, &x, &y);
+	float xs[16], ys[16];
+	vstore16(x, 0, xs);
+	vstore16(y, 0, ys);
 	for (uint p = 0u; p < RNG_QMC_DIMS; p++) {
-		float a, b;
-		qmc_pair(index, p, qseed, &a, &b);
-		q[2u * p * stride] = a;
-		q[(2u * p + 1u) * stride] = b;
+		q[2u * p] = xs[p];
+		q[2u * p + 1u] = ys[p];
 	}
+#else
+	for (uint p = 0u; p < RNG_QMC_DIMS; p++)
+		qmc_pair(index, p, qseed, &q[2u * p], &q[2u * p + 1u]);
+#endif
 }
 
 /* The stream of sample `sample_index` of `pixel`: its first RNG_QMC_DIMS
  * numbers of each sequence low-discrepancy across the pixel's samples
  * (qmc.h), read from q, which rng_qmc_table filled for the same seed,
- * pixel and sample; the rest as rng_init's stream 0. */
-INLINE Rng rng_init_pixel(uint seed, uint pixel, uint sample_index, LOCAL const float *q, uint stride)
+ * pixel and sample (q must outlive the stream); the rest as rng_init's stream 0. */
+INLINE Rng rng_init_pixel(uint seed, uint pixel, uint sample_index, const float q[RNG_QMC_FLOATS])
 {
 	Rng r = rng_init(seed, pixel, sample_index, 0u);
 	r.qmc = q;
-	r.qmc_stride = stride;
 	r.dim = r.nee_dim = 0u;
 	return r;
 }
@@ -138,8 +138,8 @@ INLINE void rng_pair(Rng *r, uint *dim, uint base, float *u1, float *u2)
 		return;
 	}
 	uint k = base + *dim; /* pair k / 2's first coordinate */
-	*u1 = r->qmc[k * r->qmc_stride];
-	*u2 = r->qmc[(k + 1u) * r->qmc_stride];
+	*u1 = r->qmc[k];
+	*u2 = r->qmc[k + 1u];
 	*dim += 2u;
 }
 
@@ -181,7 +181,7 @@ INLINE void rng_nee3(Rng *r, float *u0, float *u1, float *u2)
 		*u0 = rng_pcg_f(r);
 		return;
 	}
-	*u0 = r->qmc[(RNG_QMC_DIMS + r->nee_dim) * r->qmc_stride];
+	*u0 = r->qmc[RNG_QMC_DIMS + r->nee_dim];
 	r->nee_dim += 2u;
 }
 

@@ -15,7 +15,6 @@
 #include "device/kernel_source.h"
 #include "render/render_film.h"
 #include "render/render_overrides.h"
-#include "base/types.h" /* AJAR_GROUP_MAX */
 
 /* An explicit work-group size, measured on PoCL 3.1's CPU device (2
  * cores, 128x128 path tracing, first pass = PoCL's cold work-group
@@ -26,7 +25,7 @@
  *   64       0.63/0.68 s, 1.69/1.56        0.81/0.69 s, 0.33/0.38
  *   NULL     crashes (SIGSEGV in PoCL's work-group function) at 128x128
  *            and 256x256: PoCL picks 4096 work-items per group.
- * On the CPU the choice is within noise; 64 (AJAR_GROUP_MAX) is a multiple of every GPU's
+ * On the CPU the choice is within noise; 64 is a multiple of every GPU's
  * SIMD width, capped by what the compiled kernel allows. */
 static ajar_status work_group_size(RenderDevice *rd)
 {
@@ -34,7 +33,7 @@ static ajar_status work_group_size(RenderDevice *rd)
 	size_t max_local = 0;
 	CL_TRY(d, clGetKernelWorkGroupInfo(rd->k_render, d->id, CL_KERNEL_WORK_GROUP_SIZE, sizeof max_local,
 					   &max_local, NULL));
-	for (rd->local = AJAR_GROUP_MAX; rd->local > 1 && rd->local > max_local; rd->local /= 2)
+	for (rd->local = 64; rd->local > 1 && rd->local > max_local; rd->local /= 2)
 		;
 	if (rd->plan.soa && rd->plan.capacity % rd->local)
 		rd->plan.capacity -= rd->plan.capacity % rd->local; /* whole groups; the stride is the built one */

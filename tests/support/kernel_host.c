@@ -61,8 +61,8 @@ void host_render(HostScene *h, uint32_t spp, uint32_t seed, double *rgb, double 
 	for (uint32_t px = 0; px < npix; px++) {
 		for (uint32_t i = 0; i < spp; i++) {
 			float qmc[RNG_QMC_FLOATS];
-			rng_qmc_table(seed, px, i, qmc, 1u);
-			Rng rng = rng_init_pixel(seed, px, i, qmc, 1u);
+			rng_qmc_table(seed, px, i, qmc);
+			Rng rng = rng_init_pixel(seed, px, i, qmc);
 			float jx, jy;
 			rng_pixel(&rng, &jx, &jy);
 			float x = (float)(px % (uint32_t)cam->width) + jx;

@@ -463,8 +463,8 @@ static void test_qmc_uniform(void **state)
 		memset(obs, 0, sizeof(obs));
 		for (int p = 0; p < n; p++) {
 			float q[RNG_QMC_FLOATS];
-			rng_qmc_table(3, (uint)p, index[t], q, 1u);
-			Rng r = rng_init_pixel(3, (uint)p, index[t], q, 1u);
+			rng_qmc_table(3, (uint)p, index[t], q);
+			Rng r = rng_init_pixel(3, (uint)p, index[t], q);
 			float u, v;
 			rng_pixel(&r, &u, &v);
 			obs[(int)(u * NP) * NP + (int)(v * NP)] += 1;
@@ -489,10 +489,9 @@ static void test_qmc_uniform(void **state)
 static void test_rng_sequences(void **state)
 {
 	(void)state;
-	/* The table at a stride of 3, as a work-group's local memory holds it. */
-	float q[3 * RNG_QMC_FLOATS];
-	rng_qmc_table(9, 77, 5, q, 3u);
-	Rng r = rng_init_pixel(9, 77, 5, q, 3u), pcg = rng_init(9, 77, 5, 0);
+	float q[RNG_QMC_FLOATS];
+	rng_qmc_table(9, 77, 5, q);
+	Rng r = rng_init_pixel(9, 77, 5, q), pcg = rng_init(9, 77, 5, 0);
 	uint seed = rng_qmc_seed(9, 77);
 	float u0, u1, u2, jx, jy;
 	rng_pixel(&r, &jx, &jy);
@@ -520,7 +519,7 @@ static void test_rng_sequences(void **state)
 	rng_f3(&a, &u0, &u1, &u2);
 	assert_true(u0 == rng_pcg_f(&b) && u1 == rng_pcg_f(&b) && u2 == rng_pcg_f(&b));
 	/* Forks are PCG streams of their own, repeatable. */
-	Rng f1 = rng_init_pixel(9, 77, 5, q, 3u), f2 = rng_init_pixel(9, 77, 5, q, 3u);
+	Rng f1 = rng_init_pixel(9, 77, 5, q), f2 = rng_init_pixel(9, 77, 5, q);
 	Rng g1 = rng_fork(&f1), g2 = rng_fork(&f2);
 	assert_int_equal(g1.dim, RNG_QMC_DIMS);
 	for (int i = 0; i < 16; i++)
