@@ -28,6 +28,7 @@ the N source lines with the most samples.
 """
 import collections
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -72,6 +73,13 @@ def main():
     env = dict(os.environ, POCL_MAX_PTHREAD_COUNT="1")
     env["AJAR_CL_OPTIONS"] = (env.get("AJAR_CL_OPTIONS", "") + " -g").strip()
     tmp = tempfile.mkdtemp()
+    try:
+        profile(ajar, scene, integ, size, spp, freq, top, env, tmp)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def profile(ajar, scene, integ, size, spp, freq, top, env, tmp):
     render = [ajar, "render", scene, "-o", os.path.join(tmp, "x.exr"), "--integrator", integ, "-q"]
     subprocess.run(render + ["--size", "16x16", "--spp", "1"], env=env, check=True,
                    stderr=subprocess.DEVNULL)
