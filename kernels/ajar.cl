@@ -47,7 +47,9 @@ __kernel void render_pass(AJAR_SCENE_BUFFERS(AJAR_KERNEL_ARG) __global long *acc
 	PathVertex light[SUBPATH_MAX], eye[SUBPATH_MAX], back[SUBPATH_MAX], fwd[SUBPATH_MAX];
 #endif
 	for (uint i = lane; i < sample_count; i += lanes) {
-		Rng rng = rng_init_pixel(params->seed, pixel, sample_first + i);
+		float qmc[RNG_QMC_FLOATS];
+		rng_qmc_table(params->seed, pixel, sample_first + i, qmc);
+		Rng rng = rng_init_pixel(params->seed, pixel, sample_first + i, qmc);
 		float jx, jy;
 		rng_pixel(&rng, &jx, &jy);
 		V3 L;

@@ -100,4 +100,58 @@ INLINE float qmc_f(uint index, uint dim, uint seed)
 	return qmc_to_float(qmc_reverse_bits(qmc_lk_reversed(x, qmc_hash(ps + 1u + (dim & 1u)))));
 }
 
+#ifdef AJAR_DEVICE
+/* The functions above for 16 pairs at once, one a lane of a uint16: the
+ * same operations, so the same bits (qmc_pairs16; AVX-512 takes a uint16
+ * in one register, AVX2 in two). */
+HOT_INLINE uint16 qmc_reverse_bits16(uint16 x)
+{
+	x = (x << 16) | (x >> 16);
+	x = ((x & 0x00ff00ffu) << 8) | ((x & 0xff00ff00u) >> 8);
+	x = ((x & 0x0f0f0f0fu) << 4) | ((x & 0xf0f0f0f0u) >> 4);
+	x = ((x & 0x33333333u) << 2) | ((x & 0xccccccccu) >> 2);
+	return ((x & 0x55555555u) << 1) | ((x & 0xaaaaaaaau) >> 1);
+}
+
+HOT_INLINE uint16 qmc_hash16(uint16 x)
+{
+	x ^= x >> 16;
+	x *= 0x7feb352du;
+	x ^= x >> 15;
+	x *= 0x846ca68bu;
+	return x ^ (x >> 16);
+}
+
+HOT_INLINE uint16 qmc_lk_reversed16(uint16 x, uint16 seed)
+{
+	x += seed;
+	x ^= x * 0x6c50b47cu;
+	x ^= x * 0xb82f1e52u;
+	x ^= x * 0xc7afe638u;
+	x ^= x * 0x8d22f6e6u;
+	return x;
+}
+
+HOT_INLINE uint16 qmc_sobol1_reversed16(uint16 i)
+{
+	i ^= (i >> 1) & 0x55555555u;
+	i ^= (i >> 2) & 0x33333333u;
+	i ^= (i >> 4) & 0x0f0f0f0fu;
+	i ^= (i >> 8) & 0x00ff00ffu;
+	return i ^ ((i >> 16) & 0x0000ffffu);
+}
+
+/* qmc_pair(index, p, seed, x, y) of pairs p = 0 to 15: lane p of *x and *y. */
+HOT_INLINE void qmc_pairs16(uint index, uint seed, float16 *x, float16 *y)
+{
+	uint16 pair = (uint16)(0u, 1u, 2u, 3u, 4u, 5u, 6u, 7u, 8u, 9u, 10u, 11u, 12u, 13u, 14u, 15u);
+	uint16 ps = qmc_hash16(seed ^ qmc_hash16(pair + 0x9e3779b9u));
+	uint16 i = qmc_reverse_bits16(qmc_lk_reversed16(qmc_reverse_bits16((uint16)(index)), ps));
+	uint16 xi = qmc_reverse_bits16(qmc_lk_reversed16(i, qmc_hash16(ps + 1u)));
+	uint16 yi = qmc_reverse_bits16(qmc_lk_reversed16(qmc_sobol1_reversed16(i), qmc_hash16(ps + 2u)));
+	*x = convert_float16(xi >> 8) * (1.0f / 16777216.0f);
+	*y = convert_float16(yi >> 8) * (1.0f / 16777216.0f);
+}
+#endif
+
 #endif

@@ -27,13 +27,16 @@
  * of another for the choice of light). */
 #define RNG_QMC_DIMS 12u
 
+/* Floats of a sample's low-discrepancy numbers, both sequences: its
+ * 2 RNG_QMC_DIMS / 2 pairs, made ahead by rng_qmc_table. */
+#define RNG_QMC_FLOATS (2u * RNG_QMC_DIMS)
+
 typedef struct {
 	ulong state;
-	ulong inc;      /* odd: selects one of 2^63 PCG streams */
-	uint qmc_seed;  /* the pixel's scrambling seed */
-	uint qmc_index; /* the sample's number within its pixel */
-	uint dim;       /* main sequence: numbers drawn; PCG's from RNG_QMC_DIMS on */
-	uint nee_dim;   /* next-event sequence: the same */
+	ulong inc;              /* odd: selects one of 2^63 PCG streams */
+	const float *qmc;       /* the sample's low-discrepancy numbers (rng_qmc_table); unread by PCG-only streams */
+	uint dim;               /* main sequence: numbers drawn; PCG's from RNG_QMC_DIMS on */
+	uint nee_dim;           /* next-event sequence: the same */
 } Rng;
 
 /* splitmix64's output function: a bijective 64-bit mixer with full
@@ -62,7 +65,7 @@ INLINE Rng rng_init(uint seed, uint pixel, uint sample_index, uint stream)
 	ulong a = rng_mix64((((ulong)seed << 32) | (ulong)pixel) + 0x9e3779b97f4a7c15UL);
 	ulong b = rng_mix64(a ^ ((((ulong)sample_index << 32) | (ulong)stream) + 0x6a09e667f3bcc909UL));
 	Rng r;
-	r.qmc_seed = r.qmc_index = 0u;
+	r.qmc = 0;
 	r.dim = r.nee_dim = RNG_QMC_DIMS; /* PCG only */
 	r.state = 0UL;
 	r.inc = (rng_mix64(b + 0x9e3779b97f4a7c15UL) << 1) | 1UL;
@@ -73,14 +76,45 @@ INLINE Rng rng_init(uint seed, uint pixel, uint sample_index, uint stream)
 	return r;
 }
 
+/* The low-discrepancy numbers' scrambling seed of `pixel`. */
+INLINE uint rng_qmc_seed(uint seed, uint pixel)
+{
+	return (uint)rng_mix64((((ulong)seed << 32) | (ulong)pixel) + 0x3c6ef372fe94f82bUL);
+}
+
+/* The low-discrepancy numbers of sample `index` of `pixel` into q: pair p
+ * of the sequences (the main one's pairs 0 to RNG_QMC_DIMS / 2 - 1, then
+ * the next-event one's) at q[2p] and q[2p + 1]. Made all at once before the
+ * walk, on the device in the 16 lanes of qmc_pairs16: PoCL runs the walk
+ * one work-item at a time, and inside it each pair was made alone, a
+ * tenth of a Cornell `pt` sample (kernels/README.md, "By part, on PoCL"). */
+INLINE void rng_qmc_table(uint seed, uint pixel, uint index, float q[RNG_QMC_FLOATS])
+{
+	uint qseed = rng_qmc_seed(seed, pixel);
+#ifdef AJAR_DEVICE
+	float16 x, y;
+	qmc_pairs16(index, qseed, &x, &y);
+	float xs[16], ys[16];
+	vstore16(x, 0, xs);
+	vstore16(y, 0, ys);
+	for (uint p = 0u; p < RNG_QMC_DIMS; p++) {
+		q[2u * p] = xs[p];
+		q[2u * p + 1u] = ys[p];
+	}
+#else
+	for (uint p = 0u; p < RNG_QMC_DIMS; p++)
+		qmc_pair(index, p, qseed, &q[2u * p], &q[2u * p + 1u]);
+#endif
+}
+
 /* The stream of sample `sample_index` of `pixel`: its first RNG_QMC_DIMS
- * numbers low-discrepancy across the pixel's samples (qmc.h), the rest as
- * rng_init's stream 0. */
-INLINE Rng rng_init_pixel(uint seed, uint pixel, uint sample_index)
+ * numbers of each sequence low-discrepancy across the pixel's samples
+ * (qmc.h), read from q, which rng_qmc_table filled for the same seed,
+ * pixel and sample (q must outlive the stream); the rest as rng_init's stream 0. */
+INLINE Rng rng_init_pixel(uint seed, uint pixel, uint sample_index, const float q[RNG_QMC_FLOATS])
 {
 	Rng r = rng_init(seed, pixel, sample_index, 0u);
-	r.qmc_seed = (uint)rng_mix64((((ulong)seed << 32) | (ulong)pixel) + 0x3c6ef372fe94f82bUL);
-	r.qmc_index = sample_index;
+	r.qmc = q;
 	r.dim = r.nee_dim = 0u;
 	return r;
 }
@@ -103,7 +137,9 @@ INLINE void rng_pair(Rng *r, uint *dim, uint base, float *u1, float *u2)
 		*u2 = rng_pcg_f(r);
 		return;
 	}
-	qmc_pair(r->qmc_index, (base + *dim) >> 1, r->qmc_seed, u1, u2);
+	uint k = base + *dim; /* pair k / 2's first coordinate */
+	*u1 = r->qmc[k];
+	*u2 = r->qmc[k + 1u];
 	*dim += 2u;
 }
 
@@ -145,7 +181,7 @@ INLINE void rng_nee3(Rng *r, float *u0, float *u1, float *u2)
 		*u0 = rng_pcg_f(r);
 		return;
 	}
-	*u0 = qmc_f(r->qmc_index, RNG_QMC_DIMS + r->nee_dim, r->qmc_seed);
+	*u0 = r->qmc[RNG_QMC_DIMS + r->nee_dim];
 	r->nee_dim += 2u;
 }
 

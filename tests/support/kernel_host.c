@@ -60,7 +60,9 @@ void host_render(HostScene *h, uint32_t spp, uint32_t seed, double *rgb, double 
 	prm->seed = seed;
 	for (uint32_t px = 0; px < npix; px++) {
 		for (uint32_t i = 0; i < spp; i++) {
-			Rng rng = rng_init_pixel(seed, px, i);
+			float qmc[RNG_QMC_FLOATS];
+			rng_qmc_table(seed, px, i, qmc);
+			Rng rng = rng_init_pixel(seed, px, i, qmc);
 			float jx, jy;
 			rng_pixel(&rng, &jx, &jy);
 			float x = (float)(px % (uint32_t)cam->width) + jx;

@@ -462,7 +462,9 @@ static void test_qmc_uniform(void **state)
 	for (int t = 0; t < 2; t++) {
 		memset(obs, 0, sizeof(obs));
 		for (int p = 0; p < n; p++) {
-			Rng r = rng_init_pixel(3, (uint)p, index[t]);
+			float q[RNG_QMC_FLOATS];
+			rng_qmc_table(3, (uint)p, index[t], q);
+			Rng r = rng_init_pixel(3, (uint)p, index[t], q);
 			float u, v;
 			rng_pixel(&r, &u, &v);
 			obs[(int)(u * NP) * NP + (int)(v * NP)] += 1;
@@ -487,8 +489,10 @@ static void test_qmc_uniform(void **state)
 static void test_rng_sequences(void **state)
 {
 	(void)state;
-	Rng r = rng_init_pixel(9, 77, 5), pcg = rng_init(9, 77, 5, 0);
-	uint seed = r.qmc_seed;
+	float q[RNG_QMC_FLOATS];
+	rng_qmc_table(9, 77, 5, q);
+	Rng r = rng_init_pixel(9, 77, 5, q), pcg = rng_init(9, 77, 5, 0);
+	uint seed = rng_qmc_seed(9, 77);
 	float u0, u1, u2, jx, jy;
 	rng_pixel(&r, &jx, &jy);
 	assert_true(jx == qmc_f(5, 0, seed) && jy == qmc_f(5, 1, seed));
@@ -515,7 +519,7 @@ static void test_rng_sequences(void **state)
 	rng_f3(&a, &u0, &u1, &u2);
 	assert_true(u0 == rng_pcg_f(&b) && u1 == rng_pcg_f(&b) && u2 == rng_pcg_f(&b));
 	/* Forks are PCG streams of their own, repeatable. */
-	Rng f1 = rng_init_pixel(9, 77, 5), f2 = rng_init_pixel(9, 77, 5);
+	Rng f1 = rng_init_pixel(9, 77, 5, q), f2 = rng_init_pixel(9, 77, 5, q);
 	Rng g1 = rng_fork(&f1), g2 = rng_fork(&f2);
 	assert_int_equal(g1.dim, RNG_QMC_DIMS);
 	for (int i = 0; i < 16; i++)
