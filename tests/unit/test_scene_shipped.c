@@ -212,6 +212,38 @@ static void test_bathroom(void **state)
 	ajar_scene_destroy(&s);
 }
 
+/* sofa-room and its table variant (SOURCE.md): the materials of issue 44
+ * as make_sofa_room.py writes them, under a white sky through one window. */
+static void test_sofa_room(void **state)
+{
+	ajar_scene_info in;
+	Scene *s = load_shipped(SCENE("sofa-room/sofa-room.gltf"), &in);
+	assert_int_equal(in.triangles, 60);
+	assert_int_equal(in.materials, 3);
+	assert_int_equal(in.emissive_triangles, 0);
+	assert_int_equal(in.portals, 1);
+	assert_int_equal(in.portal_triangles, 2);
+	assert_int_equal(in.textures, 0);
+	assert_int_equal(in.environment, 1);
+	assert_v3(s->env_color, 1.0f, 1.0f, 1.0f);
+	assert_true(in.has_camera);
+	/* The window: 2 x 1.4 m. */
+	assert_float_equal(s->portals[0].area + s->portals[1].area, 2.8f, 1e-5);
+	const Material *floor = &s->materials[1], *velvet = &s->materials[2];
+	assert_float_equal(floor->clearcoat, 1.0f, 0.0);
+	assert_float_equal(floor->clearcoat_roughness, 0.05f, 1e-7);
+	assert_v3(velvet->sheen_color, 0.85f, 0.85f, 0.95f);
+	assert_float_equal(velvet->sheen_roughness, 0.4f, 1e-7);
+	assert_float_equal(velvet->anisotropy, 0.0f, 0.0);
+	ajar_scene_destroy(&s);
+
+	s = load_shipped(SCENE("sofa-room/sofa-room-table.gltf"), &in);
+	assert_int_equal(in.triangles, 70);
+	assert_int_equal(in.materials, 4);
+	assert_float_equal(s->materials[3].anisotropy, 0.7f, 1e-7);
+	ajar_scene_destroy(&s);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -220,6 +252,7 @@ int main(void)
 		cmocka_unit_test(test_living_room),
 		cmocka_unit_test(test_sky_scenes),
 		cmocka_unit_test(test_bathroom),
+		cmocka_unit_test(test_sofa_room),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
