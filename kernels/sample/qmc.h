@@ -20,58 +20,66 @@
 #define AJAR_QMC_H
 #include "base/compat.h"
 
-INLINE uint qmc_reverse_bits(uint x)
-{
-	x = (x << 16) | (x >> 16);
-	x = ((x & 0x00ff00ffu) << 8) | ((x & 0xff00ff00u) >> 8);
-	x = ((x & 0x0f0f0f0fu) << 4) | ((x & 0xf0f0f0f0u) >> 4);
-	x = ((x & 0x33333333u) << 2) | ((x & 0xccccccccu) >> 2);
-	return ((x & 0x55555555u) << 1) | ((x & 0xaaaaaaaau) >> 1);
-}
+/* The integer steps, written once for a type T with suffix S: a uint
+ * here, and on the device the 16 lanes of a uint16 as well (qmc_pairs16),
+ * the same operations and so the same bits.
+ *   qmc_reverse_bits: bit i to bit 31 - i.
+ *   qmc_hash: a 32-bit integer hash (Wellons' lowbias32), seeds from seeds.
+ *   qmc_lk_reversed: Laine and Karras' permutation of a binary fraction
+ *     stored bit-reversed (its most significant bit in bit 0): every bit is
+ *     flipped by a hash of the bits above it, and each step only carries
+ *     bits upward (Burley's constants).
+ *   qmc_sobol1_reversed: the second Sobol dimension of point i,
+ *     bit-reversed: its generator matrix is Pascal's triangle mod 2, so bit
+ *     m is the parity of the bits j of i with C(j, m) odd, which by Lucas'
+ *     theorem are the j whose binary digits contain m's: a superset parity
+ *     over the five bits of a bit's position, one shift per digit. (The
+ *     forward fraction, bit-reversed, is what the scrambling wants; the
+ *     loop over the 32 direction numbers it replaces cost a twentieth of a
+ *     living-room render.) */
+#define QMC_INT_STEPS(T, S, Q)                                                                  \
+	Q T qmc_reverse_bits##S(T x)                                                            \
+	{                                                                                       \
+		x = (x << 16) | (x >> 16);                                                      \
+		x = ((x & 0x00ff00ffu) << 8) | ((x & 0xff00ff00u) >> 8);                        \
+		x = ((x & 0x0f0f0f0fu) << 4) | ((x & 0xf0f0f0f0u) >> 4);                        \
+		x = ((x & 0x33333333u) << 2) | ((x & 0xccccccccu) >> 2);                        \
+		return ((x & 0x55555555u) << 1) | ((x & 0xaaaaaaaau) >> 1);                     \
+	}                                                                                       \
+	Q T qmc_hash##S(T x)                                                                    \
+	{                                                                                       \
+		x ^= x >> 16;                                                                   \
+		x *= 0x7feb352du;                                                               \
+		x ^= x >> 15;                                                                   \
+		x *= 0x846ca68bu;                                                               \
+		return x ^ (x >> 16);                                                           \
+	}                                                                                       \
+	Q T qmc_lk_reversed##S(T x, T seed)                                                     \
+	{                                                                                       \
+		x += seed;                                                                      \
+		x ^= x * 0x6c50b47cu;                                                           \
+		x ^= x * 0xb82f1e52u;                                                           \
+		x ^= x * 0xc7afe638u;                                                           \
+		x ^= x * 0x8d22f6e6u;                                                           \
+		return x;                                                                       \
+	}                                                                                       \
+	Q T qmc_sobol1_reversed##S(T i)                                                         \
+	{                                                                                       \
+		i ^= (i >> 1) & 0x55555555u;                                                    \
+		i ^= (i >> 2) & 0x33333333u;                                                    \
+		i ^= (i >> 4) & 0x0f0f0f0fu;                                                    \
+		i ^= (i >> 8) & 0x00ff00ffu;                                                    \
+		return i ^ ((i >> 16) & 0x0000ffffu);                                           \
+	}
 
-/* 32-bit integer hash (Wellons' lowbias32): seeds from seeds. */
-INLINE uint qmc_hash(uint x)
-{
-	x ^= x >> 16;
-	x *= 0x7feb352du;
-	x ^= x >> 15;
-	x *= 0x846ca68bu;
-	return x ^ (x >> 16);
-}
-
-/* Laine and Karras' permutation of a binary fraction stored bit-reversed
- * (its most significant bit in bit 0): every bit is flipped by a hash of
- * the bits above it, and each step only carries bits upward (Burley's
- * constants). */
-INLINE uint qmc_lk_reversed(uint x, uint seed)
-{
-	x += seed;
-	x ^= x * 0x6c50b47cu;
-	x ^= x * 0xb82f1e52u;
-	x ^= x * 0xc7afe638u;
-	x ^= x * 0x8d22f6e6u;
-	return x;
-}
+QMC_INT_STEPS(uint, , INLINE)
+#ifdef AJAR_DEVICE
+QMC_INT_STEPS(uint16, 16, HOT_INLINE)
+#endif
 
 /* Owen scrambling of x read as a binary fraction (most significant bit
  * first). */
 INLINE uint qmc_owen(uint x, uint seed) { return qmc_reverse_bits(qmc_lk_reversed(qmc_reverse_bits(x), seed)); }
-
-/* Second Sobol dimension of point i, bit-reversed: its generator matrix is
- * Pascal's triangle mod 2, so bit m is the parity of the bits j of i with
- * C(j, m) odd, which by Lucas' theorem are the j whose binary digits
- * contain m's: a superset parity over the five bits of a bit's position,
- * one shift per digit. (The forward fraction, bit-reversed, is what the
- * scrambling wants; the loop over the 32 direction numbers it replaces
- * cost a twentieth of a living-room render.) */
-INLINE uint qmc_sobol1_reversed(uint i)
-{
-	i ^= (i >> 1) & 0x55555555u;
-	i ^= (i >> 2) & 0x33333333u;
-	i ^= (i >> 4) & 0x0f0f0f0fu;
-	i ^= (i >> 8) & 0x00ff00ffu;
-	return i ^ ((i >> 16) & 0x0000ffffu);
-}
 
 INLINE float qmc_to_float(uint x) { return (float)(x >> 8) * (1.0f / 16777216.0f); }
 
@@ -101,46 +109,6 @@ INLINE float qmc_f(uint index, uint dim, uint seed)
 }
 
 #ifdef AJAR_DEVICE
-/* The functions above for 16 pairs at once, one a lane of a uint16: the
- * same operations, so the same bits (qmc_pairs16; AVX-512 takes a uint16
- * in one register, AVX2 in two). */
-HOT_INLINE uint16 qmc_reverse_bits16(uint16 x)
-{
-	x = (x << 16) | (x >> 16);
-	x = ((x & 0x00ff00ffu) << 8) | ((x & 0xff00ff00u) >> 8);
-	x = ((x & 0x0f0f0f0fu) << 4) | ((x & 0xf0f0f0f0u) >> 4);
-	x = ((x & 0x33333333u) << 2) | ((x & 0xccccccccu) >> 2);
-	return ((x & 0x55555555u) << 1) | ((x & 0xaaaaaaaau) >> 1);
-}
-
-HOT_INLINE uint16 qmc_hash16(uint16 x)
-{
-	x ^= x >> 16;
-	x *= 0x7feb352du;
-	x ^= x >> 15;
-	x *= 0x846ca68bu;
-	return x ^ (x >> 16);
-}
-
-HOT_INLINE uint16 qmc_lk_reversed16(uint16 x, uint16 seed)
-{
-	x += seed;
-	x ^= x * 0x6c50b47cu;
-	x ^= x * 0xb82f1e52u;
-	x ^= x * 0xc7afe638u;
-	x ^= x * 0x8d22f6e6u;
-	return x;
-}
-
-HOT_INLINE uint16 qmc_sobol1_reversed16(uint16 i)
-{
-	i ^= (i >> 1) & 0x55555555u;
-	i ^= (i >> 2) & 0x33333333u;
-	i ^= (i >> 4) & 0x0f0f0f0fu;
-	i ^= (i >> 8) & 0x00ff00ffu;
-	return i ^ ((i >> 16) & 0x0000ffffu);
-}
-
 /* qmc_pair(index, p, seed, x, y) of pairs p = 0 to 15: lane p of *x and *y. */
 HOT_INLINE void qmc_pairs16(uint index, uint seed, float16 *x, float16 *y)
 {
