@@ -27,56 +27,6 @@ static int file_exists(const char *path)
 	return stat(path, &st) == 0;
 }
 
-static char *read_file(const char *path)
-{
-	FILE *f = fopen(path, "rb");
-	if (!f)
-		return calloc(1, 1);
-	fseek(f, 0, SEEK_END);
-	long n = ftell(f);
-	fseek(f, 0, SEEK_SET);
-	char *s = malloc((size_t)n + 1);
-	assert_non_null(s);
-	s[fread(s, 1, (size_t)n, f)] = '\0';
-	fclose(f);
-	return s;
-}
-
-/* Starts ajar with `args` (NULL-terminated), stdout and stderr going to
- * files in test_dir; returns the child's pid. */
-static pid_t spawn(const char *const *args)
-{
-	const char *argv[32];
-	int n = 0;
-	argv[n++] = test_ajar_bin();
-	while (args[n - 1] && n < 31) {
-		argv[n] = args[n - 1];
-		n++;
-	}
-	argv[n] = NULL;
-	char *out = test_tmp("stdout.txt"), *err = test_tmp("stderr.txt");
-	pid_t pid = fork();
-	assert_true(pid >= 0);
-	if (pid == 0) {
-		int fo = open(out, O_WRONLY | O_CREAT | O_TRUNC, 0644), fe = open(err, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-		if (fo < 0 || fe < 0 || dup2(fo, 1) < 0 || dup2(fe, 2) < 0)
-			_exit(127);
-		execv(argv[0], (char *const *)argv);
-		_exit(127);
-	}
-	free(out);
-	free(err);
-	return pid;
-}
-
-static int wait_exit(pid_t pid)
-{
-	int status;
-	assert_int_equal(waitpid(pid, &status, 0), pid);
-	assert_true(WIFEXITED(status)); /* not killed by a signal */
-	return WEXITSTATUS(status);
-}
-
 typedef struct {
 	int code;
 	char *out, *err;
@@ -85,10 +35,10 @@ typedef struct {
 static Result run(const char *const *args)
 {
 	Result r;
-	r.code = wait_exit(spawn(args));
 	char *o = test_tmp("stdout.txt"), *e = test_tmp("stderr.txt");
-	r.out = read_file(o);
-	r.err = read_file(e);
+	r.code = test_wait_exit(test_spawn(test_ajar_bin(), args, o, e));
+	r.out = test_read_file(o, NULL);
+	r.err = test_read_file(e, NULL);
 	unlink(o);
 	unlink(e);
 	free(o);
@@ -279,7 +229,7 @@ static void test_tiny_render(void **state)
 	assert_int_equal(h, 32);
 	free(px);
 
-	char *bytes = read_file(png);
+	char *bytes = test_read_file(png, NULL);
 	assert_memory_equal(bytes, "\x89PNG\r\n\x1a\n", 8);
 	free(bytes);
 	/* --quiet prints nothing on success. */
@@ -351,13 +301,15 @@ static void test_sigint(void **state)
 	const uint32_t full_spp = 1000000;
 	char full[16];
 	snprintf(full, sizeof full, "%u", full_spp);
-	pid_t pid = spawn((const char *[]){"render", CORNELL, "-o", exr, "--size", "16x16", "--time", "60", "--spp",
-					   full, NULL});
+	pid_t pid = test_spawn(test_ajar_bin(),
+			       (const char *[]){"render", CORNELL, "-o", exr, "--size", "16x16", "--time", "60", "--spp", full,
+						NULL},
+			       NULL, err);
 	/* Wait for the render to start (after kernels are built, which may
 	 * take long on a cold cache), then for a pass or two. */
 	int started = 0;
 	for (double t0 = now(); !started && now() - t0 < 300;) {
-		char *s = read_file(err);
+		char *s = test_read_file(err, NULL);
 		started = strstr(s, "rendering") != NULL;
 		free(s);
 		if (waitpid(pid, NULL, WNOHANG) == pid)
@@ -432,7 +384,7 @@ static void test_special_outputs(void **state)
 
 	/* An output that is the scene, or another output. */
 	char *scene = test_tmp("scene.gltf");
-	char *text = read_file(CORNELL);
+	char *text = test_read_file(CORNELL, NULL);
 	FILE *f = fopen(scene, "wb");
 	assert_non_null(f);
 	fputs(text, f);
@@ -442,7 +394,7 @@ static void test_special_outputs(void **state)
 	assert_int_equal(system(cmd), 0);
 	expect((const char *[]){"render", scene, "-o", scene, "--size", "8x8", "--spp", "1", NULL}, 1,
 	       "is also the scene");
-	char *again = read_file(scene);
+	char *again = test_read_file(scene, NULL);
 	assert_string_equal(again, text);
 	char *out = test_tmp("same.exr"), *dotted = test_tmp("./same.exr");
 	expect((const char *[]){"render", scene, "-o", out, "--png", dotted, "--size", "8x8", "--spp", "1", NULL}, 1,

@@ -20,45 +20,11 @@ typedef struct {
 	char *out, *err;
 } Result;
 
-static char *slurp(const char *path)
-{
-	FILE *f = fopen(path, "rb");
-	if (!f)
-		return calloc(1, 1);
-	fseek(f, 0, SEEK_END);
-	long n = ftell(f);
-	fseek(f, 0, SEEK_SET);
-	char *s = malloc((size_t)n + 1);
-	assert_non_null(s);
-	s[fread(s, 1, (size_t)n, f)] = '\0';
-	fclose(f);
-	return s;
-}
-
 static Result run(const char *const *args)
 {
-	const char *argv[40];
-	int n = 0;
-	argv[n++] = test_ajar_bin();
-	while (args[n - 1] && n < 39) {
-		argv[n] = args[n - 1];
-		n++;
-	}
-	argv[n] = NULL;
 	char *out = test_tmp("stdout.txt"), *err = test_tmp("stderr.txt");
-	pid_t pid = fork();
-	assert_true(pid >= 0);
-	if (pid == 0) {
-		int fo = open(out, O_WRONLY | O_CREAT | O_TRUNC, 0644), fe = open(err, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-		if (fo < 0 || fe < 0 || dup2(fo, 1) < 0 || dup2(fe, 2) < 0)
-			_exit(127);
-		execv(argv[0], (char *const *)argv);
-		_exit(127);
-	}
-	int status;
-	assert_int_equal(waitpid(pid, &status, 0), pid);
-	assert_true(WIFEXITED(status));
-	Result r = {WEXITSTATUS(status), slurp(out), slurp(err)};
+	int code = test_wait_exit(test_spawn(test_ajar_bin(), args, out, err));
+	Result r = {code, test_read_file(out, NULL), test_read_file(err, NULL)};
 	unlink(out);
 	unlink(err);
 	free(out);
@@ -103,7 +69,7 @@ static void test_cli_portals(void **state)
 	free(r.out);
 	free(r.err);
 	/* The file: four nodes marked as portals, an embedded buffer. */
-	char *text = slurp(gltf);
+	char *text = test_read_file(gltf, NULL);
 	assert_int_equal(count(text, "\"portal\": true"), 4);
 	assert_non_null(strstr(text, "data:application/octet-stream;base64,"));
 	free(text);

@@ -79,17 +79,11 @@ static char *only_cache_file(const char *dir)
 
 static unsigned char *read_all(const char *path, long *size)
 {
-	FILE *f = fopen(path, "rb");
-	assert_non_null(f);
-	assert_int_equal(fseek(f, 0, SEEK_END), 0);
-	*size = ftell(f);
+	size_t n;
+	unsigned char *b = (unsigned char *)test_read_file(path, &n);
+	*size = (long)n;
 	assert_true(*size > 0);
-	rewind(f);
-	unsigned char *buf = malloc((size_t)*size);
-	assert_non_null(buf);
-	assert_int_equal(fread(buf, 1, (size_t)*size, f), (size_t)*size);
-	fclose(f);
-	return buf;
+	return b;
 }
 
 static void write_all(const char *path, const void *data, size_t size)

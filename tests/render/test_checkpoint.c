@@ -173,19 +173,7 @@ static void test_resume_portal_layers(void **state)
 
 /* ---- Refusals -------------------------------------------------------------- */
 
-static unsigned char *slurp(const char *path, size_t *n)
-{
-	FILE *f = fopen(path, "rb");
-	assert_non_null(f);
-	fseek(f, 0, SEEK_END);
-	*n = (size_t)ftell(f);
-	fseek(f, 0, SEEK_SET);
-	unsigned char *b = malloc(*n ? *n : 1);
-	assert_non_null(b);
-	assert_int_equal(fread(b, 1, *n, f), *n);
-	fclose(f);
-	return b;
-}
+static unsigned char *slurp(const char *path, size_t *n) { return (unsigned char *)test_read_file(path, n); }
 
 static void spit(const char *path, const void *b, size_t n)
 {
@@ -420,43 +408,20 @@ static void test_device_lost(void **state)
  * Returns the exit code; stderr goes to test_dir/stderr.txt. */
 static int run_ajar(const char *const *args, int delay_ms)
 {
-	const char *argv[40];
-	int n = 0;
-	argv[n++] = test_ajar_bin();
-	for (; args[n - 1] && n < 39; n++)
-		argv[n] = args[n - 1];
-	argv[n] = NULL;
 	char *err = test_tmp("stderr.txt");
-	fflush(NULL);
-	pid_t pid = fork();
-	assert_true(pid >= 0);
-	if (pid == 0) {
-		int fe = open(err, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-		if (fe < 0 || dup2(fe, 2) < 0)
-			_exit(127);
-		execv(argv[0], (char *const *)argv);
-		_exit(127);
-	}
+	pid_t pid = test_spawn(test_ajar_bin(), args, NULL, err);
 	free(err);
 	if (delay_ms > 0) {
 		struct timespec ts = {delay_ms / 1000, (long)(delay_ms % 1000) * 1000000L};
 		nanosleep(&ts, NULL);
 		kill(pid, SIGINT);
 	}
-	int status;
-	assert_int_equal(waitpid(pid, &status, 0), pid);
-	assert_true(WIFEXITED(status));
-	return WEXITSTATUS(status);
+	return test_wait_exit(pid);
 }
 
 static char *stderr_text(void)
 {
-	char *p = test_tmp("stderr.txt");
-	size_t n;
-	unsigned char *b = slurp(p, &n);
-	char *s = realloc(b, n + 1);
-	assert_non_null(s);
-	s[n] = '\0';
+	char *p = test_tmp("stderr.txt"), *s = test_read_file(p, NULL);
 	free(p);
 	return s;
 }

@@ -134,35 +134,11 @@ static void test_stops_within_bound(void **state)
 /* Runs ajar with args; returns the exit code, stderr in err (malloc'ed). */
 static int run(const char *const *args, char **err)
 {
-	const char *argv[24];
-	int n = 0;
-	argv[n++] = test_ajar_bin();
-	while (args[n - 1] && n < 23) {
-		argv[n] = args[n - 1];
-		n++;
-	}
-	argv[n] = NULL;
 	char *path = test_tmp("stderr.txt");
-	pid_t pid = fork();
-	assert_true(pid >= 0);
-	if (pid == 0) {
-		int fe = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0644), fo = open("/dev/null", O_WRONLY);
-		if (fe < 0 || fo < 0 || dup2(fo, 1) < 0 || dup2(fe, 2) < 0)
-			_exit(127);
-		execv(argv[0], (char *const *)argv);
-		_exit(127);
-	}
-	int status;
-	assert_int_equal(waitpid(pid, &status, 0), pid);
-	FILE *f = fopen(path, "r");
-	*err = calloc(1, 1 << 16);
-	if (f) {
-		size_t got = fread(*err, 1, (1 << 16) - 1, f);
-		(*err)[got] = '\0';
-		fclose(f);
-	}
+	int code = test_wait_exit(test_spawn(test_ajar_bin(), args, NULL, path));
+	*err = test_read_file(path, NULL);
 	free(path);
-	return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+	return code;
 }
 
 static void test_cli_noise(void **state)

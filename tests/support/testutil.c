@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <dirent.h>
+#include <fcntl.h>
+#include <sys/wait.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -168,4 +170,59 @@ float *test_sun_sky(uint32_t w, uint32_t h, float sun_x, float sun_y, float sun_
 				p[0] = p[1] = p[2] = sun_l;
 		}
 	return rgb;
+}
+
+pid_t test_spawn(const char *bin, const char *const *args, const char *out, const char *err)
+{
+	const char *argv[48];
+	int n = 0;
+	argv[n++] = bin;
+	while (args[n - 1] && n < 47) {
+		argv[n] = args[n - 1];
+		n++;
+	}
+	argv[n] = NULL;
+	/* The files exist when this returns: a test may read them at once. */
+	int fo = open(out ? out : "/dev/null", O_WRONLY | O_CREAT | O_TRUNC, 0644);
+	int fe = open(err ? err : "/dev/null", O_WRONLY | O_CREAT | O_TRUNC, 0644);
+	assert_true(fo >= 0 && fe >= 0);
+	fflush(NULL); /* nothing buffered is written twice */
+	pid_t pid = fork();
+	assert_true(pid >= 0);
+	if (pid == 0) {
+		if (dup2(fo, 1) < 0 || dup2(fe, 2) < 0)
+			_exit(127);
+		execv(argv[0], (char *const *)argv);
+		_exit(127);
+	}
+	close(fo);
+	close(fe);
+	return pid;
+}
+
+int test_wait_exit(pid_t pid)
+{
+	int status;
+	assert_int_equal(waitpid(pid, &status, 0), pid);
+	assert_true(WIFEXITED(status)); /* not killed by a signal */
+	return WEXITSTATUS(status);
+}
+
+char *test_read_file(const char *path, size_t *n)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f)
+		fail_msg("%s: cannot open", path);
+	assert_int_equal(fseek(f, 0, SEEK_END), 0);
+	long len = ftell(f);
+	assert_true(len >= 0);
+	rewind(f);
+	char *b = malloc((size_t)len + 1);
+	assert_non_null(b);
+	assert_int_equal(fread(b, 1, (size_t)len, f), (size_t)len);
+	b[len] = '\0';
+	fclose(f);
+	if (n)
+		*n = (size_t)len;
+	return b;
 }

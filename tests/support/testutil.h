@@ -6,6 +6,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <sys/types.h>
 #include <cmocka.h>
 
 /* Path of a file in the source tree's scenes/ (tests run from the top). */
@@ -44,6 +45,15 @@ int test_group_teardown(void **state);
 char *test_tmp(const char *name);
 /* The ajar program the CLI tests run: $AJAR_BIN, else build/ajar. */
 const char *test_ajar_bin(void);
+/* Starts program `bin` with args (NULL-terminated, at most 46), its
+ * standard output into file `out` and its errors into `err` (either NULL:
+ * /dev/null), both made before it starts; returns the child's pid. */
+pid_t test_spawn(const char *bin, const char *const *args, const char *out, const char *err);
+/* Waits for pid, which must exit rather than die by a signal; its code. */
+int test_wait_exit(pid_t pid);
+/* The whole file at path (which must open), with a 0 after its bytes so
+ * that text reads as a string; its length in *n unless n is NULL. */
+char *test_read_file(const char *path, size_t *n);
 /* tests/support/ajar_faults.c's program, beside the running test binary: the ajar
  * command with faults injected from AJAR_TEST_FAIL_DEVICE and
  * AJAR_TEST_PASS_SPP in its environment. */

@@ -52,18 +52,9 @@ static uint64_t fnv1a(const void *p, size_t n)
 /* Reads a whole file into a malloc'ed buffer. */
 static unsigned char *slurp(const char *path, size_t *n)
 {
-	FILE *f = fopen(path, "rb");
-	assert_non_null(f);
-	assert_int_equal(fseek(f, 0, SEEK_END), 0);
-	long len = ftell(f);
-	assert_true(len > 0);
-	rewind(f);
-	unsigned char *buf = malloc((size_t)len);
-	assert_non_null(buf);
-	assert_int_equal(fread(buf, 1, (size_t)len, f), (size_t)len);
-	fclose(f);
-	*n = (size_t)len;
-	return buf;
+	unsigned char *b = (unsigned char *)test_read_file(path, n);
+	assert_true(*n > 0);
+	return b;
 }
 
 static void spill(const char *path, const unsigned char *buf, size_t n)
