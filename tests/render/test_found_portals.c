@@ -17,13 +17,10 @@
 #include <string.h>
 
 #include "ajar.h"
+#include "batch_means.h"
 #include "testutil.h"
 
 #define BATCHES 16
-
-typedef struct {
-	double mean[3], se[3];
-} Estimate;
 
 static void estimate(ajar_scene *s, ajar_integrator integ, uint32_t w, uint32_t h, uint32_t spp, Estimate *e)
 {
@@ -41,40 +38,8 @@ static void estimate(ajar_scene *s, ajar_integrator integ, uint32_t w, uint32_t 
 	uint32_t n = 0;
 	assert_int_equal(ajar_renderer_found_portals(r, NULL, 0, &n, NULL), AJAR_OK);
 	assert_true(n > 0);
-	float *img = malloc(sizeof(float) * 4 * w * h);
-	double s1[3] = {0}, s2[3] = {0};
-	for (int b = 0; b < BATCHES; b++) {
-		assert_int_equal(ajar_renderer_restart(r, 200 + b), AJAR_OK);
-		if (ajar_renderer_render(r, NULL, NULL) != AJAR_OK)
-			fail_msg("%s", ajar_last_error());
-		assert_int_equal(ajar_renderer_image(r, img, NULL, NULL), AJAR_OK);
-		for (int c = 0; c < 3; c++) {
-			double m = 0;
-			for (uint32_t i = 0; i < w * h; i++)
-				m += img[4 * i + c];
-			m /= w * h;
-			s1[c] += m;
-			s2[c] += m * m;
-		}
-	}
-	for (int c = 0; c < 3; c++) {
-		e->mean[c] = s1[c] / BATCHES;
-		e->se[c] = sqrt(fmax(0, (s2[c] - s1[c] * s1[c] / BATCHES) / (BATCHES - 1)) / BATCHES);
-	}
-	free(img);
+	batch_means(r, w, h, BATCHES, 200, e);
 	ajar_renderer_destroy(&r);
-}
-
-static void agree(const char *what, const Estimate *a, const Estimate *b)
-{
-	for (int c = 0; c < 3; c++) {
-		double se = sqrt(a->se[c] * a->se[c] + b->se[c] * b->se[c]);
-		double z = se > 0 ? (a->mean[c] - b->mean[c]) / se : 0;
-		print_message("%s, channel %d: %.5f +- %.5f vs %.5f +- %.5f (%+.1f se)\n", what, c, a->mean[c], a->se[c],
-			      b->mean[c], b->se[c], z);
-		if (fabs(z) > 5)
-			fail_msg("%s, channel %d: the integrators differ by %.1f standard errors", what, c, z);
-	}
 }
 
 static void compare(const char *path, uint32_t w, uint32_t h, uint32_t spp_pt, uint32_t spp_bdpt)
@@ -84,15 +49,13 @@ static void compare(const char *path, uint32_t w, uint32_t h, uint32_t spp_pt, u
 		fail_msg("%s", ajar_last_error());
 	Estimate pt, bdpt, portal;
 	char what[256];
+	snprintf(what, sizeof what, "%s (found portals)", path);
 	estimate(s, AJAR_INTEGRATOR_PT, w, h, spp_pt, &pt);
 	estimate(s, AJAR_INTEGRATOR_BDPT, w, h, spp_bdpt, &bdpt);
 	estimate(s, AJAR_INTEGRATOR_PORTAL, w, h, spp_bdpt, &portal);
-	snprintf(what, sizeof what, "%s (found portals) bdpt vs pt", path);
-	agree(what, &bdpt, &pt);
-	snprintf(what, sizeof what, "%s (found portals) portal vs pt", path);
-	agree(what, &portal, &pt);
-	snprintf(what, sizeof what, "%s (found portals) portal vs bdpt", path);
-	agree(what, &portal, &bdpt);
+	estimates_agree(what, "bdpt", &bdpt, "pt", &pt);
+	estimates_agree(what, "portal", &portal, "pt", &pt);
+	estimates_agree(what, "portal", &portal, "bdpt", &bdpt);
 	ajar_scene_destroy(&s);
 }
 

@@ -17,13 +17,10 @@
 
 #include "ajar.h"
 #include "render/render_overrides.h"
+#include "batch_means.h"
 #include "testutil.h"
 
 #define BATCHES 16
-
-typedef struct {
-	double mean[3], se[3];
-} Estimate;
 
 static void estimate(const ajar_scene *s, ajar_integrator integ, uint32_t size, uint32_t spp, uint32_t depth,
 		     const PolicyOverrides *over, Estimate *e)
@@ -37,28 +34,7 @@ static void estimate(const ajar_scene *s, ajar_integrator integ, uint32_t size, 
 	o.max_depth = depth;
 	if (renderer_create_overridden(s, &o, over, &r) != AJAR_OK)
 		fail_msg("%s", ajar_last_error());
-	float *img = malloc(sizeof(float) * 4 * size * size);
-	double s1[3] = {0}, s2[3] = {0};
-	for (int b = 0; b < BATCHES; b++) {
-		assert_int_equal(ajar_renderer_restart(r, 300 + b), AJAR_OK);
-		if (ajar_renderer_render(r, NULL, NULL) != AJAR_OK)
-			fail_msg("%s", ajar_last_error());
-		assert_int_equal(ajar_renderer_image(r, img, NULL, NULL), AJAR_OK);
-		for (int c = 0; c < 3; c++) {
-			double m = 0;
-			for (uint32_t i = 0; i < size * size; i++)
-				m += img[4 * i + c];
-			m /= size * size;
-			s1[c] += m;
-			s2[c] += m * m;
-		}
-	}
-	for (int c = 0; c < 3; c++) {
-		e->mean[c] = s1[c] / BATCHES;
-		double var = (s2[c] - s1[c] * s1[c] / BATCHES) / (BATCHES - 1);
-		e->se[c] = sqrt(fmax(var, 0.0) / BATCHES);
-	}
-	free(img);
+	batch_means(r, size, size, BATCHES, 300, e);
 	ajar_renderer_destroy(&r);
 }
 
@@ -72,18 +48,6 @@ static void expect(const char *what, ajar_integrator integ, const Estimate *e, c
 		if (fabs(e->mean[c] - want[c]) > 5 * e->se[c] + margin * want[c])
 			fail_msg("%s, %s, channel %d: %.5f +- %.5f, want %.5f", what, integ_name(integ), c, e->mean[c],
 				 e->se[c], want[c]);
-	}
-}
-
-static void agree(const char *what, const char *na, const Estimate *a, const char *nb, const Estimate *b)
-{
-	for (int c = 0; c < 3; c++) {
-		double d = a->mean[c] - b->mean[c], se = sqrt(a->se[c] * a->se[c] + b->se[c] * b->se[c]);
-		print_message("%s, channel %d: %s %.5f +- %.5f, %s %.5f +- %.5f (%.1f se)\n", what, c, na, a->mean[c],
-			      a->se[c], nb, b->mean[c], b->se[c], fabs(d) / se);
-		if (fabs(d) > 5 * se)
-			fail_msg("%s, channel %d: %s %.5f +- %.5f and %s %.5f +- %.5f disagree", what, c, na, a->mean[c],
-				 a->se[c], nb, b->mean[c], b->se[c]);
 	}
 }
 
@@ -200,8 +164,8 @@ static void test_pane_brute_force(void **state)
 	estimate(s, AJAR_INTEGRATOR_PT, 24, 256, 64, &brute, &b);
 	estimate(s, AJAR_INTEGRATOR_PT, 24, 32, 64, NULL, &p);
 	estimate(s, AJAR_INTEGRATOR_PORTAL, 24, 16, 32, NULL, &q);
-	agree("glazed window-room", "pt, panes opaque to connections", &b, "pt", &p);
-	agree("glazed window-room", "pt, panes opaque to connections", &b, "portal", &q);
+	estimates_agree("glazed window-room", "pt, panes opaque to connections", &b, "pt", &p);
+	estimates_agree("glazed window-room", "pt, panes opaque to connections", &b, "portal", &q);
 	ajar_scene_destroy(&s);
 }
 
@@ -245,7 +209,7 @@ static void test_many_panes(void **state)
 	Estimate b, p;
 	estimate(s, AJAR_INTEGRATOR_PT, 16, 512, 64, &brute, &b);
 	estimate(s, AJAR_INTEGRATOR_PT, 16, 64, 64, NULL, &p);
-	agree("ten panes over a floor", "pt, panes opaque to connections", &b, "pt", &p);
+	estimates_agree("ten panes over a floor", "pt, panes opaque to connections", &b, "pt", &p);
 	ajar_scene_destroy(&s);
 }
 

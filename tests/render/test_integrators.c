@@ -20,6 +20,7 @@
 #include "ajar.h"
 #include "render/render_overrides.h"
 #include "scene/scene.h"
+#include "batch_means.h"
 #include "testutil.h"
 
 #define BATCHES 16
@@ -29,10 +30,6 @@ static PolicyOverrides g_over;
 /* The sky's intermediate strategy set with light subpaths: portal keeps its
  * intermediate strategies where it would render as bdpt. */
 static const PolicyOverrides SKY_SET = {.portal_set_given = 1, .portal_set = {1, 2, 1, 3, 1}};
-
-typedef struct {
-	double mean[3], se[3];
-} Estimate;
 
 static void estimate(ajar_scene *s, ajar_integrator integ, uint32_t w, uint32_t h, uint32_t spp, uint32_t depth,
 		     Estimate *e)
@@ -47,57 +44,20 @@ static void estimate(ajar_scene *s, ajar_integrator integ, uint32_t w, uint32_t 
 	o.max_depth = depth;
 	if (renderer_create_overridden(s, &o, &g_over, &r) != AJAR_OK)
 		fail_msg("%s", ajar_last_error());
-	float *img = malloc(sizeof(float) * 4 * w * h);
-	double s1[3] = {0}, s2[3] = {0};
-	for (int b = 0; b < BATCHES; b++) {
-		assert_int_equal(ajar_renderer_restart(r, 100 + b), AJAR_OK);
-		if (ajar_renderer_render(r, NULL, NULL) != AJAR_OK)
-			fail_msg("%s", ajar_last_error());
-		assert_int_equal(ajar_renderer_image(r, img, NULL, NULL), AJAR_OK);
-		for (int c = 0; c < 3; c++) {
-			double m = 0;
-			for (uint32_t i = 0; i < w * h; i++)
-				m += img[4 * i + c];
-			m /= w * h;
-			s1[c] += m;
-			s2[c] += m * m;
-		}
-	}
-	for (int c = 0; c < 3; c++) {
-		e->mean[c] = s1[c] / BATCHES;
-		e->se[c] = sqrt(fmax(0, (s2[c] - s1[c] * s1[c] / BATCHES) / (BATCHES - 1)) / BATCHES);
-	}
-	free(img);
+	batch_means(r, w, h, BATCHES, 100, e);
 	ajar_renderer_destroy(&r);
-}
-
-static void agree(const char *what, const Estimate *a, const Estimate *b)
-{
-	for (int c = 0; c < 3; c++) {
-		double se = sqrt(a->se[c] * a->se[c] + b->se[c] * b->se[c]);
-		double z = se > 0 ? (a->mean[c] - b->mean[c]) / se : 0;
-		print_message("%s, channel %d: %.5f +- %.5f vs %.5f +- %.5f (%+.1f se, se %.2f%% of the mean)\n",
-			      what, c, a->mean[c], a->se[c], b->mean[c], b->se[c], z,
-			      100 * se / fmax(fabs(b->mean[c]), 1e-12));
-		if (fabs(z) > 5)
-			fail_msg("%s, channel %d: the integrators differ by %.1f standard errors", what, c, z);
-	}
 }
 
 static void compare_scene(ajar_scene *s, const char *path, uint32_t w, uint32_t h, uint32_t spp_pt, uint32_t spp_bdpt)
 {
 	Estimate pt, bdpt, portal;
-	char what[256];
 	const uint32_t depth = 12;
 	estimate(s, AJAR_INTEGRATOR_PT, w, h, spp_pt, depth, &pt);
 	estimate(s, AJAR_INTEGRATOR_BDPT, w, h, spp_bdpt, depth, &bdpt);
-	snprintf(what, sizeof what, "%s bdpt vs pt", path);
-	agree(what, &bdpt, &pt);
+	estimates_agree(path, "bdpt", &bdpt, "pt", &pt);
 	estimate(s, AJAR_INTEGRATOR_PORTAL, w, h, spp_bdpt, depth, &portal);
-	snprintf(what, sizeof what, "%s portal vs pt", path);
-	agree(what, &portal, &pt);
-	snprintf(what, sizeof what, "%s portal vs bdpt", path);
-	agree(what, &portal, &bdpt);
+	estimates_agree(path, "portal", &portal, "pt", &pt);
+	estimates_agree(path, "portal", &portal, "bdpt", &bdpt);
 	ajar_scene_destroy(&s);
 }
 
