@@ -36,7 +36,8 @@ void estimates_agree(const char *what, const char *na, const Estimate *a, const 
 {
 	for (int c = 0; c < 3; c++) {
 		double se = sqrt(a->se[c] * a->se[c] + b->se[c] * b->se[c]);
-		double z = se > 0 ? (a->mean[c] - b->mean[c]) / se : 0;
+		double d = a->mean[c] - b->mean[c];
+		double z = se > 0 ? d / se : (d == 0 ? 0 : INFINITY); /* noiseless: equal or not */
 		print_message("%s, channel %d: %s %.5f +- %.5f vs %s %.5f +- %.5f (%+.1f se, se %.2f%% of the mean)\n",
 			      what, c, na, a->mean[c], a->se[c], nb, b->mean[c], b->se[c], z,
 			      100 * se / fmax(fabs(b->mean[c]), 1e-12));
