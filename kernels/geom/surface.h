@@ -142,11 +142,19 @@ INLINE void surface_from_hit(const SceneView *sc, const Hit *h, Surface *s)
 #ifndef AJAR_NO_BENT_NORMALS
 	if (t->flags & TRI_TANGENT) {
 		GLOBAL const Material *m = &sc->materials[s->material];
-		V3 tan;
-		float sign;
-		/* tangents may be there for anisotropy or the clear coat's map alone */
-		if (m->normal_tex && (sign = surface_tangent(sc, h, w, n, &tan)) != 0.0f)
-			n = surface_normal_map(sc, s, tan, sign, n, m->normal_tex - 1, m->normal_scale);
+		/* Tangents may be there for anisotropy or the clear coat's map alone. */
+		if (m->normal_tex) {
+#if !defined(AJAR_NO_LAYERS) || !defined(AJAR_NO_ANISOTROPY)
+			/* nu is n or -n: made orthogonal to either, the tangent is the same. */
+			V3 tan = s->tan;
+			float sign = s->tsign;
+#else
+			V3 tan;
+			float sign = surface_tangent(sc, h, w, n, &tan);
+#endif
+			if (sign != 0.0f)
+				n = surface_normal_map(sc, s, tan, sign, n, m->normal_tex - 1, m->normal_scale);
+		}
 	}
 #endif
 	s->ns = v3_dot(n, s->ng) < 0.0f ? v3_neg(n) : n;
