@@ -58,6 +58,7 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 		Surface s;
 		int hit, c_edge = 0;
 		float edge_t = 0.0f; /* the edge's length before the last pane crossed */
+		float exist = 1.0f;  /* the probability of a vertex where the walk stopped */
 		/* The next hit, crossing panes by their null event (vertex.h, vertex_trace). */
 		for (int panes = 0;; panes++) {
 			hit = bvh_intersect(sc, o, d, AJAR_INF, &h);
@@ -79,6 +80,7 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 					o = q;
 					continue;
 				}
+				exist = 1.0f - pn;
 			}
 #endif
 			break;
@@ -140,7 +142,7 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 						/* A punctual light is sampled by next-event estimation alone. */
 						float w = (ls.delta ? 1.0f : mis_power(ls.pdf_w, pdf_bsdf_w)) *
 							  pt_cross_weight(prm, cnt, depth + 2, c_nee);
-						float k = fabs(v3_dot(s.ns, ls.wi)) * w / ls.pdf_w;
+						float k = fabs(v3_dot(s.ns, ls.wi)) * w / (ls.pdf_w * exist);
 						L = v3_add(L, v3_scale(v3_mul(v3_mul(v3_mul(beta, f), T), ls.Le), k));
 					}
 				}
@@ -150,14 +152,20 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 		float u0, u1, u2;
 		rng_f3(rng, &u0, &u1, &u2);
 #ifndef AJAR_NO_PANES
+		float rest = 1.0f; /* the share of the BSDF's sampling left to the vertex */
 		if (sc->tris[s.tri].flags & TRI_PANE) /* the null event was decided against where it was hit */
-			u0 *= 1.0f - bsdf_null_prob(&bs, wo);
+			rest = 1.0f - bsdf_null_prob(&bs, wo);
+		u0 *= rest;
 #endif
 		if (!bsdf_sample_fwd(&bs, wo, u0, u1, u2, BSDF_RADIANCE, &bsm) || !(bsm.pdf_w > 0.0f))
 			break;
 		if (bsm.delta == BSDF_NULL) /* smooth thin glass that is no pane: a delta vertex */
 			bsm.delta = 1;
-		beta = v3_mul(beta, v3_scale(bsm.f, fabs(v3_dot(s.ns, bsm.wi)) / bsm.pdf_w));
+		float k = fabs(v3_dot(s.ns, bsm.wi)) / bsm.pdf_w;
+#ifndef AJAR_NO_PANES
+		k *= rest / exist; /* a pane's vertex had probability exist, its lobes the share rest */
+#endif
+		beta = v3_mul(beta, v3_scale(bsm.f, k));
 		prev_pdf_w = bsm.pdf_w;
 		prev_delta = bsm.delta;
 		prev_p = s.p;

@@ -213,8 +213,10 @@ INLINE float vertex_shading_correction(const PathVertex *v, V3 wo, V3 wi)
  * probability bsdf_null_prob, as bsdf_sample would pick it there: no
  * vertex, the ray goes on, beta times the transmittance over that
  * probability; the densities stay those of path[n - 1]'s sampling, over
- * the whole edge. Otherwise the pane becomes the vertex, and its
- * scattering (vertex_scatter) samples the rest of its BSDF. rng draws only
+ * the whole edge. Otherwise the pane becomes the vertex, its throughput
+ * over the probability of that (what connections from it need), and its
+ * scattering (vertex_scatter) samples the rest of its BSDF, times the
+ * rest's share (what continuing needs). rng draws only
  * at panes. The edge also takes Beer-Lambert absorption where it runs
  * inside a solid. */
 CALLED int vertex_trace(const SceneView *sc, VRef path, int n, V3 o, V3 d, V3 beta, float pdf_w, int parallel,
@@ -232,6 +234,7 @@ CALLED int vertex_trace(const SceneView *sc, VRef path, int n, V3 o, V3 d, V3 be
 	v->cross = 0;
 	int hit;
 	Surface s;
+	float exist = 1.0f; /* the probability that the walk has a vertex where it stopped */
 	for (int panes = 0;; panes++) {
 		hit = bvh_intersect(sc, o, d, AJAR_INF, &h);
 		if (!hit)
@@ -250,11 +253,12 @@ CALLED int vertex_trace(const SceneView *sc, VRef path, int n, V3 o, V3 d, V3 be
 				o = ray_offset(s.p, s.ng, d);
 				continue;
 			}
+			exist = 1.0f - pn;
 		}
 #endif
 		break;
 	}
-	v->beta = beta;
+	v->beta = v3_scale(beta, 1.0f / exist);
 	if (!hit) {
 		if (!escape_env || sc->params->env_type == ENV_NONE)
 			return 0;
@@ -312,8 +316,10 @@ INLINE int vertex_scatter(const SceneView *sc, VRef path, int n, int light_side,
 #ifndef AJAR_NO_PANES
 	/* vertex_trace decided against a pane's null event here: the rest of
 	 * its BSDF, with the lobe probabilities it has (what MIS reads). */
+	float rest = 1.0f; /* the share of the BSDF's sampling left to the vertex */
 	if (sc->tris[v->tri].flags & TRI_PANE)
-		u0 *= 1.0f - bsdf_null_prob(&v->bs, v->wo);
+		rest = 1.0f - bsdf_null_prob(&v->bs, v->wo);
+	u0 *= rest;
 #endif
 	if (!bsdf_sample(&v->bs, v->wo, u0, u1, u2, light_side ? BSDF_IMPORTANCE : BSDF_RADIANCE, &bsm) ||
 	    !(bsm.pdf_w > 0.0f))
@@ -321,6 +327,9 @@ INLINE int vertex_scatter(const SceneView *sc, VRef path, int n, int light_side,
 	if (bsm.delta == BSDF_NULL) /* smooth thin glass that is no pane (emissive): a delta vertex */
 		bsm.delta = 1;
 	float k = fabs(v3_dot(v->ns, bsm.wi)) / bsm.pdf_w;
+#ifndef AJAR_NO_PANES
+	k *= rest; /* v->beta counts the vertex's own probability (vertex_trace) */
+#endif
 	if (light_side)
 		k *= vertex_shading_correction(v, v->wo, bsm.wi);
 	*beta = v3_mul(v->beta, v3_scale(bsm.f, k));

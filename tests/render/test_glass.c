@@ -213,6 +213,46 @@ static void test_many_panes(void **state)
 	ajar_scene_destroy(&s);
 }
 
+/* A partly transmissive pane (transmission 0.5 over a diffuse base, smooth)
+ * as a floor under the white sky, nothing below it: a walk that reaches it
+ * has a vertex there only when it decides against the null event, so
+ * next-event estimation at that vertex must count its probability. Against
+ * the brute force, where the null event is an ordinary delta lobe. */
+static void test_partial_pane(void **state)
+{
+	(void)state;
+	ajar_scene *s;
+	assert_int_equal(ajar_scene_create(&s), AJAR_OK);
+	ajar_camera cam = {{0, 1, 0}, {0, -1, 0}, {0, 0, -1}, 0.5f, 0};
+	assert_int_equal(ajar_scene_set_camera(s, &cam), AJAR_OK);
+	const float white[3] = {1, 1, 1};
+	assert_int_equal(ajar_scene_set_environment_color(s, white), AJAR_OK);
+	ajar_material m;
+	ajar_material_default(&m);
+	m.base_color[0] = 0.8f;
+	m.base_color[1] = 0.6f;
+	m.base_color[2] = 0.4f;
+	m.roughness = 0.0f;
+	m.transmission = 0.5f;
+	uint32_t mat;
+	assert_int_equal(ajar_scene_add_material(s, &m, &mat), AJAR_OK);
+	const float h = 20.0f;
+	float fp[12] = {-h, 0, h, h, 0, h, h, 0, -h, -h, 0, -h};
+	uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+	ajar_mesh fm = {fp, NULL, NULL, 4, idx, 2, mat, NULL};
+	assert_int_equal(ajar_scene_add_mesh(s, &fm), AJAR_OK);
+	const PolicyOverrides brute = {.panes_opaque = 1};
+	Estimate b, p, q, r;
+	estimate(s, AJAR_INTEGRATOR_PT, 16, 256, 16, &brute, &b);
+	estimate(s, AJAR_INTEGRATOR_PT, 16, 256, 16, NULL, &p);
+	estimate(s, AJAR_INTEGRATOR_BDPT, 16, 64, 16, NULL, &q);
+	estimate(s, AJAR_INTEGRATOR_PORTAL, 16, 64, 16, NULL, &r);
+	estimates_agree("a partly transmissive pane", "pt, panes opaque to connections", &b, "pt", &p);
+	estimates_agree("a partly transmissive pane", "pt, panes opaque to connections", &b, "bdpt", &q);
+	estimates_agree("a partly transmissive pane", "pt, panes opaque to connections", &b, "portal", &r);
+	ajar_scene_destroy(&s);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -220,6 +260,7 @@ int main(void)
 		cmocka_unit_test(test_slab_absorption),
 		cmocka_unit_test(test_pane_brute_force),
 		cmocka_unit_test(test_many_panes),
+		cmocka_unit_test(test_partial_pane),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
