@@ -279,7 +279,7 @@ typedef struct {
 	float env_rot_cos;      /* cos and sin of env_rotation, from the host in double */
 	float env_rot_sin;      /* 224 (env.h, env_turn) */
 	int bdpt_conn;          /* bdpt strategies other than light tracing use at most this many
-	                         * light vertices (1 or 2; 0 = any; mis.h, mis_conn_in_set) */
+	                         * non-delta light vertices (1 or 2; 0 = any; mis.h, mis_conn_limit) */
 	int env_lines;          /* 232, a sky image's light subpaths start on lines through the
 	                         * portals, their directions from the ENV_LINE_* tables (env.h) */
 	int num_panes;          /* TRI_PANE triangles (geom/visibility.h) */

@@ -186,20 +186,40 @@ INLINE int bdpt_mis_path(const SceneView *sc, VCRef l, int s, VCRef e, int t, Mi
 	return bdpt_mis_records(sc, l, s, e, t, mv, nee_stored, 0, 0, 0);
 }
 
-/* mis_path_weight of bdpt strategy (s, t); from the connection's
- * neighbourhood and the subpaths' tails where they carry them (with
- * `cp`, the connection's densities; 0 for s = 0). */
+/* The path's first vertex after x_0 that scatters by a non-delta lobe
+ * (mis_first_scatter) for bdpt strategy (s, t): a light vertex before the
+ * connection's light end, or that end, or for s = 1 the eye end; for s = 0
+ * an eye vertex, or the camera. */
+INLINE int bdpt_first_scatter(VCRef l, int s, VCRef e, int t)
+{
+	int j = 1;
+	if (s >= 1)
+		while (j < s - 1 && VGETI(VAT(l, j), delta))
+			j++;
+	else
+		while (j < t - 1 && VGETI(VAT(e, t - 1 - j), delta))
+			j++;
+	return j;
+}
+
+/* mis_path_weight of bdpt strategy (s, t) over the strategies of
+ * Params.bdpt_conn; from the connection's neighbourhood and the subpaths'
+ * tails where they carry them (with `cp`, the connection's densities; 0
+ * for s = 0). A path the eye found through a delta vertex at x_1 (s = 0)
+ * may hold strategies of more light vertices than the eye tails count
+ * (mis.h, mis_eye_tail): the whole path. */
 INLINE float bdpt_path_weight(const SceneView *sc, VCRef l, int s, VCRef e, int t, MisVertex *mv, int nee_stored,
 			      BdptPnCache *pc, const BdptConnPdf *cp)
 {
 	int heuristic = sc->params->mis, conn = sc->params->bdpt_conn;
-	if (!(pc && pc->tails)) {
+	int first = conn ? bdpt_first_scatter(l, s, e, t) : 1, limit = mis_conn_limit(conn, first);
+	if (!(pc && pc->tails) || (s == 0 && first > 1)) {
 		int k = bdpt_mis_records(sc, l, s, e, t, mv, nee_stored, pc, 0, 0);
-		return mis_path_weight_conn(mv, k, s, heuristic, conn);
+		return mis_path_weight_conn(mv, k, s, heuristic, limit);
 	}
 	int k = bdpt_mis_records(sc, l, s, e, t, mv, nee_stored, pc, 1, cp);
 	float ltail = s >= 3 ? VGETF(VAT(l, s - 3), tail) : 0.0f, etail = t >= 4 ? VGETF(VAT(e, t - 3), tail) : 0.0f;
-	return mis_path_weight_tails(mv, k, s, heuristic, conn, ltail, etail);
+	return mis_path_weight_tails(mv, k, s, heuristic, limit, ltail, etail);
 }
 
 /* Every vertex's MIS tail (mis.h) for the weights of bdpt_strategies:
@@ -717,9 +737,11 @@ CALLED void bdpt_strategies(const SceneView *sc, VRef l, int nl, VRef e, int ne,
 				bdpt_add(sc, out, 1, t, c, bdpt_weight_cached(sc, VNEE(e, y), 1, e, t, &pc, cpp),
 					 out->pixel, rng);
 		}
-		/* s >= 2: light vertex s-1 to eye vertex t-1, up to s = conn
+		/* s >= 2: light vertex s-1 to eye vertex t-1, in the set of conn
 		 * (mis.h, mis_conn_in_set). */
-		for (int s = 2; s <= nl && s + t - 1 <= depth && (conn == 0 || s <= conn); s++) {
+		for (int s = 2; s <= nl && s + t - 1 <= depth &&
+				(conn == 0 || s <= mis_conn_limit(conn, bdpt_first_scatter(l, s, e, t)));
+		     s++) {
 			const PathVertex *ly = VLOAD(VAT(l, s - 1), lt);
 			V3 c = bdpt_connect_pdf(sc, ly, z, cpp);
 			if (v3_is_zero(c))

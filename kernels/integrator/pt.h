@@ -25,6 +25,7 @@
 #include "sample/roulette.h"
 #include "geom/surface.h"
 #include "geom/visibility.h"
+#include "integrator/pane_choice.h"
 
 #define PT_CROSS_EDGES 33
 #define PT_PANES_MAX 64 /* panes one segment may cross (vertex.h's guard) */
@@ -72,7 +73,7 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 			if ((sc->tris[s.tri].flags & TRI_PANE) && panes < PT_PANES_MAX) {
 				Bsdf pb;
 				surface_bsdf(sc, &s, surface_base_color(sc, &s), &pb);
-				float pn = bsdf_null_prob(&pb, v3_neg(d));
+				float pn = pane_null_choice(sc, bsdf_null_prob(&pb, v3_neg(d)), s.p, d, s.ng);
 				if (pn > 0.0f && rng_f(rng) < pn) {
 					beta = v3_mul(beta, v3_scale(bsdf_null_weight(&pb, d), 1.0f / pn));
 					V3 q = ray_offset(s.p, s.ng, d);

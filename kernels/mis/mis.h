@@ -54,18 +54,36 @@ INLINE float mis_term(float r, int heuristic) { return heuristic == MIS_BALANCE 
 
 /* Which bdpt strategies are in use: all (conn = 0), or light tracing
  * (t = 1, s = k - 1) with every light vertex and the other strategies with
- * at most conn light vertices (s <= conn; conn is 1 or 2, which the tails
- * below need): the portal integrator's set where light subpaths bring the
- * light in (src/prepare/prepare.c, kernels/integrator/README.md, "Connections to the first two light vertices"). */
-INLINE int mis_conn_in_set(int conn, int k, int s) { return conn == 0 || s <= conn || s == k - 1; }
+ * at most conn light vertices that scatter by non-delta lobes, x_0 counted:
+ * the portal integrator's set where light subpaths bring the light in
+ * (src/prepare/policy.c, kernels/integrator/README.md, "Connections to the
+ * first two light vertices"). A pane's or mirror's reflection on the light
+ * side takes no place in the count: the sun mirrored by a pane onto the
+ * wall beside it is joined to the eye vertices as the sun itself is. With
+ * `first` the first vertex after x_0 that scatters by a non-delta lobe
+ * (mis_first_scatter; the camera counts), that is s <= conn + first - 1:
+ * mis_conn_limit. conn is 0, 1 or 2, which the tails below need. */
+INLINE int mis_conn_limit(int conn, int first) { return conn == 0 ? 0 : conn + first - 1; }
+INLINE int mis_conn_in_set(int limit, int k, int s) { return limit == 0 || s <= limit || s == k - 1; }
+
+/* The first vertex x_j, j >= 1, of a path's records that scatters by a
+ * non-delta lobe, or the camera x_{k-1}. */
+INLINE int mis_first_scatter(const MisVertex *v, int k)
+{
+	int j = 1;
+	while (j < k - 1 && v[j].delta)
+		j++;
+	return j;
+}
 
 /* The sum behind mis_path_weight and mis_path_weight_tails: the eye
  * side's terms for x_s .. x_{eye_hi - 1} moving to the light side, then
  * `etail` times the last ratio if eye_hi < k - 1 (the terms beyond); the
  * light side's for x_{s-1} down to x_{light_lo}, then `ltail` likewise if
- * light_lo > 0; over the strategies of `conn` (mis_conn_in_set). x_0's
+ * light_lo > 0; over the strategies of the path's `limit` (mis_conn_limit,
+ * mis_conn_in_set). x_0's
  * records are read only where the walk reaches x_1. */
-INLINE float mis_path_sum(const MisVertex *v, int k, int s, int heuristic, int conn, int eye_hi, int light_lo,
+INLINE float mis_path_sum(const MisVertex *v, int k, int s, int heuristic, int limit, int eye_hi, int light_lo,
 			  float ltail, float etail)
 {
 	/* x_0's density is pn for s' = 1 and pf for s' >= 2. */
@@ -77,7 +95,7 @@ INLINE float mis_path_sum(const MisVertex *v, int k, int s, int heuristic, int c
 		else
 			r *= mis_remap0(v[i].pf) / mis_remap0(v[i].pr) / (i == 1 ? pn_pf : 1.0f);
 		if ((i == 0 || !v[i].delta) && !v[i + 1].delta &&
-		    !((v[i].infinite || v[i].delta) && i + 1 == k - 1) && mis_conn_in_set(conn, k, i + 1))
+		    !((v[i].infinite || v[i].delta) && i + 1 == k - 1) && mis_conn_in_set(limit, k, i + 1))
 			sum += mis_term(r, heuristic);
 	}
 	if (eye_hi < k - 1)
@@ -88,7 +106,7 @@ INLINE float mis_path_sum(const MisVertex *v, int k, int s, int heuristic, int c
 			r *= mis_remap0(v[0].pr) / mis_remap0(v[0].pn);
 		else
 			r *= mis_remap0(v[i].pr) / mis_remap0(v[i].pf) * (i == 1 ? pn_pf : 1.0f);
-		if (!v[i].delta && (i <= 1 || !v[i - 1].delta) && mis_conn_in_set(conn, k, i))
+		if (!v[i].delta && (i <= 1 || !v[i - 1].delta) && mis_conn_in_set(limit, k, i))
 			sum += mis_term(r, heuristic);
 	}
 	if (light_lo > 0)
@@ -105,10 +123,11 @@ CALLED float mis_path_weight(const MisVertex *v, int k, int s, int heuristic)
 	return 1.0f / mis_path_sum(v, k, s, heuristic, 0, k - 1, 0, 0.0f, 0.0f);
 }
 
-/* The same over the strategies of `conn` (mis_conn_in_set; s among them). */
-INLINE float mis_path_weight_conn(const MisVertex *v, int k, int s, int heuristic, int conn)
+/* The same over the strategies of the path's `limit` (mis_conn_limit,
+ * mis_conn_in_set; s among them). */
+INLINE float mis_path_weight_conn(const MisVertex *v, int k, int s, int heuristic, int limit)
 {
-	return 1.0f / mis_path_sum(v, k, s, heuristic, conn, k - 1, 0, 0.0f, 0.0f);
+	return 1.0f / mis_path_sum(v, k, s, heuristic, limit, k - 1, 0, 0.0f, 0.0f);
 }
 
 /* ---- The same weight from the connection's neighbourhood and two tails ----
@@ -127,16 +146,21 @@ INLINE float mis_path_weight_conn(const MisVertex *v, int k, int s, int heuristi
  * tells) of prod_{j=i..m} q_j^beta, q_j = pr_j / pf_j (pr_0 / pn_0 and
  * the pn_0 / pf_0 of q_1 as there). Recurrence A_m = q_m^beta ([valid_m]
  * + A_{m-1}), A_{-1} = 0; v[0..n-1] are the light subpath's records (x_0's
- * delta: a punctual light). With conn (1 or 2) only the terms of s' = i <=
- * conn count: a strategy that reads A_m has s >= m + 3 > conn light
- * vertices, so it is light tracing, and the tail's s' are all below it. */
+ * delta: a punctual light). With conn (1 or 2) only the terms of s' = i in
+ * the set count (mis_conn_in_set): i <= conn, or x_1 .. x_{i - conn} all
+ * delta, which lie on the light subpath before the strategy's own
+ * connection (s >= m + 3). */
 INLINE void mis_light_tails(const MisVertex *v, int n, int heuristic, int conn, float *A)
 {
 	float pn_pf = mis_remap0(v[0].pn) / mis_remap0(v[0].pf), a = 0.0f;
+	int first = n; /* the first of v[1..] that scatters by a non-delta lobe */
+	for (int j = n - 1; j >= 1; j--)
+		if (!v[j].delta)
+			first = j;
 	for (int m = 0; m < n; m++) {
 		float q = m == 0 ? mis_remap0(v[0].pr) / mis_remap0(v[0].pn)
 				 : mis_remap0(v[m].pr) / mis_remap0(v[m].pf) * (m == 1 ? pn_pf : 1.0f);
-		int valid = !v[m].delta && (m <= 1 || !v[m - 1].delta) && (conn == 0 || m <= conn);
+		int valid = !v[m].delta && (m <= 1 || !v[m - 1].delta) && (conn == 0 || m <= conn + first - 1);
 		a = mis_term(q, heuristic) * ((valid ? 1.0f : 0.0f) + a);
 		A[m] = a;
 	}
@@ -148,8 +172,10 @@ INLINE void mis_light_tails(const MisVertex *v, int n, int heuristic, int conn, 
  * e[a] nor e[a-1] scattered by a delta lobe, and e[1] joins the camera
  * only from a surface. v[a] holds e[a]'s record. With conn (1 or 2) only
  * light tracing (a = 1) counts: the strategy of a >= 2 eye vertices that
- * a strategy with t >= a + 3 reads here has s' >= s + 3 > conn light
- * vertices. */
+ * a strategy (s >= 1) with t >= a + 3 reads here has s' >= s + 3 light
+ * vertices, among them x_1 (or x_s, the connection's non-delta eye end)
+ * and x_{s'-1}: more than conn that scatter by non-delta lobes. (s = 0
+ * with a delta vertex at x_1 takes the whole path: bdpt_path_weight.) */
 INLINE float mis_eye_tail(const MisVertex *v, int a, int heuristic, int conn, float prev)
 {
 	float u = mis_remap0(v[a].pf) / mis_remap0(v[a].pr);
@@ -159,12 +185,12 @@ INLINE float mis_eye_tail(const MisVertex *v, int a, int heuristic, int conn, fl
 
 /* mis_path_weight_conn with v[] filled at x_{s-3} .. x_{s+2} (those that
  * exist; x_0 too when s <= 3) and the tails beyond, made with the same
- * conn: `etail` the eye tail B_{t-3} (read when t >= 4), `ltail` the light
- * tail A_{s-3} (read when s >= 3). */
-INLINE float mis_path_weight_tails(const MisVertex *v, int k, int s, int heuristic, int conn, float ltail,
+ * conn (the path's limit here): `etail` the eye tail B_{t-3} (read when t
+ * >= 4), `ltail` the light tail A_{s-3} (read when s >= 3). */
+INLINE float mis_path_weight_tails(const MisVertex *v, int k, int s, int heuristic, int limit, float ltail,
 				   float etail)
 {
-	return 1.0f / mis_path_sum(v, k, s, heuristic, conn, min(k - 1, s + 2), max(0, s - 2), ltail, etail);
+	return 1.0f / mis_path_sum(v, k, s, heuristic, limit, min(k - 1, s + 2), max(0, s - 2), ltail, etail);
 }
 
 /* ---- BDPT and intermediate-subpath strategies together (design.md) ----

@@ -56,7 +56,7 @@ typedef struct {
 
 /* Where portal renders as bdpt (light subpaths bring the light in), its
  * strategies other than light tracing join eye vertices to at most this many
- * light vertices (kernels/mis/mis.h, mis_conn_in_set): the longer
+ * light vertices, delta ones not counted (kernels/mis/mis.h, mis_conn_limit): the longer
  * connections cost a third of the time and lowered no variance on
  * window-room-sunset and -forest; 1 was 1.24x worse on window-room-forest. */
 #define POLICY_PORTAL_BDPT_CONN 2
