@@ -7,7 +7,7 @@
 
 #define AJAR_LAYOUT_TYPES(X) \
 	X(BvhNode, 256) X(Tri, 48) X(TriShade, 64) X(TriExtra, 128) X(Material, 176) X(Texture, 48) \
-	X(Emitter, 16) X(PortalTri, 64) X(Camera, 64) X(Params, 240) \
+	X(Emitter, 16) X(PortalTri, 64) X(Camera, 64) X(Params, 320) \
 	X(PortalPlane, 80) X(PunctualLight, 64) X(Instance, 112)
 
 #define AJAR_LAYOUT_FIELDS(X)                                                          \
@@ -50,6 +50,7 @@
 	X(PunctualLight, disk_radius)                                                  \
 	X(Params, num_portal_planes) X(Params, env_rot_cos) X(Params, env_rot_sin)     \
 	X(Params, bdpt_conn) X(Params, env_lines) X(Params, num_panes)                 \
+	X(Params, num_pane_planes) X(Params, pane_n) X(Params, pane_d)                 \
 	X(PortalPlane, o) X(PortalPlane, a0) X(PortalPlane, t) X(PortalPlane, n)      \
 	X(PortalPlane, b1) X(PortalPlane, table)                                       \
 	X(Instance, xf) X(Instance, inv) X(Instance, root) X(Instance, flags) X(Instance, mesh)

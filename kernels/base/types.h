@@ -238,6 +238,15 @@ typedef struct {
 #define PARAMS_INTEGRATOR(p) ((p)->integrator)
 #endif
 
+/* At most this many planes of panes mirror the sky for next-event
+ * estimation (integrator/pane_mirror.h): a room's windows share few. */
+#define PANE_PLANES_MAX 4
+/* A pane lies in such a plane where their normals' cosine exceeds
+ * PANE_PLANE_COS and its points lie within PANE_PLANE_TOL of the scene's
+ * radius of it. */
+#define PANE_PLANE_COS 0.9999f
+#define PANE_PLANE_TOL 1e-4f
+
 /* Everything about a render that is not an array. One per upload. */
 typedef struct {
 	Camera camera;          /* 0 */
@@ -283,7 +292,12 @@ typedef struct {
 	int env_lines;          /* 232, a sky image's light subpaths start on lines through the
 	                         * portals, their directions from the ENV_LINE_* tables (env.h) */
 	int num_panes;          /* TRI_PANE triangles (geom/visibility.h) */
-} Params; /* 240 */
+	int num_pane_planes;    /* 240, planes of panes whose mirror image of the sky next-event
+	                         * estimation samples (integrator/pane_mirror.h), 0 = none */
+	V3 pane_n[PANE_PLANES_MAX]; /* unit normals, toward each plane's sky side */
+	float pane_d[PANE_PLANES_MAX]; /* the plane: dot(pane_n, x) = pane_d */
+	int pad_pane[3];
+} Params; /* 320 */
 
 /* Layout of the float array `env`: for an ENV_IMAGE of W x H,
  *   [0, 3WH)                    linear RGB radiance, row-major, row 0 = top

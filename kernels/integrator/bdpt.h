@@ -39,6 +39,7 @@
 #include "film/film.h"
 #include "mis/union_mis.h"
 #include "mis/strategies.h"
+#include "integrator/pane_mirror.h"
 
 /* pn_0 of one light subpath's origin for the two sides of its first
  * vertex's normal: bdpt_nee_pdf reads a path's x_2 only for the side of
@@ -694,6 +695,104 @@ INLINE V3 bdpt_nee(const SceneView *sc, const PathVertex *z, const PathVertex *f
 	return bdpt_nee_conn(sc, z, from, y, rng, 0);
 }
 
+#ifndef AJAR_NO_PANES
+/* Whether the eye walk's hit of the sky at e[t-1] left a pane's mirror
+ * for it after a vertex that sampled that mirrored sky (pane_mirror.h):
+ * then it counts there, by bdpt_pane_mirror. */
+INLINE int bdpt_pane_mirror_family(const SceneView *sc, VCRef e, int t)
+{
+	if (!sc->params->num_pane_planes || sc->params->cross_filter || t < 4 ||
+	    VGETI(VAT(e, t - 2), type) != VERTEX_SURFACE || !VGETI(VAT(e, t - 2), delta) ||
+	    VGETI(VAT(e, t - 3), type) != VERTEX_SURFACE || VGETI(VAT(e, t - 3), delta))
+		return 0;
+	VTMP(ht);
+	VTMP(xt);
+	const PathVertex *h = VLOAD(VAT(e, t - 2), ht);
+	int i = pane_mirror_plane(sc, h->tri, h->p, h->ng, &h->bs);
+	if (i < 0)
+		return 0;
+	const PathVertex *x = VLOAD(VAT(e, t - 3), xt);
+	return !bsdf_is_delta(&x->bs) && pane_sky_side(sc, i, x->p);
+}
+
+/* The sky mirrored in the panes whose sky side eye vertex e[t-1] lies on
+ * (pane_mirror.h), each a path of the eye vertices, the pane point and
+ * the sky, weighted as the eye walk's hit of that sky (s = 0, t + 2)
+ * would be: its two vertices are put in e[t], e[t + 1] for the weight and
+ * the subpath's own put back after. */
+INLINE void bdpt_pane_mirror(const SceneView *sc, VCRef l, VRef e, int t, BdptFilm *out, Rng *rng)
+{
+	GLOBAL const Params *prm = sc->params;
+	VTMP(zt);
+	VTMP(ft);
+	const PathVertex *z = VLOAD(VAT(e, t - 1), zt);
+	if (z->type != VERTEX_SURFACE || bsdf_is_delta(&z->bs))
+		return;
+	V3 n_nee = vertex_nee_normal(z, VLOAD(VAT(e, t - 2), ft));
+	for (int i = 0; i < prm->num_pane_planes; i++) {
+		if (!pane_sky_side(sc, i, z->p))
+			continue;
+		float u0, u1, u2, pdf_m, pdf_z;
+		rng_f3(rng, &u0, &u1, &u2);
+		V3 wx, wsky;
+		Surface hs;
+		PathVertex h, sky;
+		V3 c = pane_mirror_sample(sc, i, z->p, z->ng, n_nee, u0, u1, u2, &wx, &wsky, &pdf_m, &hs, &h.bs);
+		if (v3_is_zero(c))
+			continue;
+		V3 f = bdpt_scatter_pdf(z, wx, BSDF_RADIANCE, &pdf_z);
+		if (v3_is_zero(f))
+			continue;
+		h.type = VERTEX_SURFACE;
+		h.p = hs.p;
+		h.ng = hs.ng;
+		h.ns = hs.ns;
+		h.wo = v3_neg(wx);
+		h.beta = z->beta;
+		h.base = surface_base_color(sc, &hs);
+		h.pf = 0.0f;
+		h.pr = vertex_density_a(z, &h, pdf_z);
+		h.delta = 1;
+		h.material = hs.material;
+		h.tri = hs.tri;
+		h.cross = portal_crossings(sc, z->p, hs.p, 0);
+		h.w0 = h.p;
+		h.w0_tri = -1;
+		h.tail = 0.0f;
+		sky.type = VERTEX_ENV;
+		sky.p = wsky;
+		sky.ng = sky.ns = sky.wo = v3_neg(wsky);
+		sky.beta = z->beta;
+		sky.base = v3(0.0f, 0.0f, 0.0f);
+		sky.pf = sky.pr = 0.0f; /* after a delta vertex */
+		sky.delta = 0;
+		sky.material = sky.tri = -1;
+		sky.cross = portal_crossings(sc, hs.p, wsky, 1);
+		sky.w0 = sky.p;
+		sky.w0_tri = -1;
+		sky.tail = 0.0f;
+		sky.bs = h.bs;
+		VTMP(s0);
+		VTMP(s1);
+		PathVertex keep0 = *VLOAD(VAT(e, t), s0), keep1 = *VLOAD(VAT(e, t + 1), s1); /* copies */
+		float z_pf = VGETF(VAT(e, t - 1), pf);
+		int z_delta = VGETI(VAT(e, t - 1), delta);
+		VSETF(VAT(e, t - 1), pf, 0.0f); /* from the pane's mirror: a delta density */
+		VSETI(VAT(e, t - 1), delta, 0);
+		VSTORE(VAT(e, t), &h);
+		VSTORE(VAT(e, t + 1), &sky);
+		/* From the whole path's records: e[t - 1]'s eye tail holds its
+		 * own subpath's densities. */
+		float w = bdpt_weight_cached(sc, l, 0, e, t + 2, 0, 0);
+		VSTORE(VAT(e, t), &keep0);
+		VSTORE(VAT(e, t + 1), &keep1);
+		VSETF(VAT(e, t - 1), pf, z_pf);
+		VSETI(VAT(e, t - 1), delta, z_delta);
+		bdpt_add(sc, out, 0, t + 2, v3_mul(v3_mul(z->beta, f), c), w, out->pixel, rng);
+	}
+}
+#endif
+
 /* Every bdpt strategy of one light and one eye subpath: adds the eye
  * strategies to out->L and splats light tracing (t = 1). */
 CALLED void bdpt_strategies(const SceneView *sc, VRef l, int nl, VRef e, int ne, BdptFilm *out, Rng *rng)
@@ -718,7 +817,12 @@ CALLED void bdpt_strategies(const SceneView *sc, VRef l, int nl, VRef e, int ne,
 		VTMP(ft);
 		VTMP(lt);
 		const PathVertex *z = VLOAD(VAT(e, t - 1), zt);
-		/* s = 0: the eye subpath found the light. */
+		/* s = 0: the eye subpath found the light (a sky mirrored in a pane
+		 * counts at the vertex that sampled it, bdpt_pane_mirror). */
+#ifndef AJAR_NO_PANES
+		if (z->type == VERTEX_ENV && bdpt_pane_mirror_family(sc, e, t))
+			break;
+#endif
 		if (z->type == VERTEX_ENV || sc->tris[z->tri].emitter >= 0) {
 			V3 Le = bdpt_emitted(sc, z, z->wo);
 			if (!v3_is_zero(Le))
@@ -737,6 +841,10 @@ CALLED void bdpt_strategies(const SceneView *sc, VRef l, int nl, VRef e, int ne,
 				bdpt_add(sc, out, 1, t, c, bdpt_weight_cached(sc, VNEE(e, y), 1, e, t, &pc, cpp),
 					 out->pixel, rng);
 		}
+#ifndef AJAR_NO_PANES
+		if (sc->params->num_pane_planes && !sc->params->cross_filter && t + 1 <= depth)
+			bdpt_pane_mirror(sc, l, e, t, out, rng);
+#endif
 		/* s >= 2: light vertex s-1 to eye vertex t-1, in the set of conn
 		 * (mis.h, mis_conn_in_set). */
 		for (int s = 2; s <= nl && s + t - 1 <= depth &&

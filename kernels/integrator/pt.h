@@ -26,6 +26,7 @@
 #include "geom/surface.h"
 #include "geom/visibility.h"
 #include "integrator/pane_choice.h"
+#include "integrator/pane_mirror.h"
 
 #define PT_CROSS_EDGES 33
 #define PT_PANES_MAX 64 /* panes one segment may cross (vertex.h's guard) */
@@ -53,6 +54,9 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 	V3 prev_ng = prev_n;
 	int prev_mat = -1; /* the material the ray leaves, for a solid's absorption */
 	float beta_ref = 1.0f;
+	int prev_nee = 0;    /* the previous vertex had next-event estimation (a non-delta BSDF) */
+	int mirror_fam = 0;  /* this edge leaves a pane's mirror for the sky sampled at the vertex
+			      * before it (pane_mirror.h): a sky it finds counts there, not here */
 	int cnt[PT_CROSS_EDGES];
 	for (int depth = 0;; depth++) {
 		Hit h;
@@ -94,7 +98,7 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 			if (!v3_is_zero(Le)) {
 				float w = prev_delta ? 1.0f : mis_power(prev_pdf_w, light_env_pdf_w(sc, prev_p, prev_n, d, pe));
 				w *= pt_cross_weight(prm, cnt, depth + 1, c_edge);
-				if (depth + 1 >= prm->min_depth)
+				if (depth + 1 >= prm->min_depth && !mirror_fam)
 					L = v3_add(L, v3_scale(v3_mul(beta, Le), w));
 			}
 			break;
@@ -149,6 +153,27 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 				}
 			}
 		}
+#ifndef AJAR_NO_PANES
+		/* The sky mirrored in the panes whose sky side this is, a path of
+		 * depth + 3 segments (pane_mirror.h). */
+		int nee = !bsdf_is_delta(&bs);
+		if (nee && prm->num_pane_planes && !prm->cross_filter && depth + 3 <= prm->max_depth &&
+		    depth + 3 >= prm->min_depth)
+			for (int i = 0; i < prm->num_pane_planes; i++) {
+				if (!pane_sky_side(sc, i, s.p))
+					continue;
+				float u0, u1, u2, pdf_m, pb;
+				rng_f3(rng, &u0, &u1, &u2);
+				V3 wx, wsky;
+				Surface hs;
+				Bsdf hb;
+				V3 c = pane_mirror_sample(sc, i, s.p, s.ng, n_nee, u0, u1, u2, &wx, &wsky, &pdf_m, &hs, &hb);
+				if (!v3_is_zero(c)) {
+					V3 f = bsdf_eval_fwd(&bs, wo, wx, BSDF_RADIANCE, &pb);
+					L = v3_add(L, v3_scale(v3_mul(v3_mul(beta, f), c), fabs(v3_dot(s.ns, wx)) / exist));
+				}
+			}
+#endif
 		BsdfSample bsm;
 		float u0, u1, u2;
 		rng_f3(rng, &u0, &u1, &u2);
@@ -167,6 +192,16 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 		k *= rest / exist; /* a pane's vertex had probability exist, its lobes the share rest */
 #endif
 		beta = v3_mul(beta, v3_scale(bsm.f, k));
+#ifndef AJAR_NO_PANES
+		/* A pane's mirror left for the sky after a vertex that sampled it
+		 * (pane_mirror.h, the family of that sample). */
+		mirror_fam = 0;
+		if (prm->num_pane_planes && !prm->cross_filter && bsm.delta && prev_nee && !prev_delta) {
+			int i = pane_mirror_plane(sc, s.tri, s.p, s.ng, &bs);
+			mirror_fam = i >= 0 && pane_sky_side(sc, i, prev_p);
+		}
+		prev_nee = nee;
+#endif
 		prev_pdf_w = bsm.pdf_w;
 		prev_delta = bsm.delta;
 		prev_p = s.p;

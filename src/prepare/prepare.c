@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "prepare/found_portals.h"
+#include "prepare/pane_planes.h"
 #include "prepare/policy.h"
 #include "prepare/portal_flux.h"
 #include "prepare/scene_bvh.h"
@@ -393,6 +394,8 @@ ajar_status prepare_scene(Scene *s, const ajar_options *o, uint32_t width, uint3
 		return st;
 	}
 	p->num_portal_planes = (int)d->n_portal_planes;
+	if (p->num_panes && p->env_type != ENV_NONE)
+		pane_planes_build(d->tris, scene_flat_triangles(s), d->portals, (uint32_t)d->n_portals, radius, p);
 	if (p->num_emitters == 0 && p->num_lights == 0 && p->env_type == ENV_NONE)
 		log_msg(AJAR_LOG_WARNING, "%s: no emissive triangles, no lights and no environment: the image is black",
 			s->source);

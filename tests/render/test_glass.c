@@ -253,6 +253,46 @@ static void test_partial_pane(void **state)
 	ajar_scene_destroy(&s);
 }
 
+/* The sky a pane mirrors (kernels/integrator/pane_mirror.h): window-room
+ * with a pane 25 cm inside its window, the camera on a patch of the
+ * window wall beside the opening, between wall and pane: the sky that comes
+ * in through the opening and off the pane's back lights it more than the
+ * room does. pt, bdpt and portal, which take that light by next-event
+ * estimation of the mirrored sky, against the brute force, where only the
+ * eye walk's reflection off the pane finds it. */
+static void test_pane_mirror(void **state)
+{
+	(void)state;
+	ajar_scene *s;
+	assert_int_equal(ajar_scene_load(SCENE("window-room/window-room.gltf"), &s), AJAR_OK);
+	ajar_camera cam = {{2.0f, 1.4f, 1.2f}, {1.2f, 1.4f, 0.0f}, {0, 1, 0}, 0.3f, 0};
+	assert_int_equal(ajar_scene_set_camera(s, &cam), AJAR_OK);
+	ajar_material m;
+	ajar_material_default(&m);
+	m.roughness = 0.0f;
+	m.transmission = 1.0f;
+	uint32_t glass;
+	assert_int_equal(ajar_scene_add_material(s, &m, &glass), AJAR_OK);
+	float gp[12] = {1.5f, 0.9f, 0.25f, 2.5f, 0.9f, 0.25f, 2.5f, 1.9f, 0.25f, 1.5f, 1.9f, 0.25f};
+	uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+	ajar_mesh gm = {gp, NULL, NULL, 4, idx, 2, glass, NULL};
+	assert_int_equal(ajar_scene_add_mesh(s, &gm), AJAR_OK);
+	const PolicyOverrides brute = {.panes_opaque = 1};
+	Estimate b, p, p32, q, r;
+	estimate(s, AJAR_INTEGRATOR_PT, 16, 2048, 64, &brute, &b);
+	estimate(s, AJAR_INTEGRATOR_PT, 16, 512, 64, NULL, &p);
+	estimates_agree("a pane's mirrored sky", "pt, panes opaque to connections", &b, "pt", &p);
+	/* bdpt and portal weigh the mirrored sample as the eye walk's hit: against
+	 * pt, tighter than the brute force (a weight read from the eye vertex's
+	 * stale MIS tail came out 0.3% high: 5.4 standard errors). */
+	estimate(s, AJAR_INTEGRATOR_PT, 16, 1024, 32, NULL, &p32);
+	estimate(s, AJAR_INTEGRATOR_BDPT, 16, 512, 32, NULL, &q);
+	estimate(s, AJAR_INTEGRATOR_PORTAL, 16, 256, 32, NULL, &r);
+	estimates_agree("a pane's mirrored sky", "pt", &p32, "bdpt", &q);
+	estimates_agree("a pane's mirrored sky", "pt", &p32, "portal", &r);
+	ajar_scene_destroy(&s);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -261,6 +301,7 @@ int main(void)
 		cmocka_unit_test(test_pane_brute_force),
 		cmocka_unit_test(test_many_panes),
 		cmocka_unit_test(test_partial_pane),
+		cmocka_unit_test(test_pane_mirror),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
