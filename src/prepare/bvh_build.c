@@ -94,10 +94,9 @@ static void refs_fill(void *ctx, int part, int nparts)
 	slice(0, b->nrefs, part, nparts, &s, &e);
 	for (uint32_t i = s; i < e; i++) {
 		Ref *r = &b->refs[i];
-		r->idx = i;
 		if (i >= in->ntris) {
 			V3 lo = in->inst_lo[i - in->ntris], hi = in->inst_hi[i - in->ntris];
-			r->b = (Box){{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}};
+			*r = (Ref){{lo.x, lo.y, lo.z}, i, {hi.x, hi.y, hi.z}, 0.0f};
 			continue;
 		}
 		const Tri *t = &in->tris[in->index ? in->index[i] : i];
@@ -105,10 +104,7 @@ static void refs_fill(void *ctx, int part, int nparts)
 		float lo[4], hi[4];
 		f4_store(lo, f4_min(f4_min(p2, p1), p0));
 		f4_store(hi, f4_max(f4_max(p2, p1), p0));
-		for (int a = 0; a < 3; a++) {
-			r->b.lo[a] = lo[a];
-			r->b.hi[a] = hi[a];
-		}
+		*r = (Ref){{lo[0], lo[1], lo[2]}, i, {hi[0], hi[1], hi[2]}, 0.0f};
 	}
 }
 
@@ -330,7 +326,7 @@ ajar_status bvh_build_input(const BvhInput *in, int threads, BvhReorder reorder,
 	/* The binary tree's array is as large as any tree could need; pages
 	 * the build leaves untouched cost no memory. */
 	size_t max_nodes = 2 * (size_t)in->n - 1;
-	b.refs = malloc(sizeof(Ref) * in->n);
+	b.refs = aligned_alloc(64, (sizeof(Ref) * in->n + 63) / 64 * 64);
 	b.bn = malloc(sizeof(BinNode) * max_nodes);
 	out->order = malloc(sizeof(uint32_t) * (in->ntris ? in->ntris : 1));
 	ajar_status st = AJAR_OK;

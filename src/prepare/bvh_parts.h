@@ -24,6 +24,8 @@ static inline F4 f4_load3(const float *p)
 {
 	return _mm_and_ps(_mm_loadu_ps(p), _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0)));
 }
+/* Four floats at p, 16-byte aligned. */
+static inline F4 f4_load(const float *p) { return _mm_load_ps(p); }
 static inline F4 f4_add(F4 a, F4 b) { return _mm_add_ps(a, b); }
 static inline F4 f4_sub(F4 a, F4 b) { return _mm_sub_ps(a, b); }
 static inline F4 f4_mul(F4 a, F4 b) { return _mm_mul_ps(a, b); }
@@ -59,6 +61,7 @@ static inline F4 f4_zero(void) { return (F4){{0.0f, 0.0f, 0.0f, 0.0f}}; }
 static inline F4 f4_set(float x, float y, float z) { return (F4){{x, y, z, 0.0f}}; }
 static inline F4 f4_splat(float v) { return (F4){{v, v, v, v}}; }
 static inline F4 f4_load3(const float *p) { return (F4){{p[0], p[1], p[2], 0.0f}}; }
+static inline F4 f4_load(const float *p) { return (F4){{p[0], p[1], p[2], p[3]}}; }
 static inline F4 f4_add(F4 a, F4 b)
 {
 	for (int i = 0; i < 4; i++)
@@ -130,10 +133,13 @@ typedef struct {
 } Box4;
 
 /* A triangle's bounds and where it came from; the build permutes these.
- * f4_load3 of b.lo reads b.hi[0] too, of b.hi reads idx: both inside. */
+ * 32 bytes, aligned: each bound is one aligned vector load (28-byte refs
+ * split a cache line every other ref) and a swap two vector moves. */
 typedef struct {
-	Box b;
-	uint32_t idx;
+	_Alignas(16) float lo[3];
+	uint32_t idx; /* lane 3 of lo's load: masked off */
+	float hi[3];
+	float zero; /* lane 3 of hi's load: 0 */
 } Ref;
 
 /* Node of the binary tree: an interior node's left child is the next
@@ -165,12 +171,9 @@ static inline Box4 box4_grow(Box4 b, Box4 o)
 
 static inline Box4 box4_of_ref(const Ref *r)
 {
-	Box4 b = {f4_load3(r->b.lo), f4_load3(r->b.hi)};
+	Box4 b = {f4_load3(r->lo), f4_load(r->hi)};
 	return b;
 }
-
-/* Twice the centroid on every axis: only compared, never a position. */
-static inline F4 ref_keys(const Ref *r) { return f4_add(f4_load3(r->b.lo), f4_load3(r->b.hi)); }
 
 static inline void box4_store(Box *out, Box4 b)
 {

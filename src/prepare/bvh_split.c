@@ -124,7 +124,7 @@ static int bin_of(float key, float cmin, float scale, int nbins)
 	return !(f > 0.0f) ? 0 : (f >= (float)nbins ? nbins - 1 : (int)f);
 }
 
-static float ref_key(const Ref *r, int axis) { return r->b.lo[axis] + r->b.hi[axis]; }
+static float ref_key(const Ref *r, int axis) { return r->lo[axis] + r->hi[axis]; }
 
 /* Reorders r[0, n) so that r[k] has the k-th smallest key on `axis` and
  * nothing before it is larger (Hoare partition, median-of-three pivot;
