@@ -54,6 +54,7 @@ typedef struct {
 	uint32_t start, end; /* references */
 	uint32_t node;       /* its binary node */
 	uint32_t depth;
+	NodeBounds nb;       /* of its references, from its parent's split */
 } Task;
 
 typedef struct {
@@ -63,11 +64,13 @@ typedef struct {
 	BinNode *bn;
 	uint32_t *order;
 	uint32_t nrefs;
+	int nan_free;            /* no NaN in any ref's bounds or key (SplitPlan) */
 	Workers workers;
-	/* Phase 1: the node whose bounds or bins the threads fill. */
+	/* Phase 1: the node whose bins the threads fill. */
 	Task node;
 	const SplitPlan *plan;
-	NodeBounds *part_bounds; /* one per thread */
+	NodeBounds *part_bounds; /* one per thread: the root's, by slice */
+	int *part_nan;           /* one per thread: a NaN in its slice */
 	Bins *part_bins;         /* one per thread */
 	/* Phase 2. */
 	Task *tasks;
@@ -85,13 +88,15 @@ static void slice(uint32_t start, uint32_t end, int part, int nparts, uint32_t *
 
 /* A triangle's bounds: fmin/fmax of its corners, which keep the first
  * argument on ties (-0 and +0 as the scalar build had them); an
- * instance's as given. */
+ * instance's as given. With them the root's bounds over the slice, and
+ * whether a NaN is among them. */
 static void refs_fill(void *ctx, int part, int nparts)
 {
 	Build *b = ctx;
 	const BvhInput *in = b->in;
 	uint32_t s, e;
 	slice(0, b->nrefs, part, nparts, &s, &e);
+	int nan = 0;
 	for (uint32_t i = s; i < e; i++) {
 		Ref *r = &b->refs[i];
 		if (i >= in->ntris) {
@@ -106,13 +111,11 @@ static void refs_fill(void *ctx, int part, int nparts)
 		f4_store(hi, f4_max(f4_max(p2, p1), p0));
 		*r = (Ref){{lo[0], lo[1], lo[2]}, i, {hi[0], hi[1], hi[2]}, 0.0f};
 	}
-}
-
-static void part_bounds(void *ctx, int part, int nparts)
-{
-	Build *b = ctx;
-	uint32_t s, e;
-	slice(b->node.start, b->node.end, part, nparts, &s, &e);
+	for (uint32_t i = s; i < e; i++) {
+		Box4 r = box4_of_ref(&b->refs[i]);
+		nan |= f4_any_nan3(r.lo) | f4_any_nan3(r.hi) | f4_any_nan3(f4_add(r.lo, r.hi));
+	}
+	b->part_nan[part] = nan;
 	NodeBounds *nb = &b->part_bounds[part];
 	nb->box = nb->cbox = box4_empty();
 	bvh_bounds(b->refs, s, e, nb);
@@ -157,18 +160,17 @@ static void build_subtree(Build *b, Task root)
 			b->bn[parent].index = (int)id;
 		if (task.depth + 1 > max_depth)
 			max_depth = task.depth + 1;
-		NodeBounds nb = {box4_empty(), box4_empty()};
-		bvh_bounds(b->refs, task.start, task.end, &nb);
 		BinNode *node = &b->bn[id];
-		box4_store(&node->b, nb.box);
+		box4_store(&node->b, task.nb.box);
 		uint32_t n = task.end - task.start;
 		SplitPlan plan;
-		bvh_split_plan(n, &nb.cbox, task.depth, b->inst_from, &plan);
+		bvh_split_plan(n, &task.nb.cbox, task.depth, b->inst_from, b->nan_free, &plan);
 		if (plan.nb) {
 			bvh_bins_clear(&bins, plan.nb);
 			bvh_bins_add(&bins, &plan, b->refs, task.start, task.end);
 		}
-		uint32_t nleft = bvh_split_apply(b->refs + task.start, n, &node->b, &plan, &bins);
+		NodeBounds child[2];
+		uint32_t nleft = bvh_split_apply(b->refs + task.start, n, &node->b, &plan, &bins, child);
 		if (nleft == 0) {
 			node->index = (int)task.start;
 			node->count = (int)n;
@@ -178,9 +180,9 @@ static void build_subtree(Build *b, Task root)
 		node->count = 0;
 		ninterior++;
 		uint32_t mid = task.start + nleft;
-		stack[sp].t = (Task){mid, task.end, 0, task.depth + 1};
+		stack[sp].t = (Task){mid, task.end, 0, task.depth + 1, child[1]};
 		stack[sp++].parent = id;
-		stack[sp].t = (Task){task.start, mid, 0, task.depth + 1};
+		stack[sp].t = (Task){task.start, mid, 0, task.depth + 1, child[0]};
 		stack[sp++].parent = UINT32_MAX;
 	}
 	atomic_fetch_add(&b->ninterior, ninterior);
@@ -216,12 +218,17 @@ static ajar_status build_tree(Build *b)
 	size_t cap = 2 * BVH_MAX_DEPTH * ((size_t)b->nrefs / big + 1) + 1;
 	Task queue[BVH_MAX_DEPTH + 2];
 	b->tasks = malloc(sizeof *b->tasks * cap);
-	b->part_bounds = malloc(sizeof *b->part_bounds * (size_t)nt);
 	b->part_bins = malloc(sizeof *b->part_bins * (size_t)nt);
-	if (!b->tasks || !b->part_bounds || !b->part_bins)
+	if (!b->tasks || !b->part_bins)
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for the build's tasks");
 	size_t nq = 0;
-	queue[nq++] = (Task){0, b->nrefs, 0, 0};
+	queue[nq] = (Task){0, b->nrefs, 0, 0, b->part_bounds[0]};
+	b->nan_free = !b->part_nan[0];
+	for (int k = 1; k < nt; k++) {
+		bvh_bounds_merge(&queue[nq].nb, &b->part_bounds[k]);
+		b->nan_free &= !b->part_nan[k];
+	}
+	nq++;
 	b->ntasks = 0;
 	while (nq > 0) {
 		Task t = queue[--nq];
@@ -232,21 +239,18 @@ static ajar_status build_tree(Build *b)
 		}
 		note_depth(b, t.depth + 1);
 		b->node = t;
-		workers_run(&b->workers, part_bounds, b);
-		NodeBounds nb = b->part_bounds[0];
-		for (int k = 1; k < nt; k++)
-			bvh_bounds_merge(&nb, &b->part_bounds[k]);
 		BinNode *node = &b->bn[t.node];
-		box4_store(&node->b, nb.box);
+		box4_store(&node->b, t.nb.box);
 		SplitPlan plan;
-		bvh_split_plan(n, &nb.cbox, t.depth, b->inst_from, &plan);
+		bvh_split_plan(n, &t.nb.cbox, t.depth, b->inst_from, b->nan_free, &plan);
 		if (plan.nb) {
 			b->plan = &plan;
 			workers_run(&b->workers, part_bins, b);
 			for (int k = 1; k < nt; k++)
 				bvh_bins_merge(&b->part_bins[0], &b->part_bins[k], plan.nb);
 		}
-		uint32_t nleft = bvh_split_apply(b->refs + t.start, n, &node->b, &plan, &b->part_bins[0]);
+		NodeBounds child[2];
+		uint32_t nleft = bvh_split_apply(b->refs + t.start, n, &node->b, &plan, &b->part_bins[0], child);
 		if (nleft == 0) { /* not for n >= PAR_MIN, but harmless */
 			node->index = (int)t.start;
 			node->count = (int)n;
@@ -256,8 +260,8 @@ static ajar_status build_tree(Build *b)
 		node->count = 0;
 		atomic_fetch_add(&b->ninterior, 1);
 		uint32_t mid = t.start + nleft;
-		queue[nq++] = (Task){mid, t.end, t.node + 2 * nleft, t.depth + 1};
-		queue[nq++] = (Task){t.start, mid, t.node + 1, t.depth + 1};
+		queue[nq++] = (Task){mid, t.end, t.node + 2 * nleft, t.depth + 1, child[1]};
+		queue[nq++] = (Task){t.start, mid, t.node + 1, t.depth + 1, child[0]};
 	}
 	qsort(b->tasks, b->ntasks, sizeof *b->tasks, task_larger);
 	atomic_store(&b->next_task, 0);
@@ -335,6 +339,12 @@ ajar_status bvh_build_input(const BvhInput *in, int threads, BvhReorder reorder,
 	if (st == AJAR_OK)
 		st = workers_start(&b.workers, threads < 1 ? 1 : threads);
 	if (st == AJAR_OK) {
+		b.part_bounds = malloc(sizeof *b.part_bounds * (size_t)b.workers.n);
+		b.part_nan = malloc(sizeof *b.part_nan * (size_t)b.workers.n);
+		if (!b.part_bounds || !b.part_nan)
+			st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for the build's tasks");
+	}
+	if (st == AJAR_OK) {
 		workers_run(&b.workers, refs_fill, &b);
 		st = build_tree(&b);
 	}
@@ -349,6 +359,7 @@ ajar_status bvh_build_input(const BvhInput *in, int threads, BvhReorder reorder,
 		workers_stop(&b.workers);
 	free(b.tasks);
 	free(b.part_bounds);
+	free(b.part_nan);
 	free(b.part_bins);
 	free(b.refs);
 	if (st == AJAR_OK) {

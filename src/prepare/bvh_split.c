@@ -39,9 +39,10 @@ void bvh_bounds_merge(NodeBounds *acc, const NodeBounds *later)
 	acc->cbox = box4_grow(acc->cbox, later->cbox);
 }
 
-void bvh_split_plan(uint32_t n, const Box4 *cbox, uint32_t depth, uint32_t inst_from, SplitPlan *p)
+void bvh_split_plan(uint32_t n, const Box4 *cbox, uint32_t depth, uint32_t inst_from, int nan_free, SplitPlan *p)
 {
 	p->inst_from = inst_from;
+	p->nan_free = nan_free;
 	float lo[4], hi[4];
 	f4_store(lo, cbox->lo);
 	f4_store(hi, cbox->hi);
@@ -64,11 +65,18 @@ void bvh_split_plan(uint32_t n, const Box4 *cbox, uint32_t depth, uint32_t inst_
 
 void bvh_bins_clear(Bins *b, int nb)
 {
+	Box4 e = box4_empty();
+	e.hi = f4_set_lane3_bits(e.hi, 0);
 	for (int a = 0; a < 3; a++)
-		for (int k = 0; k < nb; k++) {
-			b->box[a][k] = box4_empty();
-			b->count[a][k] = 0;
-		}
+		for (int k = 0; k < nb; k++)
+			b->box[a][k] = e;
+}
+
+/* A bin grown by ref box r and counted. */
+static inline void bin_grow(Box4 *bin, Box4 r)
+{
+	bin->lo = f4_min(r.lo, bin->lo);
+	bin->hi = f4_count1(f4_max(r.hi, bin->hi));
 }
 
 /* Bins one ref: (int)((key - cmin) * scale) clamped to [0, nb - 1], as
@@ -77,12 +85,11 @@ static inline void bin_ref(Bins *b, const Ref *ref, F4 cmin, F4 scale, F4 top)
 {
 	Box4 r = box4_of_ref(ref);
 	F4 f = f4_mul(f4_sub(f4_add(r.lo, r.hi), cmin), scale);
-	int k[3];
-	f4_trunc3(f4_min(f4_max(f, f4_zero()), top), &k[0], &k[1], &k[2]);
-	for (int a = 0; a < 3; a++) {
-		b->count[a][k[a]]++;
-		b->box[a][k[a]] = box4_grow(b->box[a][k[a]], r);
-	}
+	int k0, k1, k2;
+	f4_trunc3(f4_min(f4_max(f, f4_zero()), top), &k0, &k1, &k2);
+	bin_grow(&b->box[0][k0], r);
+	bin_grow(&b->box[1][k1], r);
+	bin_grow(&b->box[2][k2], r);
 }
 
 void bvh_bins_add(Bins *b, const SplitPlan *p, const Ref *refs, uint32_t start, uint32_t end)
@@ -111,8 +118,9 @@ void bvh_bins_merge(Bins *acc, const Bins *later, int nb)
 {
 	for (int a = 0; a < 3; a++)
 		for (int k = 0; k < nb; k++) {
-			acc->count[a][k] += later->count[a][k];
+			uint32_t count = bins_count(acc, a, k) + bins_count(later, a, k);
 			acc->box[a][k] = box4_grow(acc->box[a][k], later->box[a][k]);
+			acc->box[a][k].hi = f4_set_lane3_bits(acc->box[a][k].hi, count);
 		}
 }
 
@@ -166,40 +174,53 @@ static inline float box4_area(Box4 b) { return f4_half_area(f4_sub(b.hi, b.lo));
 
 /* The cheapest SAH split over the bins: its axis (-1 if none) and the
  * last bin on its left; costs in units of one triangle test times the
- * parent's area, so a zero-area node still compares splits consistently. */
+ * parent's area, so a zero-area node still compares splits consistently.
+ * Only non-empty bins are swept: an empty bin changes neither side, so a
+ * split after it costs the bits of the split before it, which the strict
+ * < below has already taken (or both have an empty side). */
 static int sah_sweep(const Bins *bins, const SplitPlan *p, int *best_bin, float *best_cost)
 {
-	int best_axis = -1, nb = p->nb;
-	*best_cost = FLT_MAX;
-	*best_bin = 0;
+	int best_axis = -1, nb = p->nb, best = 0;
+	float best_c = FLT_MAX;
 	for (int a = 0; a < 3; a++) {
 		if (p->ext[a] <= 0.0f)
 			continue;
+		Box4 box[BVH_BINS];
+		uint32_t count[BVH_BINS];
+		int bin[BVH_BINS], m = 0;
+		for (int k = 0; k < nb; k++) { /* written always, kept if non-empty: no branch to mispredict */
+			uint32_t c = bins_count(bins, a, k);
+			box[m].lo = bins->box[a][k].lo;
+			box[m].hi = f4_set_lane3_bits(bins->box[a][k].hi, 0); /* no count in the area's arithmetic */
+			count[m] = c;
+			bin[m] = k;
+			m += c != 0;
+		}
 		float right_area[BVH_BINS];
 		uint32_t right_count[BVH_BINS];
 		Box4 acc = box4_empty();
 		uint32_t cnt = 0;
-		for (int k = nb - 1; k > 0; k--) {
-			acc = box4_grow(acc, bins->box[a][k]);
-			cnt += bins->count[a][k];
-			right_area[k] = box4_area(acc);
-			right_count[k] = cnt;
+		for (int i = m - 1; i > 0; i--) {
+			acc = box4_grow(acc, box[i]);
+			cnt += count[i];
+			right_area[i] = box4_area(acc);
+			right_count[i] = cnt;
 		}
 		acc = box4_empty();
 		cnt = 0;
-		for (int k = 0; k < nb - 1; k++) {
-			acc = box4_grow(acc, bins->box[a][k]);
-			cnt += bins->count[a][k];
-			if (cnt == 0 || right_count[k + 1] == 0)
-				continue;
-			float cost = box4_area(acc) * (float)cnt + right_area[k + 1] * (float)right_count[k + 1];
-			if (cost < *best_cost) {
-				*best_cost = cost;
+		for (int i = 0; i < m - 1; i++) {
+			acc = box4_grow(acc, box[i]);
+			cnt += count[i];
+			float cost = box4_area(acc) * (float)cnt + right_area[i + 1] * (float)right_count[i + 1];
+			if (cost < best_c) {
+				best_c = cost;
 				best_axis = a;
-				*best_bin = k;
+				best = bin[i];
 			}
 		}
 	}
+	*best_bin = best;
+	*best_cost = best_c;
 	return best_axis;
 }
 
@@ -216,13 +237,82 @@ static int may_be_leaf(const Ref *refs, uint32_t n, const SplitPlan *p)
 	return 1;
 }
 
-uint32_t bvh_split_apply(Ref *refs, uint32_t n, const Box *box, const SplitPlan *p, const Bins *bins)
+/* The SAH partition: refs whose bin on `axis` is at most best_bin first.
+ * A ref found on the right is swapped with the last unexamined one, which
+ * is examined next: the order every tree was built with. */
+static uint32_t partition(Ref *refs, uint32_t n, const SplitPlan *p, int axis, int best_bin)
+{
+	float cmin = p->cmin[axis], scale = p->scale[axis];
+	uint32_t i = 0, j = n;
+	while (i < j) {
+		if (bin_of(ref_key(&refs[i], axis), cmin, scale, p->nb) <= best_bin) {
+			i++;
+		} else {
+			Ref t = refs[i];
+			refs[i] = refs[--j];
+			refs[j] = t;
+		}
+	}
+	return i;
+}
+
+/* partition, filling the two sides' bounds on the way (one pass less per
+ * level). A bin is at most best_bin exactly where (key - cmin) * scale is
+ * not >= best_bin + 1 (negative and NaN keys bin to 0). The left side's
+ * refs are met in their final order, so its bounds grow as bvh_bounds
+ * grows them; the right side's in the reverse of theirs, so a tie goes to
+ * the later ref (f4_min_late), which is the earlier in the final order:
+ * the same bits, given no NaN (p->nan_free). */
+static uint32_t partition_bounds(Ref *refs, uint32_t n, const SplitPlan *p, int axis, int best_bin,
+				 NodeBounds child[2])
+{
+	F4 cmin = f4_set(p->cmin[0], p->cmin[1], p->cmin[2]), scale = f4_set(p->scale[0], p->scale[1], p->scale[2]);
+	F4 edge = f4_splat((float)(best_bin + 1));
+	Box4 lbox = box4_empty(), lc = box4_empty(), rbox = box4_empty(), rc = box4_empty();
+	uint32_t i = 0, j = n;
+	while (i < j) {
+		Box4 r = box4_of_ref(&refs[i]);
+		F4 key = f4_add(r.lo, r.hi);
+		if (!f4_lane_ge(f4_mul(f4_sub(key, cmin), scale), edge, axis)) {
+			lbox = box4_grow(lbox, r);
+			lc.lo = f4_min(key, lc.lo);
+			lc.hi = f4_max(key, lc.hi);
+			i++;
+		} else {
+			rbox.lo = f4_min_late(rbox.lo, r.lo);
+			rbox.hi = f4_max_late(rbox.hi, r.hi);
+			rc.lo = f4_min_late(rc.lo, key);
+			rc.hi = f4_max_late(rc.hi, key);
+			Ref t = refs[i];
+			refs[i] = refs[--j];
+			refs[j] = t;
+		}
+	}
+	child[0] = (NodeBounds){lbox, lc};
+	child[1] = (NodeBounds){rbox, rc};
+	return i;
+}
+
+/* Both sides' bounds after a split that did not fill them. */
+static void sides_bounds(const Ref *refs, uint32_t n, uint32_t nleft, NodeBounds child[2])
+{
+	child[0] = child[1] = (NodeBounds){box4_empty(), box4_empty()};
+	bvh_bounds(refs, 0, nleft, &child[0]);
+	bvh_bounds(refs, nleft, n, &child[1]);
+}
+
+uint32_t bvh_split_apply(Ref *refs, uint32_t n, const Box *box, const SplitPlan *p, const Bins *bins,
+			 NodeBounds child[2])
 {
 	if (n <= 1)
 		return 0;
 	int leaf_ok = may_be_leaf(refs, n, p);
-	if (p->ext[p->axis] <= 0.0f) /* all centroids equal: any halving will do */
-		return leaf_ok ? 0 : n / 2;
+	if (p->ext[p->axis] <= 0.0f) { /* all centroids equal: any halving will do */
+		if (leaf_ok)
+			return 0;
+		sides_bounds(refs, n, n / 2, child);
+		return n / 2;
+	}
 	if (p->nb) {
 		int best_bin;
 		float best_cost;
@@ -231,18 +321,12 @@ uint32_t bvh_split_apply(Ref *refs, uint32_t n, const Box *box, const SplitPlan 
 			float area = box_area(box);
 			if (leaf_ok && (float)n * area <= BVH_COST_TRAVERSE * area + best_cost)
 				return 0;
-			float cmin = p->cmin[best_axis], scale = p->scale[best_axis];
-			uint32_t i = 0, j = n;
-			while (i < j) {
-				if (bin_of(ref_key(&refs[i], best_axis), cmin, scale, p->nb) <= best_bin) {
-					i++;
-				} else {
-					Ref t = refs[i];
-					refs[i] = refs[--j];
-					refs[j] = t;
-				}
-			}
-			return i; /* both sides non-empty by construction of the bins */
+			/* Both sides non-empty by construction of the bins. */
+			if (p->nan_free)
+				return partition_bounds(refs, n, p, best_axis, best_bin, child);
+			uint32_t nleft = partition(refs, n, p, best_axis, best_bin);
+			sides_bounds(refs, n, nleft, child);
+			return nleft;
 		}
 		/* Every centroid fell into one bin (float rounding on a tiny
 		 * extent): fall through to the median. */
@@ -250,5 +334,6 @@ uint32_t bvh_split_apply(Ref *refs, uint32_t n, const Box *box, const SplitPlan 
 	if (leaf_ok)
 		return 0;
 	select_nth(refs, n, n / 2, p->axis);
+	sides_bounds(refs, n, n / 2, child);
 	return n / 2;
 }
