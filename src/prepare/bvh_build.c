@@ -308,6 +308,57 @@ static void order_fill(void *ctx, int part, int nparts)
 		b->order[i] = b->refs[i].idx;
 }
 
+struct BvhPermute {
+	const uint32_t *order;
+	uint32_t n;
+	Ref *scratch; /* the references, done with: 32 bytes a triangle */
+	Workers *workers;
+	char *array;  /* the array being permuted, and its slice */
+	size_t stride, off, len;
+};
+
+/* A slice of len bytes at off: fixed sizes compile to vector moves. */
+static inline void move_slice(char *to, const char *from, size_t len)
+{
+	if (len == 32)
+		memcpy(to, from, 32);
+	else if (len == 16)
+		memcpy(to, from, 16);
+	else
+		memcpy(to, from, len);
+}
+
+static void permute_gather(void *ctx, int part, int nparts)
+{
+	BvhPermute *p = ctx;
+	uint32_t s, e;
+	slice(0, p->n, part, nparts, &s, &e);
+	for (uint32_t i = s; i < e; i++)
+		move_slice((char *)&p->scratch[i], p->array + p->stride * p->order[i] + p->off, p->len);
+}
+
+static void permute_back(void *ctx, int part, int nparts)
+{
+	BvhPermute *p = ctx;
+	uint32_t s, e;
+	slice(0, p->n, part, nparts, &s, &e);
+	for (uint32_t i = s; i < e; i++)
+		move_slice(p->array + p->stride * i + p->off, (const char *)&p->scratch[i], p->len);
+}
+
+void bvh_permute(BvhPermute *p, void *array, size_t stride)
+{
+	_Static_assert(sizeof(Ref) == 32, "bvh_permute moves 32 bytes a reference");
+	p->array = array;
+	p->stride = stride;
+	for (p->off = 0; p->off < stride; p->off += p->len) {
+		p->len = stride - p->off < 32 ? stride - p->off : 32;
+		/* Every read before any write: a slice read may lie anywhere. */
+		workers_run(p->workers, permute_gather, p);
+		workers_run(p->workers, permute_back, p);
+	}
+}
+
 int bvh_threads(void) { return workers_cores(); }
 
 ajar_status bvh_build_input(const BvhInput *in, int threads, BvhReorder reorder, void *ctx, Bvh *out)
@@ -355,21 +406,22 @@ ajar_status bvh_build_input(const BvhInput *in, int threads, BvhReorder reorder,
 		else
 			workers_run(&b.workers, order_fill, &b);
 	}
-	if (b.workers.threads || b.workers.n)
-		workers_stop(&b.workers);
 	free(b.tasks);
 	free(b.part_bounds);
 	free(b.part_nan);
 	free(b.part_bins);
+	if (st == AJAR_OK && reorder) {
+		BvhPermute p = {out->order, in->ntris, b.refs, &b.workers, NULL, 0, 0, 0};
+		reorder(&p, ctx);
+		free(out->order);
+		out->order = NULL;
+	}
+	if (b.workers.threads || b.workers.n)
+		workers_stop(&b.workers);
 	free(b.refs);
 	if (st == AJAR_OK) {
 		out->ntris = in->ntris;
 		out->depth = atomic_load(&b.max_depth);
-		if (reorder) {
-			reorder(out->order, in->ntris, ctx);
-			free(out->order);
-			out->order = NULL;
-		}
 		st = bvh_collapse(b.bn, atomic_load(&b.ninterior), in->tri_base, out);
 	}
 	free(b.bn);
