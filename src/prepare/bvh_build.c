@@ -165,7 +165,7 @@ static void build_subtree(Build *b, Task root)
 		uint32_t n = task.end - task.start;
 		SplitPlan plan;
 		bvh_split_plan(n, &task.nb.cbox, task.depth, b->inst_from, b->nan_free, &plan);
-		if (plan.nb) {
+		if (plan.nb && n > BVH_FEW) { /* fewer are split without bins (bvh_split.c) */
 			bvh_bins_clear(&bins, plan.nb);
 			bvh_bins_add(&bins, &plan, b->refs, task.start, task.end);
 		}

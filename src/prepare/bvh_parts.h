@@ -170,6 +170,8 @@ static inline float f4_half_area(F4 d)
 #define BVH_MAX_LEAF 4
 /* SAH bins per axis at most; a node of fewer refs gets one per ref. */
 #define BVH_BINS 32
+/* Nodes of at most this many refs are swept without bins (bvh_split.c). */
+#define BVH_FEW 4
 /* Traversal cost relative to one triangle test. */
 #define BVH_COST_TRAVERSE 1.0f
 

@@ -224,6 +224,57 @@ static int sah_sweep(const Bins *bins, const SplitPlan *p, int *best_bin, float 
 	return best_axis;
 }
 
+/* sah_sweep for a node of at most BVH_FEW refs, without bins: over half
+ * of all nodes, where filling and sweeping bins cost more than the split.
+ * Each candidate's sides are grown from the refs themselves: min and max
+ * of the same values as the bins' (only the sign of a zero may differ,
+ * which no area or comparison sees), counted and costed with the same
+ * operations, candidates in the same order (a bin no ref falls in offers
+ * none, as in sah_sweep). */
+static int sweep_few(const Ref *refs, uint32_t n, const SplitPlan *p, int *best_bin, float *best_cost)
+{
+	F4 cmin = f4_set(p->cmin[0], p->cmin[1], p->cmin[2]), scale = f4_set(p->scale[0], p->scale[1], p->scale[2]);
+	F4 top = f4_splat((float)(p->nb - 1));
+	Box4 r[BVH_FEW];
+	int k[BVH_FEW][3];
+	for (uint32_t i = 0; i < n; i++) { /* bin_ref's bins */
+		r[i] = box4_of_ref(&refs[i]);
+		F4 f = f4_mul(f4_sub(f4_add(r[i].lo, r[i].hi), cmin), scale);
+		f4_trunc3(f4_min(f4_max(f, f4_zero()), top), &k[i][0], &k[i][1], &k[i][2]);
+	}
+	int best_axis = -1, best = 0;
+	float best_c = FLT_MAX;
+	for (int a = 0; a < 3; a++) {
+		if (p->ext[a] <= 0.0f)
+			continue;
+		for (int t = 0; t < p->nb - 1; t++) {
+			Box4 left = box4_empty(), right = box4_empty();
+			uint32_t nl = 0;
+			int used = 0;
+			for (uint32_t i = 0; i < n; i++) {
+				if (k[i][a] <= t) {
+					left = box4_grow(left, r[i]);
+					nl++;
+					used |= k[i][a] == t;
+				} else {
+					right = box4_grow(right, r[i]);
+				}
+			}
+			if (!used || nl == n)
+				continue;
+			float cost = box4_area(left) * (float)nl + box4_area(right) * (float)(n - nl);
+			if (cost < best_c) {
+				best_c = cost;
+				best_axis = a;
+				best = t;
+			}
+		}
+	}
+	*best_bin = best;
+	*best_cost = best_c;
+	return best_axis;
+}
+
 /* Whether a node of at most BVH_MAX_LEAF refs may be a leaf: not if it
  * holds an instance beside anything else. */
 static int may_be_leaf(const Ref *refs, uint32_t n, const SplitPlan *p)
@@ -316,7 +367,8 @@ uint32_t bvh_split_apply(Ref *refs, uint32_t n, const Box *box, const SplitPlan 
 	if (p->nb) {
 		int best_bin;
 		float best_cost;
-		int best_axis = sah_sweep(bins, p, &best_bin, &best_cost);
+		int best_axis = n <= BVH_FEW ? sweep_few(refs, n, p, &best_bin, &best_cost)
+					     : sah_sweep(bins, p, &best_bin, &best_cost);
 		if (best_axis >= 0) {
 			float area = box_area(box);
 			if (leaf_ok && (float)n * area <= BVH_COST_TRAVERSE * area + best_cost)
