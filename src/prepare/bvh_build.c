@@ -5,18 +5,22 @@
  * SAH split (bvh_split.c); the binary tree is then collapsed into
  * eight-wide nodes (bvh_collapse.c). Two phases share the cores:
  *
- *  1. The nodes of more than PAR_MIN references at the top, one at a time:
- *     their bounds and bins are filled by every thread over a slice of the
+ *  1. The nodes of at least 1/threads of the references (and PAR_MIN), one
+ *     at a time: their bins are filled by every thread over a slice of the
  *     references each and merged in slice order (bvh_parts.h: the same
  *     bits as one pass); the partition is one thread's.
- *  2. The subtrees below them, largest first, one thread each, from an
+ *  2. The nodes below them from a shared stack, each thread taking the
+ *     latest: a node of at least SPLIT_MIN references is split alone and
+ *     its children pushed, a smaller one's whole subtree is built from an
  *     explicit stack (no recursion, so a pathological input cannot
- *     overflow the C stack), numbered depth-first as the one-thread build
- *     numbers them.
+ *     overflow the C stack), numbered depth-first. The cores stay busy
+ *     down to the last small subtree: on two cores, against subtrees of
+ *     up to 1/8 of the references taken largest first, bathroom's build
+ *     took XXX of the wall time.
  *
  * A node's split depends on its references alone, and a subtree over n
- * references rooted at binary node p fits in [p, p + 2n - 1): phase 1
- * places a node's children at p + 1 and p + 2 n_left before they are
+ * references rooted at binary node p fits in [p, p + 2n - 1): a node split
+ * alone places its children at p + 1 and p + 2 n_left before they are
  * built, so the phases need no stitching, and the tree is the same, bit for
  * bit, whatever the number of threads (test_bvh's test_threads_same_tree,
  * test_instances).
@@ -30,6 +34,7 @@
  * 0.69 s of CPU before the vector bins, 0.23 s after. */
 #include "prepare/bvh_build.h"
 
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -47,8 +52,11 @@ _Static_assert((BVH_WIDTH - 1) * (BVH_MAX_DEPTH / 2) <= BVH_STACK_SIZE, "kernels
 _Static_assert(BVH_MAX_LEAF <= 4, "leaf slots encode at most 4 triangles");
 
 /* Phase 1 takes nodes of at least this many references, and of at least
- * 1/(4 threads) of them all, so phase 2 has some 4 subtrees a thread. */
+ * 1/threads of them all. */
 #define PAR_MIN (1u << 15)
+/* Phase 2 splits nodes of at least this many references one at a time;
+ * a smaller subtree (a few hundred microseconds) is one thread's. */
+#define SPLIT_MIN 4096u
 
 typedef struct {
 	uint32_t start, end; /* references */
@@ -72,10 +80,12 @@ typedef struct {
 	NodeBounds *part_bounds; /* one per thread: the root's, by slice */
 	int *part_nan;           /* one per thread: a NaN in its slice */
 	Bins *part_bins;         /* one per thread */
-	/* Phase 2. */
+	/* Phase 2: the shared stack of nodes not yet taken. */
+	pthread_mutex_t mu;
+	pthread_cond_t cv;
 	Task *tasks;
-	uint32_t ntasks;
-	atomic_uint next_task;
+	size_t ntasks, cap;
+	int busy; /* threads working on a node or subtree */
 	atomic_uint ninterior, max_depth;
 } Build;
 
@@ -189,58 +199,122 @@ static void build_subtree(Build *b, Task root)
 	note_depth(b, max_depth);
 }
 
-static void part_subtrees(void *ctx, int part, int nparts)
+/* Splits node t alone with the bins given (filled when plan->nb), its
+ * children placed at t.node + 1 and t.node + 2 n_left. Returns how many
+ * children go to kids (0 for a leaf). */
+static int split_alone(Build *b, Task t, const SplitPlan *plan, const Bins *bins, Task kids[2])
+{
+	uint32_t n = t.end - t.start;
+	note_depth(b, t.depth + 1);
+	BinNode *node = &b->bn[t.node];
+	box4_store(&node->b, t.nb.box);
+	NodeBounds child[2];
+	uint32_t nleft = bvh_split_apply(b->refs + t.start, n, &node->b, plan, bins, child);
+	if (nleft == 0) {
+		node->index = (int)t.start;
+		node->count = (int)n;
+		return 0;
+	}
+	node->index = (int)(t.node + 2 * nleft);
+	node->count = 0;
+	atomic_fetch_add(&b->ninterior, 1);
+	uint32_t mid = t.start + nleft;
+	kids[0] = (Task){mid, t.end, t.node + 2 * nleft, t.depth + 1, child[1]};
+	kids[1] = (Task){t.start, mid, t.node + 1, t.depth + 1, child[0]};
+	return 2;
+}
+
+/* Pushes a task on the shared stack (b->mu held); 0 if out of memory. */
+static int push_task(Build *b, Task t)
+{
+	if (b->ntasks == b->cap) {
+		size_t cap = b->cap ? 2 * b->cap : 64;
+		Task *q = realloc(b->tasks, sizeof *q * cap);
+		if (!q)
+			return 0;
+		b->tasks = q;
+		b->cap = cap;
+	}
+	b->tasks[b->ntasks++] = t;
+	return 1;
+}
+
+/* Phase 2 on one thread: takes the latest node until none is left and no
+ * thread can push more. */
+static void part_nodes(void *ctx, int part, int nparts)
 {
 	(void)part;
 	(void)nparts;
 	Build *b = ctx;
-	for (uint32_t k; (k = atomic_fetch_add(&b->next_task, 1)) < b->ntasks;)
-		build_subtree(b, b->tasks[k]);
+	Bins bins;
+	pthread_mutex_lock(&b->mu);
+	for (;;) {
+		while (b->ntasks == 0 && b->busy > 0)
+			pthread_cond_wait(&b->cv, &b->mu);
+		if (b->ntasks == 0)
+			break;
+		Task t = b->tasks[--b->ntasks];
+		b->busy++;
+		pthread_mutex_unlock(&b->mu);
+		Task kids[2];
+		int nk = 0;
+		uint32_t n = t.end - t.start;
+		if (n >= SPLIT_MIN) {
+			SplitPlan plan;
+			bvh_split_plan(n, &t.nb.cbox, t.depth, b->inst_from, b->nan_free, &plan);
+			if (plan.nb) {
+				bvh_bins_clear(&bins, plan.nb);
+				bvh_bins_add(&bins, &plan, b->refs, t.start, t.end);
+			}
+			nk = split_alone(b, t, &plan, &bins, kids);
+		} else {
+			build_subtree(b, t);
+		}
+		pthread_mutex_lock(&b->mu);
+		for (int k = 0; k < nk; k++)
+			if (!push_task(b, kids[k])) { /* out of memory: built here, one thread's */
+				pthread_mutex_unlock(&b->mu);
+				build_subtree(b, kids[k]);
+				pthread_mutex_lock(&b->mu);
+			}
+		b->busy--;
+		if (nk || b->busy == 0)
+			pthread_cond_broadcast(&b->cv);
+	}
+	pthread_mutex_unlock(&b->mu);
 }
 
-static int task_larger(const void *x, const void *y)
-{
-	const Task *a = x, *c = y;
-	uint32_t na = a->end - a->start, nc = c->end - c->start;
-	return na > nc ? -1 : na < nc ? 1 : (a->start > c->start) - (a->start < c->start);
-}
-
-/* Phase 1 from the root, then phase 2 over the subtrees it left. */
+/* Phase 1 from the root, then phase 2 over the nodes it left. */
 static ajar_status build_tree(Build *b)
 {
 	int nt = b->workers.n;
-	uint32_t big = b->nrefs / (4u * (uint32_t)nt);
-	if (big < PAR_MIN)
-		big = PAR_MIN;
-	/* Phase-1 nodes of one depth are disjoint, so at most nrefs / big of
-	 * them a level, each leaving at most two subtrees. The queue is
-	 * depth-first: one pending sibling a level. */
-	size_t cap = 2 * BVH_MAX_DEPTH * ((size_t)b->nrefs / big + 1) + 1;
-	Task queue[BVH_MAX_DEPTH + 2];
-	b->tasks = malloc(sizeof *b->tasks * cap);
-	b->part_bins = malloc(sizeof *b->part_bins * (size_t)nt);
-	if (!b->tasks || !b->part_bins)
-		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for the build's tasks");
-	size_t nq = 0;
-	queue[nq] = (Task){0, b->nrefs, 0, 0, b->part_bounds[0]};
+	Task root = {0, b->nrefs, 0, 0, b->part_bounds[0]};
 	b->nan_free = !b->part_nan[0];
 	for (int k = 1; k < nt; k++) {
-		bvh_bounds_merge(&queue[nq].nb, &b->part_bounds[k]);
+		bvh_bounds_merge(&root.nb, &b->part_bounds[k]);
 		b->nan_free &= !b->part_nan[k];
 	}
-	nq++;
-	b->ntasks = 0;
-	while (nq > 0) {
-		Task t = queue[--nq];
+	if (nt == 1) { /* one subtree, numbered depth-first from the root */
+		build_subtree(b, root);
+		return AJAR_OK;
+	}
+	uint32_t big = b->nrefs / (uint32_t)nt;
+	if (big < PAR_MIN)
+		big = PAR_MIN;
+	b->part_bins = malloc(sizeof *b->part_bins * (size_t)nt);
+	if (!b->part_bins || !push_task(b, root))
+		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for the build's tasks");
+	/* Phase 1: while a node on the stack is big (a few at most). */
+	for (;;) {
+		size_t k = 0;
+		while (k < b->ntasks && b->tasks[k].end - b->tasks[k].start < big)
+			k++;
+		if (k == b->ntasks)
+			break;
+		Task t = b->tasks[k], kids[2];
+		b->tasks[k] = b->tasks[--b->ntasks];
 		uint32_t n = t.end - t.start;
-		if (n < big || nt == 1) {
-			b->tasks[b->ntasks++] = t;
-			continue;
-		}
-		note_depth(b, t.depth + 1);
 		b->node = t;
-		BinNode *node = &b->bn[t.node];
-		box4_store(&node->b, t.nb.box);
 		SplitPlan plan;
 		bvh_split_plan(n, &t.nb.cbox, t.depth, b->inst_from, b->nan_free, &plan);
 		if (plan.nb) {
@@ -249,23 +323,13 @@ static ajar_status build_tree(Build *b)
 			for (int k = 1; k < nt; k++)
 				bvh_bins_merge(&b->part_bins[0], &b->part_bins[k], plan.nb);
 		}
-		NodeBounds child[2];
-		uint32_t nleft = bvh_split_apply(b->refs + t.start, n, &node->b, &plan, &b->part_bins[0], child);
-		if (nleft == 0) { /* not for n >= PAR_MIN, but harmless */
-			node->index = (int)t.start;
-			node->count = (int)n;
-			continue;
-		}
-		node->index = (int)(t.node + 2 * nleft);
-		node->count = 0;
-		atomic_fetch_add(&b->ninterior, 1);
-		uint32_t mid = t.start + nleft;
-		queue[nq++] = (Task){mid, t.end, t.node + 2 * nleft, t.depth + 1, child[1]};
-		queue[nq++] = (Task){t.start, mid, t.node + 1, t.depth + 1, child[0]};
+		int nk = split_alone(b, t, &plan, &b->part_bins[0], kids);
+		for (int k = 0; k < nk; k++)
+			if (!push_task(b, kids[k]))
+				return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for the build's tasks");
 	}
-	qsort(b->tasks, b->ntasks, sizeof *b->tasks, task_larger);
-	atomic_store(&b->next_task, 0);
-	workers_run(&b->workers, part_subtrees, b);
+	b->busy = 0;
+	workers_run(&b->workers, part_nodes, b);
 	return AJAR_OK;
 }
 
@@ -397,7 +461,11 @@ ajar_status bvh_build_input(const BvhInput *in, int threads, BvhReorder reorder,
 	}
 	if (st == AJAR_OK) {
 		workers_run(&b.workers, refs_fill, &b);
+		pthread_mutex_init(&b.mu, NULL);
+		pthread_cond_init(&b.cv, NULL);
 		st = build_tree(&b);
+		pthread_cond_destroy(&b.cv);
+		pthread_mutex_destroy(&b.mu);
 	}
 	if (st == AJAR_OK) {
 		b.order = out->order;
