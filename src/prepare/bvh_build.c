@@ -445,7 +445,8 @@ ajar_status bvh_build_input(const BvhInput *in, int threads, BvhReorder reorder,
 	/* The binary tree's array is as large as any tree could need; pages
 	 * the build leaves untouched cost no memory. */
 	size_t max_nodes = 2 * (size_t)in->n - 1;
-	b.refs = aligned_alloc(64, (sizeof(Ref) * in->n + 63) / 64 * 64);
+	b.refs = big_alloc(sizeof(Ref) * in->n); /* page-aligned: the refs are aligned */
+	big_advise_huge(b.refs, 0, sizeof(Ref) * in->n);
 	b.bn = malloc(sizeof(BinNode) * max_nodes);
 	out->order = malloc(sizeof(uint32_t) * (in->ntris ? in->ntris : 1));
 	ajar_status st = AJAR_OK;
@@ -486,7 +487,7 @@ ajar_status bvh_build_input(const BvhInput *in, int threads, BvhReorder reorder,
 	}
 	if (b.workers.threads || b.workers.n)
 		workers_stop(&b.workers);
-	free(b.refs);
+	big_free(b.refs, sizeof(Ref) * in->n);
 	if (st == AJAR_OK) {
 		out->ntris = in->ntris;
 		out->depth = atomic_load(&b.max_depth);

@@ -95,6 +95,8 @@ ajar_status bvh_collapse(const BinNode *bn, uint32_t ninterior, uint32_t tri_bas
 	BvhNode *nodes = big_resize(out->nodes, sizeof(BvhNode) * base, sizeof(BvhNode) * cap);
 	if (!nodes)
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for %zu nodes", cap);
+	/* Written node after node: huge pages (untouched ones cost nothing). */
+	big_advise_huge(nodes, sizeof(BvhNode) * base, sizeof(BvhNode) * cap);
 	out->nodes = nodes;
 	/* Pending (binary node, wide id) pairs: at most BVH_WIDTH - 1 per wide
 	 * level plus one; BVH_MAX_DEPTH bounds the levels. */
