@@ -106,29 +106,31 @@ static void refs_fill(void *ctx, int part, int nparts)
 	const BvhInput *in = b->in;
 	uint32_t s, e;
 	slice(0, b->nrefs, part, nparts, &s, &e);
-	int nan = 0;
+	F4 nan = f4_zero(); /* NaN lanes seen: x != x */
+	Box4 box = box4_empty(), cbox = box4_empty();
 	for (uint32_t i = s; i < e; i++) {
 		Ref *r = &b->refs[i];
 		if (i >= in->ntris) {
 			V3 lo = in->inst_lo[i - in->ntris], hi = in->inst_hi[i - in->ntris];
 			*r = (Ref){{lo.x, lo.y, lo.z}, i, {hi.x, hi.y, hi.z}, 0.0f};
-			continue;
+		} else {
+			const Tri *t = &in->tris[in->index ? in->index[i] : i];
+			F4 p0 = f4_load3(&t->p0.x), p1 = f4_load3(&t->p1.x), p2 = f4_load3(&t->p2.x);
+			float lo[4], hi[4];
+			f4_store(lo, f4_min(f4_min(p2, p1), p0));
+			f4_store(hi, f4_max(f4_max(p2, p1), p0));
+			*r = (Ref){{lo[0], lo[1], lo[2]}, i, {hi[0], hi[1], hi[2]}, 0.0f};
 		}
-		const Tri *t = &in->tris[in->index ? in->index[i] : i];
-		F4 p0 = f4_load3(&t->p0.x), p1 = f4_load3(&t->p1.x), p2 = f4_load3(&t->p2.x);
-		float lo[4], hi[4];
-		f4_store(lo, f4_min(f4_min(p2, p1), p0));
-		f4_store(hi, f4_max(f4_max(p2, p1), p0));
-		*r = (Ref){{lo[0], lo[1], lo[2]}, i, {hi[0], hi[1], hi[2]}, 0.0f};
+		/* bvh_bounds' growth, ref by ref */
+		Box4 rb = box4_of_ref(r);
+		F4 key = f4_add(rb.lo, rb.hi);
+		box = box4_grow(box, rb);
+		cbox.lo = f4_min(key, cbox.lo);
+		cbox.hi = f4_max(key, cbox.hi);
+		nan = f4_mark_nan(f4_mark_nan(f4_mark_nan(nan, rb.lo), rb.hi), key);
 	}
-	for (uint32_t i = s; i < e; i++) {
-		Box4 r = box4_of_ref(&b->refs[i]);
-		nan |= f4_any_nan3(r.lo) | f4_any_nan3(r.hi) | f4_any_nan3(f4_add(r.lo, r.hi));
-	}
-	b->part_nan[part] = nan;
-	NodeBounds *nb = &b->part_bounds[part];
-	nb->box = nb->cbox = box4_empty();
-	bvh_bounds(b->refs, s, e, nb);
+	b->part_nan[part] = f4_any_nan3(nan);
+	b->part_bounds[part] = (NodeBounds){box, cbox};
 }
 
 static void part_bins(void *ctx, int part, int nparts)

@@ -54,6 +54,8 @@ static inline F4 f4_set_lane3_bits(F4 a, uint32_t v)
 }
 /* Whether a lane of 0-2 is NaN. */
 static inline int f4_any_nan3(F4 a) { return _mm_movemask_ps(_mm_cmpunord_ps(a, a)) & 7; }
+/* seen with a NaN in every lane where a has one. */
+static inline F4 f4_mark_nan(F4 seen, F4 a) { return _mm_or_ps(seen, _mm_cmpunord_ps(a, a)); }
 /* Whether lane `axis` of a is >= t. */
 static inline int f4_lane_ge(F4 a, F4 t, int axis) { return (_mm_movemask_ps(_mm_cmpge_ps(a, t)) >> axis) & 1; }
 static inline void f4_store(float out[4], F4 a) { _mm_storeu_ps(out, a); }
@@ -141,6 +143,13 @@ static inline F4 f4_set_lane3_bits(F4 a, uint32_t v)
 }
 static inline F4 f4_count1(F4 a) { return f4_set_lane3_bits(a, f4_lane3_bits(a) + 1); }
 static inline int f4_any_nan3(F4 a) { return a.v[0] != a.v[0] || a.v[1] != a.v[1] || a.v[2] != a.v[2]; }
+static inline F4 f4_mark_nan(F4 seen, F4 a)
+{
+	for (int i = 0; i < 4; i++)
+		if (a.v[i] != a.v[i])
+			seen.v[i] = a.v[i];
+	return seen;
+}
 static inline int f4_lane_ge(F4 a, F4 t, int axis) { return a.v[axis] >= t.v[axis]; }
 static inline void f4_store(float out[4], F4 a)
 {
