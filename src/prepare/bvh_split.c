@@ -186,6 +186,95 @@ static void select_nth(Ref *r, uint32_t n, uint32_t k, int axis)
 /* box_area of a vector box: the same products and sums in the same order. */
 static inline float box4_area(Box4 b) { return f4_half_area(f4_sub(b.hi, b.lo)); }
 
+#if defined(__SSE2__)
+/* Half the areas of three boxes' extents d0, d1, d2 in lanes 0-2: each
+ * f4_half_area's products and sums in its order, lane by lane. */
+static inline __m128 half_area3(__m128 d0, __m128 d1, __m128 d2)
+{
+	__m128 t0 = _mm_unpacklo_ps(d0, d1), t1 = _mm_unpackhi_ps(d0, d1);
+	__m128 x = _mm_movelh_ps(t0, d2), y = _mm_shuffle_ps(t0, d2, _MM_SHUFFLE(3, 1, 3, 2));
+	__m128 z = _mm_shuffle_ps(t1, d2, _MM_SHUFFLE(3, 2, 1, 0));
+	__m128 zero = _mm_setzero_ps();
+	__m128 neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(x, zero), _mm_cmplt_ps(y, zero)), _mm_cmplt_ps(z, zero));
+	__m128 a = _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, y), _mm_mul_ps(y, z)), _mm_mul_ps(z, x));
+	return _mm_andnot_ps(neg, a);
+}
+
+/* Bin k's three boxes (count lanes cleared) grown into acc, its three
+ * counts (lanes 0-2) returned. */
+static inline __m128i grow3(Box4 acc[3], const Bins *bins, int k)
+{
+	__m128 keep = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
+	__m128 h0 = bins->box[0][k].hi, h1 = bins->box[1][k].hi, h2 = bins->box[2][k].hi;
+	acc[0].lo = _mm_min_ps(bins->box[0][k].lo, acc[0].lo);
+	acc[1].lo = _mm_min_ps(bins->box[1][k].lo, acc[1].lo);
+	acc[2].lo = _mm_min_ps(bins->box[2][k].lo, acc[2].lo);
+	acc[0].hi = _mm_max_ps(_mm_and_ps(h0, keep), acc[0].hi);
+	acc[1].hi = _mm_max_ps(_mm_and_ps(h1, keep), acc[1].hi);
+	acc[2].hi = _mm_max_ps(_mm_and_ps(h2, keep), acc[2].hi);
+	__m128 c = _mm_shuffle_ps(_mm_unpackhi_ps(h0, h1), h2, _MM_SHUFFLE(3, 3, 3, 2));
+	return _mm_castps_si128(c);
+}
+
+static inline __m128 area3(const Box4 acc[3])
+{
+	return half_area3(_mm_sub_ps(acc[0].hi, acc[0].lo), _mm_sub_ps(acc[1].hi, acc[1].lo),
+			  _mm_sub_ps(acc[2].hi, acc[2].lo));
+}
+
+/* The cheapest SAH split over the bins (the scalar sah_sweep below, for
+ * builds without SSE2, says how), the three axes side by side (lane a:
+ * axis a):
+ * every lane's areas, counts and costs are the scalar sweep's operations
+ * on the same values, each lane keeps its first cheapest bin (strict <),
+ * and the axes are then compared in order with strict <, as the scalar
+ * scan over axis after axis compares them. Empty bins are swept too:
+ * they change nothing, and a split after one is never strictly cheaper. */
+static int sah_sweep(const Bins *bins, const SplitPlan *p, int *best_bin, float *best_cost)
+{
+	int nb = p->nb;
+	__m128 right_area[BVH_BINS];
+	__m128i right_count[BVH_BINS];
+	Box4 acc[3] = {box4_empty(), box4_empty(), box4_empty()};
+	__m128i cnt = _mm_setzero_si128(), zero = _mm_setzero_si128();
+	for (int k = nb - 1; k > 0; k--) {
+		cnt = _mm_add_epi32(cnt, grow3(acc, bins, k));
+		right_area[k] = area3(acc);
+		right_count[k] = cnt;
+	}
+	__m128i axes = _mm_setr_epi32(p->ext[0] > 0.0f ? -1 : 0, p->ext[1] > 0.0f ? -1 : 0,
+				      p->ext[2] > 0.0f ? -1 : 0, 0);
+	__m128 best = _mm_set1_ps(FLT_MAX);
+	__m128i best_k = zero;
+	acc[0] = acc[1] = acc[2] = box4_empty();
+	cnt = zero;
+	for (int k = 0; k < nb - 1; k++) {
+		cnt = _mm_add_epi32(cnt, grow3(acc, bins, k));
+		__m128 cost = _mm_add_ps(_mm_mul_ps(area3(acc), _mm_cvtepi32_ps(cnt)),
+					 _mm_mul_ps(right_area[k + 1], _mm_cvtepi32_ps(right_count[k + 1])));
+		__m128i valid = _mm_and_si128(axes, _mm_and_si128(_mm_cmpgt_epi32(cnt, zero),
+								   _mm_cmpgt_epi32(right_count[k + 1], zero)));
+		__m128 better = _mm_and_ps(_mm_castsi128_ps(valid), _mm_cmplt_ps(cost, best));
+		best = _mm_or_ps(_mm_and_ps(better, cost), _mm_andnot_ps(better, best));
+		__m128i bi = _mm_castps_si128(better);
+		best_k = _mm_or_si128(_mm_and_si128(bi, _mm_set1_epi32(k)), _mm_andnot_si128(bi, best_k));
+	}
+	float bc[4];
+	int bk[4];
+	_mm_storeu_ps(bc, best);
+	_mm_storeu_si128((__m128i *)bk, best_k);
+	int best_axis = -1;
+	*best_cost = FLT_MAX;
+	*best_bin = 0;
+	for (int a = 0; a < 3; a++)
+		if (bc[a] < *best_cost) {
+			*best_cost = bc[a];
+			*best_bin = bk[a];
+			best_axis = a;
+		}
+	return best_axis;
+}
+#else
 /* The cheapest SAH split over the bins: its axis (-1 if none) and the
  * last bin on its left; costs in units of one triangle test times the
  * parent's area, so a zero-area node still compares splits consistently.
@@ -237,6 +326,7 @@ static int sah_sweep(const Bins *bins, const SplitPlan *p, int *best_bin, float 
 	*best_cost = best_c;
 	return best_axis;
 }
+#endif
 
 /* sah_sweep for a node of at most BVH_FEW refs, without bins: over half
  * of all nodes, where filling and sweeping bins cost more than the split.
