@@ -32,6 +32,19 @@ void big_free(void *p, size_t bytes)
 	if (p)
 		munmap(p, pages(bytes));
 }
+
+void big_advise_huge(void *p, size_t from, size_t to)
+{
+#ifdef MADV_HUGEPAGE
+	size_t a = pages(from), b = to / BIG_ARRAY_ALIGN * BIG_ARRAY_ALIGN; /* whole pages inside */
+	if (p && b > a)
+		madvise((char *)p + a, b - a, MADV_HUGEPAGE);
+#else
+	(void)p;
+	(void)from;
+	(void)to;
+#endif
+}
 #else
 void *big_alloc(size_t bytes)
 {
@@ -57,5 +70,12 @@ void big_free(void *p, size_t bytes)
 {
 	(void)bytes;
 	free(p);
+}
+
+void big_advise_huge(void *p, size_t from, size_t to)
+{
+	(void)p;
+	(void)from;
+	(void)to;
 }
 #endif

@@ -5,18 +5,22 @@
  * SAH split (bvh_split.c); the binary tree is then collapsed into
  * eight-wide nodes (bvh_collapse.c). Two phases share the cores:
  *
- *  1. The nodes of more than PAR_MIN references at the top, one at a time:
- *     their bounds and bins are filled by every thread over a slice of the
+ *  1. The nodes of at least 1/threads of the references (and PAR_MIN), one
+ *     at a time: their bins are filled by every thread over a slice of the
  *     references each and merged in slice order (bvh_parts.h: the same
  *     bits as one pass); the partition is one thread's.
- *  2. The subtrees below them, largest first, one thread each, from an
+ *  2. The nodes below them from a shared stack, each thread taking the
+ *     latest: a node of at least SPLIT_MIN references is split alone and
+ *     its children pushed, a smaller one's whole subtree is built from an
  *     explicit stack (no recursion, so a pathological input cannot
- *     overflow the C stack), numbered depth-first as the one-thread build
- *     numbers them.
+ *     overflow the C stack), numbered depth-first. The cores stay busy
+ *     down to the last small subtree (before, subtrees of up to 1/(4
+ *     threads) of the references went one a thread, largest first, and
+ *     a core could wait out the last of them).
  *
  * A node's split depends on its references alone, and a subtree over n
- * references rooted at binary node p fits in [p, p + 2n - 1): phase 1
- * places a node's children at p + 1 and p + 2 n_left before they are
+ * references rooted at binary node p fits in [p, p + 2n - 1): a node split
+ * alone places its children at p + 1 and p + 2 n_left before they are
  * built, so the phases need no stitching, and the tree is the same, bit for
  * bit, whatever the number of threads (test_bvh's test_threads_same_tree,
  * test_instances).
@@ -27,9 +31,11 @@
  * triangles alone (number_leaves).
  *
  * Times (src/prepare/README.md, "The BVH"): bathroom, 592,188 triangles,
- * 0.69 s of CPU before the vector bins, 0.23 s after. */
+ * 0.69 s of CPU before the vector bins, 0.23 s after; issue 42's second
+ * round (the same tree) 0.74x that, Embree 1.3x faster where it was 1.8x. */
 #include "prepare/bvh_build.h"
 
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -47,13 +53,17 @@ _Static_assert((BVH_WIDTH - 1) * (BVH_MAX_DEPTH / 2) <= BVH_STACK_SIZE, "kernels
 _Static_assert(BVH_MAX_LEAF <= 4, "leaf slots encode at most 4 triangles");
 
 /* Phase 1 takes nodes of at least this many references, and of at least
- * 1/(4 threads) of them all, so phase 2 has some 4 subtrees a thread. */
+ * 1/threads of them all. */
 #define PAR_MIN (1u << 15)
+/* Phase 2 splits nodes of at least this many references one at a time;
+ * a smaller subtree (a few hundred microseconds) is one thread's. */
+#define SPLIT_MIN 4096u
 
 typedef struct {
 	uint32_t start, end; /* references */
 	uint32_t node;       /* its binary node */
 	uint32_t depth;
+	NodeBounds nb;       /* of its references, from its parent's split */
 } Task;
 
 typedef struct {
@@ -63,16 +73,20 @@ typedef struct {
 	BinNode *bn;
 	uint32_t *order;
 	uint32_t nrefs;
+	int nan_free;            /* no NaN in any ref's bounds or key (SplitPlan) */
 	Workers workers;
-	/* Phase 1: the node whose bounds or bins the threads fill. */
+	/* Phase 1: the node whose bins the threads fill. */
 	Task node;
 	const SplitPlan *plan;
-	NodeBounds *part_bounds; /* one per thread */
+	NodeBounds *part_bounds; /* one per thread: the root's, by slice */
+	int *part_nan;           /* one per thread: a NaN in its slice */
 	Bins *part_bins;         /* one per thread */
-	/* Phase 2. */
+	/* Phase 2: the shared stack of nodes not yet taken. */
+	pthread_mutex_t mu;
+	pthread_cond_t cv;
 	Task *tasks;
-	uint32_t ntasks;
-	atomic_uint next_task;
+	size_t ntasks, cap;
+	int busy; /* threads working on a node or subtree */
 	atomic_uint ninterior, max_depth;
 } Build;
 
@@ -85,41 +99,39 @@ static void slice(uint32_t start, uint32_t end, int part, int nparts, uint32_t *
 
 /* A triangle's bounds: fmin/fmax of its corners, which keep the first
  * argument on ties (-0 and +0 as the scalar build had them); an
- * instance's as given. */
+ * instance's as given. With them the root's bounds over the slice, and
+ * whether a NaN is among them. */
 static void refs_fill(void *ctx, int part, int nparts)
 {
 	Build *b = ctx;
 	const BvhInput *in = b->in;
 	uint32_t s, e;
 	slice(0, b->nrefs, part, nparts, &s, &e);
+	F4 nan = f4_zero(); /* NaN lanes seen: x != x */
+	Box4 box = box4_empty(), cbox = box4_empty();
 	for (uint32_t i = s; i < e; i++) {
 		Ref *r = &b->refs[i];
-		r->idx = i;
 		if (i >= in->ntris) {
 			V3 lo = in->inst_lo[i - in->ntris], hi = in->inst_hi[i - in->ntris];
-			r->b = (Box){{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}};
-			continue;
+			*r = (Ref){{lo.x, lo.y, lo.z}, i, {hi.x, hi.y, hi.z}, 0.0f};
+		} else {
+			const Tri *t = &in->tris[in->index ? in->index[i] : i];
+			F4 p0 = f4_load3(&t->p0.x), p1 = f4_load3(&t->p1.x), p2 = f4_load3(&t->p2.x);
+			float lo[4], hi[4];
+			f4_store(lo, f4_min(f4_min(p2, p1), p0));
+			f4_store(hi, f4_max(f4_max(p2, p1), p0));
+			*r = (Ref){{lo[0], lo[1], lo[2]}, i, {hi[0], hi[1], hi[2]}, 0.0f};
 		}
-		const Tri *t = &in->tris[in->index ? in->index[i] : i];
-		F4 p0 = f4_load3(&t->p0.x), p1 = f4_load3(&t->p1.x), p2 = f4_load3(&t->p2.x);
-		float lo[4], hi[4];
-		f4_store(lo, f4_min(f4_min(p2, p1), p0));
-		f4_store(hi, f4_max(f4_max(p2, p1), p0));
-		for (int a = 0; a < 3; a++) {
-			r->b.lo[a] = lo[a];
-			r->b.hi[a] = hi[a];
-		}
+		/* bvh_bounds' growth, ref by ref */
+		Box4 rb = box4_of_ref(r);
+		F4 key = f4_add(rb.lo, rb.hi);
+		box = box4_grow(box, rb);
+		cbox.lo = f4_min(key, cbox.lo);
+		cbox.hi = f4_max(key, cbox.hi);
+		nan = f4_mark_nan(f4_mark_nan(f4_mark_nan(nan, rb.lo), rb.hi), key);
 	}
-}
-
-static void part_bounds(void *ctx, int part, int nparts)
-{
-	Build *b = ctx;
-	uint32_t s, e;
-	slice(b->node.start, b->node.end, part, nparts, &s, &e);
-	NodeBounds *nb = &b->part_bounds[part];
-	nb->box = nb->cbox = box4_empty();
-	bvh_bounds(b->refs, s, e, nb);
+	b->part_nan[part] = f4_any_nan3(nan);
+	b->part_bounds[part] = (NodeBounds){box, cbox};
 }
 
 static void part_bins(void *ctx, int part, int nparts)
@@ -161,18 +173,17 @@ static void build_subtree(Build *b, Task root)
 			b->bn[parent].index = (int)id;
 		if (task.depth + 1 > max_depth)
 			max_depth = task.depth + 1;
-		NodeBounds nb = {box4_empty(), box4_empty()};
-		bvh_bounds(b->refs, task.start, task.end, &nb);
 		BinNode *node = &b->bn[id];
-		box4_store(&node->b, nb.box);
+		box4_store(&node->b, task.nb.box);
 		uint32_t n = task.end - task.start;
 		SplitPlan plan;
-		bvh_split_plan(n, &nb.cbox, task.depth, b->inst_from, &plan);
-		if (plan.nb) {
+		bvh_split_plan(n, &task.nb.cbox, task.depth, b->inst_from, b->nan_free, &plan);
+		if (plan.nb && n > BVH_FEW) { /* fewer are split without bins (bvh_split.c) */
 			bvh_bins_clear(&bins, plan.nb);
 			bvh_bins_add(&bins, &plan, b->refs, task.start, task.end);
 		}
-		uint32_t nleft = bvh_split_apply(b->refs + task.start, n, &node->b, &plan, &bins);
+		NodeBounds child[2];
+		uint32_t nleft = bvh_split_apply(b->refs + task.start, n, &node->b, &plan, &bins, child);
 		if (nleft == 0) {
 			node->index = (int)task.start;
 			node->count = (int)n;
@@ -182,90 +193,146 @@ static void build_subtree(Build *b, Task root)
 		node->count = 0;
 		ninterior++;
 		uint32_t mid = task.start + nleft;
-		stack[sp].t = (Task){mid, task.end, 0, task.depth + 1};
+		stack[sp].t = (Task){mid, task.end, 0, task.depth + 1, child[1]};
 		stack[sp++].parent = id;
-		stack[sp].t = (Task){task.start, mid, 0, task.depth + 1};
+		stack[sp].t = (Task){task.start, mid, 0, task.depth + 1, child[0]};
 		stack[sp++].parent = UINT32_MAX;
 	}
 	atomic_fetch_add(&b->ninterior, ninterior);
 	note_depth(b, max_depth);
 }
 
-static void part_subtrees(void *ctx, int part, int nparts)
+/* Splits node t alone with the bins given (filled when plan->nb), its
+ * children placed at t.node + 1 and t.node + 2 n_left. Returns how many
+ * children go to kids (0 for a leaf). */
+static int split_alone(Build *b, Task t, const SplitPlan *plan, const Bins *bins, Task kids[2])
+{
+	uint32_t n = t.end - t.start;
+	note_depth(b, t.depth + 1);
+	BinNode *node = &b->bn[t.node];
+	box4_store(&node->b, t.nb.box);
+	NodeBounds child[2];
+	uint32_t nleft = bvh_split_apply(b->refs + t.start, n, &node->b, plan, bins, child);
+	if (nleft == 0) {
+		node->index = (int)t.start;
+		node->count = (int)n;
+		return 0;
+	}
+	node->index = (int)(t.node + 2 * nleft);
+	node->count = 0;
+	atomic_fetch_add(&b->ninterior, 1);
+	uint32_t mid = t.start + nleft;
+	kids[0] = (Task){mid, t.end, t.node + 2 * nleft, t.depth + 1, child[1]};
+	kids[1] = (Task){t.start, mid, t.node + 1, t.depth + 1, child[0]};
+	return 2;
+}
+
+/* Pushes a task on the shared stack (b->mu held); 0 if out of memory. */
+static int push_task(Build *b, Task t)
+{
+	if (b->ntasks == b->cap) {
+		size_t cap = b->cap ? 2 * b->cap : 64;
+		Task *q = realloc(b->tasks, sizeof *q * cap);
+		if (!q)
+			return 0;
+		b->tasks = q;
+		b->cap = cap;
+	}
+	b->tasks[b->ntasks++] = t;
+	return 1;
+}
+
+/* Phase 2 on one thread: takes the latest node until none is left and no
+ * thread can push more. */
+static void part_nodes(void *ctx, int part, int nparts)
 {
 	(void)part;
 	(void)nparts;
 	Build *b = ctx;
-	for (uint32_t k; (k = atomic_fetch_add(&b->next_task, 1)) < b->ntasks;)
-		build_subtree(b, b->tasks[k]);
+	Bins bins;
+	pthread_mutex_lock(&b->mu);
+	for (;;) {
+		while (b->ntasks == 0 && b->busy > 0)
+			pthread_cond_wait(&b->cv, &b->mu);
+		if (b->ntasks == 0)
+			break;
+		Task t = b->tasks[--b->ntasks];
+		b->busy++;
+		pthread_mutex_unlock(&b->mu);
+		Task kids[2];
+		int nk = 0;
+		uint32_t n = t.end - t.start;
+		if (n >= SPLIT_MIN) {
+			SplitPlan plan;
+			bvh_split_plan(n, &t.nb.cbox, t.depth, b->inst_from, b->nan_free, &plan);
+			if (plan.nb) {
+				bvh_bins_clear(&bins, plan.nb);
+				bvh_bins_add(&bins, &plan, b->refs, t.start, t.end);
+			}
+			nk = split_alone(b, t, &plan, &bins, kids);
+		} else {
+			build_subtree(b, t);
+		}
+		pthread_mutex_lock(&b->mu);
+		for (int k = 0; k < nk; k++)
+			if (!push_task(b, kids[k])) { /* out of memory: built here, one thread's */
+				pthread_mutex_unlock(&b->mu);
+				build_subtree(b, kids[k]);
+				pthread_mutex_lock(&b->mu);
+			}
+		b->busy--;
+		if (nk || b->busy == 0)
+			pthread_cond_broadcast(&b->cv);
+	}
+	pthread_mutex_unlock(&b->mu);
 }
 
-static int task_larger(const void *x, const void *y)
-{
-	const Task *a = x, *c = y;
-	uint32_t na = a->end - a->start, nc = c->end - c->start;
-	return na > nc ? -1 : na < nc ? 1 : (a->start > c->start) - (a->start < c->start);
-}
-
-/* Phase 1 from the root, then phase 2 over the subtrees it left. */
+/* Phase 1 from the root, then phase 2 over the nodes it left. */
 static ajar_status build_tree(Build *b)
 {
 	int nt = b->workers.n;
-	uint32_t big = b->nrefs / (4u * (uint32_t)nt);
+	Task root = {0, b->nrefs, 0, 0, b->part_bounds[0]};
+	b->nan_free = !b->part_nan[0];
+	for (int k = 1; k < nt; k++) {
+		bvh_bounds_merge(&root.nb, &b->part_bounds[k]);
+		b->nan_free &= !b->part_nan[k];
+	}
+	if (nt == 1) { /* one subtree, numbered depth-first from the root */
+		build_subtree(b, root);
+		return AJAR_OK;
+	}
+	uint32_t big = b->nrefs / (uint32_t)nt;
 	if (big < PAR_MIN)
 		big = PAR_MIN;
-	/* Phase-1 nodes of one depth are disjoint, so at most nrefs / big of
-	 * them a level, each leaving at most two subtrees. The queue is
-	 * depth-first: one pending sibling a level. */
-	size_t cap = 2 * BVH_MAX_DEPTH * ((size_t)b->nrefs / big + 1) + 1;
-	Task queue[BVH_MAX_DEPTH + 2];
-	b->tasks = malloc(sizeof *b->tasks * cap);
-	b->part_bounds = malloc(sizeof *b->part_bounds * (size_t)nt);
 	b->part_bins = malloc(sizeof *b->part_bins * (size_t)nt);
-	if (!b->tasks || !b->part_bounds || !b->part_bins)
+	if (!b->part_bins || !push_task(b, root))
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for the build's tasks");
-	size_t nq = 0;
-	queue[nq++] = (Task){0, b->nrefs, 0, 0};
-	b->ntasks = 0;
-	while (nq > 0) {
-		Task t = queue[--nq];
+	/* Phase 1: while a node on the stack is big (a few at most). */
+	for (;;) {
+		size_t k = 0;
+		while (k < b->ntasks && b->tasks[k].end - b->tasks[k].start < big)
+			k++;
+		if (k == b->ntasks)
+			break;
+		Task t = b->tasks[k], kids[2];
+		b->tasks[k] = b->tasks[--b->ntasks];
 		uint32_t n = t.end - t.start;
-		if (n < big || nt == 1) {
-			b->tasks[b->ntasks++] = t;
-			continue;
-		}
-		note_depth(b, t.depth + 1);
 		b->node = t;
-		workers_run(&b->workers, part_bounds, b);
-		NodeBounds nb = b->part_bounds[0];
-		for (int k = 1; k < nt; k++)
-			bvh_bounds_merge(&nb, &b->part_bounds[k]);
-		BinNode *node = &b->bn[t.node];
-		box4_store(&node->b, nb.box);
 		SplitPlan plan;
-		bvh_split_plan(n, &nb.cbox, t.depth, b->inst_from, &plan);
+		bvh_split_plan(n, &t.nb.cbox, t.depth, b->inst_from, b->nan_free, &plan);
 		if (plan.nb) {
 			b->plan = &plan;
 			workers_run(&b->workers, part_bins, b);
 			for (int k = 1; k < nt; k++)
 				bvh_bins_merge(&b->part_bins[0], &b->part_bins[k], plan.nb);
 		}
-		uint32_t nleft = bvh_split_apply(b->refs + t.start, n, &node->b, &plan, &b->part_bins[0]);
-		if (nleft == 0) { /* not for n >= PAR_MIN, but harmless */
-			node->index = (int)t.start;
-			node->count = (int)n;
-			continue;
-		}
-		node->index = (int)(t.node + 2 * nleft);
-		node->count = 0;
-		atomic_fetch_add(&b->ninterior, 1);
-		uint32_t mid = t.start + nleft;
-		queue[nq++] = (Task){mid, t.end, t.node + 2 * nleft, t.depth + 1};
-		queue[nq++] = (Task){t.start, mid, t.node + 1, t.depth + 1};
+		int nk = split_alone(b, t, &plan, &b->part_bins[0], kids);
+		for (int k = 0; k < nk; k++)
+			if (!push_task(b, kids[k]))
+				return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for the build's tasks");
 	}
-	qsort(b->tasks, b->ntasks, sizeof *b->tasks, task_larger);
-	atomic_store(&b->next_task, 0);
-	workers_run(&b->workers, part_subtrees, b);
+	b->busy = 0;
+	workers_run(&b->workers, part_nodes, b);
 	return AJAR_OK;
 }
 
@@ -308,6 +375,57 @@ static void order_fill(void *ctx, int part, int nparts)
 		b->order[i] = b->refs[i].idx;
 }
 
+struct BvhPermute {
+	const uint32_t *order;
+	uint32_t n;
+	Ref *scratch; /* the references, done with: 32 bytes a triangle */
+	Workers *workers;
+	char *array;  /* the array being permuted, and its slice */
+	size_t stride, off, len;
+};
+
+/* A slice of len bytes at off: fixed sizes compile to vector moves. */
+static inline void move_slice(char *to, const char *from, size_t len)
+{
+	if (len == 32)
+		memcpy(to, from, 32);
+	else if (len == 16)
+		memcpy(to, from, 16);
+	else
+		memcpy(to, from, len);
+}
+
+static void permute_gather(void *ctx, int part, int nparts)
+{
+	BvhPermute *p = ctx;
+	uint32_t s, e;
+	slice(0, p->n, part, nparts, &s, &e);
+	for (uint32_t i = s; i < e; i++)
+		move_slice((char *)&p->scratch[i], p->array + p->stride * p->order[i] + p->off, p->len);
+}
+
+static void permute_back(void *ctx, int part, int nparts)
+{
+	BvhPermute *p = ctx;
+	uint32_t s, e;
+	slice(0, p->n, part, nparts, &s, &e);
+	for (uint32_t i = s; i < e; i++)
+		move_slice(p->array + p->stride * i + p->off, (const char *)&p->scratch[i], p->len);
+}
+
+void bvh_permute(BvhPermute *p, void *array, size_t stride)
+{
+	_Static_assert(sizeof(Ref) == 32, "bvh_permute moves 32 bytes a reference");
+	p->array = array;
+	p->stride = stride;
+	for (p->off = 0; p->off < stride; p->off += p->len) {
+		p->len = stride - p->off < 32 ? stride - p->off : 32;
+		/* Every read before any write: a slice read may lie anywhere. */
+		workers_run(p->workers, permute_gather, p);
+		workers_run(p->workers, permute_back, p);
+	}
+}
+
 int bvh_threads(void) { return workers_cores(); }
 
 ajar_status bvh_build_input(const BvhInput *in, int threads, BvhReorder reorder, void *ctx, Bvh *out)
@@ -330,7 +448,8 @@ ajar_status bvh_build_input(const BvhInput *in, int threads, BvhReorder reorder,
 	/* The binary tree's array is as large as any tree could need; pages
 	 * the build leaves untouched cost no memory. */
 	size_t max_nodes = 2 * (size_t)in->n - 1;
-	b.refs = malloc(sizeof(Ref) * in->n);
+	b.refs = big_alloc(sizeof(Ref) * in->n); /* page-aligned: the refs are aligned */
+	big_advise_huge(b.refs, 0, sizeof(Ref) * in->n);
 	b.bn = malloc(sizeof(BinNode) * max_nodes);
 	out->order = malloc(sizeof(uint32_t) * (in->ntris ? in->ntris : 1));
 	ajar_status st = AJAR_OK;
@@ -339,8 +458,18 @@ ajar_status bvh_build_input(const BvhInput *in, int threads, BvhReorder reorder,
 	if (st == AJAR_OK)
 		st = workers_start(&b.workers, threads < 1 ? 1 : threads);
 	if (st == AJAR_OK) {
+		b.part_bounds = malloc(sizeof *b.part_bounds * (size_t)b.workers.n);
+		b.part_nan = malloc(sizeof *b.part_nan * (size_t)b.workers.n);
+		if (!b.part_bounds || !b.part_nan)
+			st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for the build's tasks");
+	}
+	if (st == AJAR_OK) {
 		workers_run(&b.workers, refs_fill, &b);
+		pthread_mutex_init(&b.mu, NULL);
+		pthread_cond_init(&b.cv, NULL);
 		st = build_tree(&b);
+		pthread_cond_destroy(&b.cv);
+		pthread_mutex_destroy(&b.mu);
 	}
 	if (st == AJAR_OK) {
 		b.order = out->order;
@@ -349,20 +478,22 @@ ajar_status bvh_build_input(const BvhInput *in, int threads, BvhReorder reorder,
 		else
 			workers_run(&b.workers, order_fill, &b);
 	}
-	if (b.workers.threads || b.workers.n)
-		workers_stop(&b.workers);
 	free(b.tasks);
 	free(b.part_bounds);
+	free(b.part_nan);
 	free(b.part_bins);
-	free(b.refs);
+	if (st == AJAR_OK && reorder) {
+		BvhPermute p = {out->order, in->ntris, b.refs, &b.workers, NULL, 0, 0, 0};
+		reorder(&p, ctx);
+		free(out->order);
+		out->order = NULL;
+	}
+	if (b.workers.threads || b.workers.n)
+		workers_stop(&b.workers);
+	big_free(b.refs, sizeof(Ref) * in->n);
 	if (st == AJAR_OK) {
 		out->ntris = in->ntris;
 		out->depth = atomic_load(&b.max_depth);
-		if (reorder) {
-			reorder(out->order, in->ntris, ctx);
-			free(out->order);
-			out->order = NULL;
-		}
 		st = bvh_collapse(b.bn, atomic_load(&b.ninterior), in->tri_base, out);
 	}
 	free(b.bn);

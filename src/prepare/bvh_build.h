@@ -51,9 +51,16 @@ typedef struct {
 ajar_status bvh_build(const Tri *tris, uint32_t ntris, Bvh *out);
 /* The same tree, bit for bit, on `threads` threads (1: the caller's alone). */
 ajar_status bvh_build_threads(const Tri *tris, uint32_t ntris, int threads, Bvh *out);
-/* Puts the caller's triangle arrays in the leaf order: order[i] is the
- * original index of triangle i, and order may be written (scratch). */
-typedef void (*BvhReorder)(uint32_t *order, uint32_t n, void *ctx);
+/* The leaf order as the build hands it over: bvh_permute puts an array of
+ * one element per triangle in that order, on the build's threads. */
+typedef struct BvhPermute BvhPermute;
+/* array[i] = the old array[order[i]] for every triangle i: gathered a
+ * 32-byte slice of each element at a time into the build's reference
+ * array (freed after), so no second copy of the array is made and the
+ * reads run in parallel rather than one cycle's miss after another. */
+void bvh_permute(BvhPermute *p, void *array, size_t stride);
+/* Puts the caller's triangle arrays in the leaf order (bvh_permute). */
+typedef void (*BvhReorder)(BvhPermute *p, void *ctx);
 /* bvh_build_threads that hands the order to `reorder` between building
  * the binary tree and collapsing it, when the build holds the least
  * memory, and frees it (out->order NULL). */

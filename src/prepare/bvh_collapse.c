@@ -22,29 +22,38 @@
 #include "prepare/bvh_collapse.h"
 #include "prepare/bvh_parts.h"
 
-/* Slots of a wide node under construction: binary node ids. */
+/* Slots of a wide node under construction: binary node ids, and the box
+ * area of each interior one (-1 for a leaf), taken once. */
 typedef struct {
 	uint32_t bin[BVH_WIDTH];
+	float area[BVH_WIDTH];
 	int n;
 } Slots;
 
 static int bin_is_leaf(const BinNode *bn, uint32_t i) { return bn[i].count > 0; }
 
+static float slot_area(const BinNode *bn, uint32_t i) { return bin_is_leaf(bn, i) ? -1.0f : box_area(&bn[i].b); }
+
 /* Opens slot k (an interior binary node) into its two children. */
 static void slots_open(const BinNode *bn, Slots *s, int k)
 {
-	uint32_t i = s->bin[k];
+	uint32_t i = s->bin[k], r = (uint32_t)bn[i].index;
 	s->bin[k] = i + 1;
-	s->bin[s->n++] = (uint32_t)bn[i].index;
+	s->area[k] = slot_area(bn, i + 1);
+	s->bin[s->n] = r;
+	s->area[s->n++] = slot_area(bn, r);
 }
 
 /* The binary children of interior node i, each interior one opened, then
- * while a slot is free the interior slot of largest box area opened. */
+ * while a slot is free the interior slot of largest box area opened (the
+ * first of equal ones). */
 static void slots_fill(const BinNode *bn, uint32_t i, Slots *s)
 {
 	s->n = 0;
-	s->bin[s->n++] = i + 1;
-	s->bin[s->n++] = (uint32_t)bn[i].index;
+	s->bin[s->n] = i + 1;
+	s->area[s->n++] = slot_area(bn, i + 1);
+	s->bin[s->n] = (uint32_t)bn[i].index;
+	s->area[s->n++] = slot_area(bn, (uint32_t)bn[i].index);
 	for (int k = 0, n0 = s->n; k < n0; k++)
 		if (!bin_is_leaf(bn, s->bin[k]))
 			slots_open(bn, s, k);
@@ -52,8 +61,8 @@ static void slots_fill(const BinNode *bn, uint32_t i, Slots *s)
 		int best = -1;
 		float best_area = -1.0f;
 		for (int k = 0; k < s->n; k++)
-			if (!bin_is_leaf(bn, s->bin[k]) && box_area(&bn[s->bin[k]].b) > best_area) {
-				best_area = box_area(&bn[s->bin[k]].b);
+			if (s->area[k] > best_area) {
+				best_area = s->area[k];
 				best = k;
 			}
 		if (best < 0)
@@ -86,6 +95,8 @@ ajar_status bvh_collapse(const BinNode *bn, uint32_t ninterior, uint32_t tri_bas
 	BvhNode *nodes = big_resize(out->nodes, sizeof(BvhNode) * base, sizeof(BvhNode) * cap);
 	if (!nodes)
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "bvh_build: out of memory for %zu nodes", cap);
+	/* Written node after node: huge pages (untouched ones cost nothing). */
+	big_advise_huge(nodes, sizeof(BvhNode) * base, sizeof(BvhNode) * cap);
 	out->nodes = nodes;
 	/* Pending (binary node, wide id) pairs: at most BVH_WIDTH - 1 per wide
 	 * level plus one; BVH_MAX_DEPTH bounds the levels. */

@@ -12,6 +12,7 @@
 #ifndef AJAR_BVH_PARTS_H
 #define AJAR_BVH_PARTS_H
 #include <stdint.h>
+#include <string.h>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -24,12 +25,39 @@ static inline F4 f4_load3(const float *p)
 {
 	return _mm_and_ps(_mm_loadu_ps(p), _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0)));
 }
+/* Four floats at p, 16-byte aligned. */
+static inline F4 f4_load(const float *p) { return _mm_load_ps(p); }
 static inline F4 f4_add(F4 a, F4 b) { return _mm_add_ps(a, b); }
 static inline F4 f4_sub(F4 a, F4 b) { return _mm_sub_ps(a, b); }
 static inline F4 f4_mul(F4 a, F4 b) { return _mm_mul_ps(a, b); }
 /* o < b ? o : b and o > b ? o : b, lane by lane: b stays on ties. */
 static inline F4 f4_min(F4 o, F4 b) { return _mm_min_ps(o, b); }
 static inline F4 f4_max(F4 o, F4 b) { return _mm_max_ps(o, b); }
+/* acc < o ? acc : o and acc > o ? acc : o: o replaces acc on ties too
+ * (and would on a NaN o: for NaN-free values only). */
+static inline F4 f4_min_late(F4 acc, F4 o) { return _mm_min_ps(acc, o); }
+static inline F4 f4_max_late(F4 acc, F4 o) { return _mm_max_ps(acc, o); }
+/* a with 1 added to lane 3's bits as an integer. */
+static inline F4 f4_count1(F4 a)
+{
+	return _mm_castsi128_ps(_mm_add_epi32(_mm_castps_si128(a), _mm_setr_epi32(0, 0, 0, 1)));
+}
+/* Lane 3's bits as an integer. */
+static inline uint32_t f4_lane3_bits(F4 a)
+{
+	return (uint32_t)_mm_cvtsi128_si32(_mm_shuffle_epi32(_mm_castps_si128(a), 3));
+}
+static inline F4 f4_set_lane3_bits(F4 a, uint32_t v)
+{
+	__m128i keep = _mm_setr_epi32(-1, -1, -1, 0);
+	return _mm_or_ps(_mm_and_ps(a, _mm_castsi128_ps(keep)), _mm_castsi128_ps(_mm_setr_epi32(0, 0, 0, (int)v)));
+}
+/* Whether a lane of 0-2 is NaN. */
+static inline int f4_any_nan3(F4 a) { return _mm_movemask_ps(_mm_cmpunord_ps(a, a)) & 7; }
+/* seen with a NaN in every lane where a has one. */
+static inline F4 f4_mark_nan(F4 seen, F4 a) { return _mm_or_ps(seen, _mm_cmpunord_ps(a, a)); }
+/* Whether lane `axis` of a is >= t. */
+static inline int f4_lane_ge(F4 a, F4 t, int axis) { return (_mm_movemask_ps(_mm_cmpge_ps(a, t)) >> axis) & 1; }
 static inline void f4_store(float out[4], F4 a) { _mm_storeu_ps(out, a); }
 /* Lanes truncated toward zero (the values fit an int). */
 static inline void f4_trunc(int out[4], F4 a) { _mm_storeu_si128((__m128i *)out, _mm_cvttps_epi32(a)); }
@@ -59,6 +87,7 @@ static inline F4 f4_zero(void) { return (F4){{0.0f, 0.0f, 0.0f, 0.0f}}; }
 static inline F4 f4_set(float x, float y, float z) { return (F4){{x, y, z, 0.0f}}; }
 static inline F4 f4_splat(float v) { return (F4){{v, v, v, v}}; }
 static inline F4 f4_load3(const float *p) { return (F4){{p[0], p[1], p[2], 0.0f}}; }
+static inline F4 f4_load(const float *p) { return (F4){{p[0], p[1], p[2], p[3]}}; }
 static inline F4 f4_add(F4 a, F4 b)
 {
 	for (int i = 0; i < 4; i++)
@@ -89,6 +118,39 @@ static inline F4 f4_max(F4 o, F4 b)
 		b.v[i] = o.v[i] > b.v[i] ? o.v[i] : b.v[i];
 	return b;
 }
+static inline F4 f4_min_late(F4 acc, F4 o)
+{
+	for (int i = 0; i < 4; i++)
+		acc.v[i] = acc.v[i] < o.v[i] ? acc.v[i] : o.v[i];
+	return acc;
+}
+static inline F4 f4_max_late(F4 acc, F4 o)
+{
+	for (int i = 0; i < 4; i++)
+		acc.v[i] = acc.v[i] > o.v[i] ? acc.v[i] : o.v[i];
+	return acc;
+}
+static inline uint32_t f4_lane3_bits(F4 a)
+{
+	uint32_t v;
+	memcpy(&v, &a.v[3], sizeof v);
+	return v;
+}
+static inline F4 f4_set_lane3_bits(F4 a, uint32_t v)
+{
+	memcpy(&a.v[3], &v, sizeof v);
+	return a;
+}
+static inline F4 f4_count1(F4 a) { return f4_set_lane3_bits(a, f4_lane3_bits(a) + 1); }
+static inline int f4_any_nan3(F4 a) { return a.v[0] != a.v[0] || a.v[1] != a.v[1] || a.v[2] != a.v[2]; }
+static inline F4 f4_mark_nan(F4 seen, F4 a)
+{
+	for (int i = 0; i < 4; i++)
+		if (a.v[i] != a.v[i])
+			seen.v[i] = a.v[i];
+	return seen;
+}
+static inline int f4_lane_ge(F4 a, F4 t, int axis) { return a.v[axis] >= t.v[axis]; }
 static inline void f4_store(float out[4], F4 a)
 {
 	for (int i = 0; i < 4; i++)
@@ -117,6 +179,8 @@ static inline float f4_half_area(F4 d)
 #define BVH_MAX_LEAF 4
 /* SAH bins per axis at most; a node of fewer refs gets one per ref. */
 #define BVH_BINS 32
+/* Nodes of at most this many refs are swept without bins (bvh_split.c). */
+#define BVH_FEW 4
 /* Traversal cost relative to one triangle test. */
 #define BVH_COST_TRAVERSE 1.0f
 
@@ -130,10 +194,13 @@ typedef struct {
 } Box4;
 
 /* A triangle's bounds and where it came from; the build permutes these.
- * f4_load3 of b.lo reads b.hi[0] too, of b.hi reads idx: both inside. */
+ * 32 bytes, aligned: each bound is one aligned vector load (28-byte refs
+ * split a cache line every other ref) and a swap two vector moves. */
 typedef struct {
-	Box b;
-	uint32_t idx;
+	_Alignas(16) float lo[3];
+	uint32_t idx; /* lane 3 of lo's load: masked off */
+	float hi[3];
+	float zero; /* lane 3 of hi's load: 0 */
 } Ref;
 
 /* Node of the binary tree: an interior node's left child is the next
@@ -165,12 +232,9 @@ static inline Box4 box4_grow(Box4 b, Box4 o)
 
 static inline Box4 box4_of_ref(const Ref *r)
 {
-	Box4 b = {f4_load3(r->b.lo), f4_load3(r->b.hi)};
+	Box4 b = {f4_load3(r->lo), f4_load(r->hi)};
 	return b;
 }
-
-/* Twice the centroid on every axis: only compared, never a position. */
-static inline F4 ref_keys(const Ref *r) { return f4_add(f4_load3(r->b.lo), f4_load3(r->b.hi)); }
 
 static inline void box4_store(Box *out, Box4 b)
 {
@@ -195,7 +259,10 @@ static inline float box_area(const Box *b)
 	return d[0] * d[1] + d[1] * d[2] + d[2] * d[0];
 }
 
-/* A node's bounds and its refs' centroid (key) bounds. */
+/* A node's bounds and its refs' centroid (key) bounds. A lane that equals
+ * several refs' (-0 and +0 compare equal) holds the first one's bits in
+ * the refs' order: that is the bits of one pass in order, which is what
+ * the trees were measured with. */
 typedef struct {
 	Box4 box, cbox;
 } NodeBounds;
@@ -205,11 +272,15 @@ void bvh_bounds(const Ref *refs, uint32_t start, uint32_t end, NodeBounds *nb);
 /* *acc grown by `later`, the bounds of refs after acc's. */
 void bvh_bounds_merge(NodeBounds *acc, const NodeBounds *later);
 
-/* A node's SAH bins: one box and count per bin and axis. */
+/* A node's SAH bins: one box per bin and axis, its count in the bits of
+ * lane 3 of hi (a ref's hi has +0 there, never larger as a float, so the
+ * max keeps the count and one integer add counts the ref: no second
+ * read-modify-write per bin). */
 typedef struct {
 	Box4 box[3][BVH_BINS];
-	uint32_t count[3][BVH_BINS];
 } Bins;
+
+static inline uint32_t bins_count(const Bins *b, int a, int k) { return f4_lane3_bits(b->box[a][k].hi); }
 
 /* How a node of n refs with centroid bounds cbox is split: the axis of
  * largest centroid extent, and whether SAH bins are needed (else a leaf,
@@ -221,9 +292,10 @@ typedef struct {
 	float scale[3];   /* nb / extent, 0 for a flat axis */
 	float ext[3];
 	uint32_t inst_from; /* refs with idx >= this are instances, leaves of one (UINT32_MAX: none) */
+	int nan_free;       /* no ref's bounds or key has a NaN lane */
 } SplitPlan;
 
-void bvh_split_plan(uint32_t n, const Box4 *cbox, uint32_t depth, uint32_t inst_from, SplitPlan *p);
+void bvh_split_plan(uint32_t n, const Box4 *cbox, uint32_t depth, uint32_t inst_from, int nan_free, SplitPlan *p);
 void bvh_bins_clear(Bins *b, int nb);
 /* Bins refs [start, end) into b. */
 void bvh_bins_add(Bins *b, const SplitPlan *p, const Ref *refs, uint32_t start, uint32_t end);
@@ -231,6 +303,8 @@ void bvh_bins_add(Bins *b, const SplitPlan *p, const Ref *refs, uint32_t start, 
 void bvh_bins_merge(Bins *acc, const Bins *later, int nb);
 /* Chooses the split of refs[0, n) (node box `box`) with the plan and, when
  * p->nb, its bins; reorders refs. Returns the count on the left, or 0 for
- * a leaf. */
-uint32_t bvh_split_apply(Ref *refs, uint32_t n, const Box *box, const SplitPlan *p, const Bins *bins);
+ * a leaf; with a split, child[0] and child[1] are the bounds of the two
+ * sides (as bvh_bounds over each). */
+uint32_t bvh_split_apply(Ref *refs, uint32_t n, const Box *box, const SplitPlan *p, const Bins *bins,
+			 NodeBounds child[2]);
 #endif

@@ -39,9 +39,10 @@ void bvh_bounds_merge(NodeBounds *acc, const NodeBounds *later)
 	acc->cbox = box4_grow(acc->cbox, later->cbox);
 }
 
-void bvh_split_plan(uint32_t n, const Box4 *cbox, uint32_t depth, uint32_t inst_from, SplitPlan *p)
+void bvh_split_plan(uint32_t n, const Box4 *cbox, uint32_t depth, uint32_t inst_from, int nan_free, SplitPlan *p)
 {
 	p->inst_from = inst_from;
+	p->nan_free = nan_free;
 	float lo[4], hi[4];
 	f4_store(lo, cbox->lo);
 	f4_store(hi, cbox->hi);
@@ -64,11 +65,18 @@ void bvh_split_plan(uint32_t n, const Box4 *cbox, uint32_t depth, uint32_t inst_
 
 void bvh_bins_clear(Bins *b, int nb)
 {
+	Box4 e = box4_empty();
+	e.hi = f4_set_lane3_bits(e.hi, 0);
 	for (int a = 0; a < 3; a++)
-		for (int k = 0; k < nb; k++) {
-			b->box[a][k] = box4_empty();
-			b->count[a][k] = 0;
-		}
+		for (int k = 0; k < nb; k++)
+			b->box[a][k] = e;
+}
+
+/* A bin grown by ref box r and counted. */
+static inline void bin_grow(Box4 *bin, Box4 r)
+{
+	bin->lo = f4_min(r.lo, bin->lo);
+	bin->hi = f4_count1(f4_max(r.hi, bin->hi));
 }
 
 /* Bins one ref: (int)((key - cmin) * scale) clamped to [0, nb - 1], as
@@ -77,12 +85,11 @@ static inline void bin_ref(Bins *b, const Ref *ref, F4 cmin, F4 scale, F4 top)
 {
 	Box4 r = box4_of_ref(ref);
 	F4 f = f4_mul(f4_sub(f4_add(r.lo, r.hi), cmin), scale);
-	int k[3];
-	f4_trunc3(f4_min(f4_max(f, f4_zero()), top), &k[0], &k[1], &k[2]);
-	for (int a = 0; a < 3; a++) {
-		b->count[a][k[a]]++;
-		b->box[a][k[a]] = box4_grow(b->box[a][k[a]], r);
-	}
+	int k0, k1, k2;
+	f4_trunc3(f4_min(f4_max(f, f4_zero()), top), &k0, &k1, &k2);
+	bin_grow(&b->box[0][k0], r);
+	bin_grow(&b->box[1][k1], r);
+	bin_grow(&b->box[2][k2], r);
 }
 
 void bvh_bins_add(Bins *b, const SplitPlan *p, const Ref *refs, uint32_t start, uint32_t end)
@@ -90,11 +97,25 @@ void bvh_bins_add(Bins *b, const SplitPlan *p, const Ref *refs, uint32_t start, 
 	F4 cmin = f4_set(p->cmin[0], p->cmin[1], p->cmin[2]), scale = f4_set(p->scale[0], p->scale[1], p->scale[2]);
 	F4 top = f4_splat((float)(p->nb - 1));
 	uint32_t i = start;
-	/* Neighbouring refs often share a bin; alternating them between two
-	 * sets of bins lets one's update run while the other's waits on its
-	 * store (1.3x). The merged boxes may differ from one pass's only in
-	 * the sign of a zero, which neither their areas nor the split see. */
+	/* Neighbouring refs often share a bin; dealing them out over four
+	 * sets of bins (two below 256 refs) lets each update run while the
+	 * others wait on their stores: against two sets from 256 refs on,
+	 * unique-1m 0.86x and bathroom 0.92x the CPU of the whole build. The
+	 * merged boxes may differ from one pass's only in the sign of a zero,
+	 * which neither their areas nor the split see. */
 	if (end - start >= 256) {
+		Bins more[3];
+		for (int k = 0; k < 3; k++)
+			bvh_bins_clear(&more[k], p->nb);
+		for (; i + 3 < end; i += 4) {
+			bin_ref(b, &refs[i], cmin, scale, top);
+			bin_ref(&more[0], &refs[i + 1], cmin, scale, top);
+			bin_ref(&more[1], &refs[i + 2], cmin, scale, top);
+			bin_ref(&more[2], &refs[i + 3], cmin, scale, top);
+		}
+		for (int k = 0; k < 3; k++)
+			bvh_bins_merge(b, &more[k], p->nb);
+	} else if (end - start >= 64) {
 		Bins odd;
 		bvh_bins_clear(&odd, p->nb);
 		for (; i + 1 < end; i += 2) {
@@ -111,8 +132,9 @@ void bvh_bins_merge(Bins *acc, const Bins *later, int nb)
 {
 	for (int a = 0; a < 3; a++)
 		for (int k = 0; k < nb; k++) {
-			acc->count[a][k] += later->count[a][k];
+			uint32_t count = bins_count(acc, a, k) + bins_count(later, a, k);
 			acc->box[a][k] = box4_grow(acc->box[a][k], later->box[a][k]);
+			acc->box[a][k].hi = f4_set_lane3_bits(acc->box[a][k].hi, count);
 		}
 }
 
@@ -124,7 +146,7 @@ static int bin_of(float key, float cmin, float scale, int nbins)
 	return !(f > 0.0f) ? 0 : (f >= (float)nbins ? nbins - 1 : (int)f);
 }
 
-static float ref_key(const Ref *r, int axis) { return r->b.lo[axis] + r->b.hi[axis]; }
+static float ref_key(const Ref *r, int axis) { return r->lo[axis] + r->hi[axis]; }
 
 /* Reorders r[0, n) so that r[k] has the k-th smallest key on `axis` and
  * nothing before it is larger (Hoare partition, median-of-three pivot;
@@ -164,42 +186,196 @@ static void select_nth(Ref *r, uint32_t n, uint32_t k, int axis)
 /* box_area of a vector box: the same products and sums in the same order. */
 static inline float box4_area(Box4 b) { return f4_half_area(f4_sub(b.hi, b.lo)); }
 
-/* The cheapest SAH split over the bins: its axis (-1 if none) and the
- * last bin on its left; costs in units of one triangle test times the
- * parent's area, so a zero-area node still compares splits consistently. */
+#if defined(__SSE2__)
+/* Half the areas of three boxes' extents d0, d1, d2 in lanes 0-2: each
+ * f4_half_area's products and sums in its order, lane by lane. */
+static inline __m128 half_area3(__m128 d0, __m128 d1, __m128 d2)
+{
+	__m128 t0 = _mm_unpacklo_ps(d0, d1), t1 = _mm_unpackhi_ps(d0, d1);
+	__m128 x = _mm_movelh_ps(t0, d2), y = _mm_shuffle_ps(t0, d2, _MM_SHUFFLE(3, 1, 3, 2));
+	__m128 z = _mm_shuffle_ps(t1, d2, _MM_SHUFFLE(3, 2, 1, 0));
+	__m128 zero = _mm_setzero_ps();
+	__m128 neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(x, zero), _mm_cmplt_ps(y, zero)), _mm_cmplt_ps(z, zero));
+	__m128 a = _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, y), _mm_mul_ps(y, z)), _mm_mul_ps(z, x));
+	return _mm_andnot_ps(neg, a);
+}
+
+/* Bin k's three boxes (count lanes cleared) grown into acc, its three
+ * counts (lanes 0-2) returned. */
+static inline __m128i grow3(Box4 acc[3], const Bins *bins, int k)
+{
+	__m128 keep = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
+	__m128 h0 = bins->box[0][k].hi, h1 = bins->box[1][k].hi, h2 = bins->box[2][k].hi;
+	acc[0].lo = _mm_min_ps(bins->box[0][k].lo, acc[0].lo);
+	acc[1].lo = _mm_min_ps(bins->box[1][k].lo, acc[1].lo);
+	acc[2].lo = _mm_min_ps(bins->box[2][k].lo, acc[2].lo);
+	acc[0].hi = _mm_max_ps(_mm_and_ps(h0, keep), acc[0].hi);
+	acc[1].hi = _mm_max_ps(_mm_and_ps(h1, keep), acc[1].hi);
+	acc[2].hi = _mm_max_ps(_mm_and_ps(h2, keep), acc[2].hi);
+	__m128 c = _mm_shuffle_ps(_mm_unpackhi_ps(h0, h1), h2, _MM_SHUFFLE(3, 3, 3, 2));
+	return _mm_castps_si128(c);
+}
+
+static inline __m128 area3(const Box4 acc[3])
+{
+	return half_area3(_mm_sub_ps(acc[0].hi, acc[0].lo), _mm_sub_ps(acc[1].hi, acc[1].lo),
+			  _mm_sub_ps(acc[2].hi, acc[2].lo));
+}
+
+/* The cheapest SAH split over the bins (the scalar sah_sweep below, for
+ * builds without SSE2, says how), the three axes side by side (lane a:
+ * axis a):
+ * every lane's areas, counts and costs are the scalar sweep's operations
+ * on the same values, each lane keeps its first cheapest bin (strict <),
+ * and the axes are then compared in order with strict <, as the scalar
+ * scan over axis after axis compares them. Empty bins are swept too:
+ * they change nothing, and a split after one is never strictly cheaper. */
 static int sah_sweep(const Bins *bins, const SplitPlan *p, int *best_bin, float *best_cost)
 {
-	int best_axis = -1, nb = p->nb;
+	int nb = p->nb;
+	__m128 right_area[BVH_BINS];
+	__m128i right_count[BVH_BINS];
+	Box4 acc[3] = {box4_empty(), box4_empty(), box4_empty()};
+	__m128i cnt = _mm_setzero_si128(), zero = _mm_setzero_si128();
+	for (int k = nb - 1; k > 0; k--) {
+		cnt = _mm_add_epi32(cnt, grow3(acc, bins, k));
+		right_area[k] = area3(acc);
+		right_count[k] = cnt;
+	}
+	__m128i axes = _mm_setr_epi32(p->ext[0] > 0.0f ? -1 : 0, p->ext[1] > 0.0f ? -1 : 0,
+				      p->ext[2] > 0.0f ? -1 : 0, 0);
+	__m128 best = _mm_set1_ps(FLT_MAX);
+	__m128i best_k = zero;
+	acc[0] = acc[1] = acc[2] = box4_empty();
+	cnt = zero;
+	for (int k = 0; k < nb - 1; k++) {
+		cnt = _mm_add_epi32(cnt, grow3(acc, bins, k));
+		__m128 cost = _mm_add_ps(_mm_mul_ps(area3(acc), _mm_cvtepi32_ps(cnt)),
+					 _mm_mul_ps(right_area[k + 1], _mm_cvtepi32_ps(right_count[k + 1])));
+		__m128i valid = _mm_and_si128(axes, _mm_and_si128(_mm_cmpgt_epi32(cnt, zero),
+								   _mm_cmpgt_epi32(right_count[k + 1], zero)));
+		__m128 better = _mm_and_ps(_mm_castsi128_ps(valid), _mm_cmplt_ps(cost, best));
+		best = _mm_or_ps(_mm_and_ps(better, cost), _mm_andnot_ps(better, best));
+		__m128i bi = _mm_castps_si128(better);
+		best_k = _mm_or_si128(_mm_and_si128(bi, _mm_set1_epi32(k)), _mm_andnot_si128(bi, best_k));
+	}
+	float bc[4];
+	int bk[4];
+	_mm_storeu_ps(bc, best);
+	_mm_storeu_si128((__m128i *)bk, best_k);
+	int best_axis = -1;
 	*best_cost = FLT_MAX;
 	*best_bin = 0;
+	for (int a = 0; a < 3; a++)
+		if (bc[a] < *best_cost) {
+			*best_cost = bc[a];
+			*best_bin = bk[a];
+			best_axis = a;
+		}
+	return best_axis;
+}
+#else
+/* The cheapest SAH split over the bins: its axis (-1 if none) and the
+ * last bin on its left; costs in units of one triangle test times the
+ * parent's area, so a zero-area node still compares splits consistently.
+ * Only non-empty bins are swept: an empty bin changes neither side, so a
+ * split after it costs the bits of the split before it, which the strict
+ * < below has already taken (or both have an empty side). */
+static int sah_sweep(const Bins *bins, const SplitPlan *p, int *best_bin, float *best_cost)
+{
+	int best_axis = -1, nb = p->nb, best = 0;
+	float best_c = FLT_MAX;
 	for (int a = 0; a < 3; a++) {
 		if (p->ext[a] <= 0.0f)
 			continue;
+		Box4 box[BVH_BINS];
+		uint32_t count[BVH_BINS];
+		int bin[BVH_BINS], m = 0;
+		for (int k = 0; k < nb; k++) { /* written always, kept if non-empty: no branch to mispredict */
+			uint32_t c = bins_count(bins, a, k);
+			box[m].lo = bins->box[a][k].lo;
+			box[m].hi = f4_set_lane3_bits(bins->box[a][k].hi, 0); /* no count in the area's arithmetic */
+			count[m] = c;
+			bin[m] = k;
+			m += c != 0;
+		}
 		float right_area[BVH_BINS];
 		uint32_t right_count[BVH_BINS];
 		Box4 acc = box4_empty();
 		uint32_t cnt = 0;
-		for (int k = nb - 1; k > 0; k--) {
-			acc = box4_grow(acc, bins->box[a][k]);
-			cnt += bins->count[a][k];
-			right_area[k] = box4_area(acc);
-			right_count[k] = cnt;
+		for (int i = m - 1; i > 0; i--) {
+			acc = box4_grow(acc, box[i]);
+			cnt += count[i];
+			right_area[i] = box4_area(acc);
+			right_count[i] = cnt;
 		}
 		acc = box4_empty();
 		cnt = 0;
-		for (int k = 0; k < nb - 1; k++) {
-			acc = box4_grow(acc, bins->box[a][k]);
-			cnt += bins->count[a][k];
-			if (cnt == 0 || right_count[k + 1] == 0)
-				continue;
-			float cost = box4_area(acc) * (float)cnt + right_area[k + 1] * (float)right_count[k + 1];
-			if (cost < *best_cost) {
-				*best_cost = cost;
+		for (int i = 0; i < m - 1; i++) {
+			acc = box4_grow(acc, box[i]);
+			cnt += count[i];
+			float cost = box4_area(acc) * (float)cnt + right_area[i + 1] * (float)right_count[i + 1];
+			if (cost < best_c) {
+				best_c = cost;
 				best_axis = a;
-				*best_bin = k;
+				best = bin[i];
 			}
 		}
 	}
+	*best_bin = best;
+	*best_cost = best_c;
+	return best_axis;
+}
+#endif
+
+/* sah_sweep for a node of at most BVH_FEW refs, without bins: over half
+ * of all nodes, where filling and sweeping bins cost more than the split.
+ * Each candidate's sides are grown from the refs themselves: min and max
+ * of the same values as the bins' (only the sign of a zero may differ,
+ * which no area or comparison sees), counted and costed with the same
+ * operations, candidates in the same order (a bin no ref falls in offers
+ * none, as in sah_sweep). */
+static int sweep_few(const Ref *refs, uint32_t n, const SplitPlan *p, int *best_bin, float *best_cost)
+{
+	F4 cmin = f4_set(p->cmin[0], p->cmin[1], p->cmin[2]), scale = f4_set(p->scale[0], p->scale[1], p->scale[2]);
+	F4 top = f4_splat((float)(p->nb - 1));
+	Box4 r[BVH_FEW];
+	int k[BVH_FEW][3];
+	for (uint32_t i = 0; i < n; i++) { /* bin_ref's bins */
+		r[i] = box4_of_ref(&refs[i]);
+		F4 f = f4_mul(f4_sub(f4_add(r[i].lo, r[i].hi), cmin), scale);
+		f4_trunc3(f4_min(f4_max(f, f4_zero()), top), &k[i][0], &k[i][1], &k[i][2]);
+	}
+	int best_axis = -1, best = 0;
+	float best_c = FLT_MAX;
+	for (int a = 0; a < 3; a++) {
+		if (p->ext[a] <= 0.0f)
+			continue;
+		for (int t = 0; t < p->nb - 1; t++) {
+			Box4 left = box4_empty(), right = box4_empty();
+			uint32_t nl = 0;
+			int used = 0;
+			for (uint32_t i = 0; i < n; i++) {
+				if (k[i][a] <= t) {
+					left = box4_grow(left, r[i]);
+					nl++;
+					used |= k[i][a] == t;
+				} else {
+					right = box4_grow(right, r[i]);
+				}
+			}
+			if (!used || nl == n)
+				continue;
+			float cost = box4_area(left) * (float)nl + box4_area(right) * (float)(n - nl);
+			if (cost < best_c) {
+				best_c = cost;
+				best_axis = a;
+				best = t;
+			}
+		}
+	}
+	*best_bin = best;
+	*best_cost = best_c;
 	return best_axis;
 }
 
@@ -216,33 +392,97 @@ static int may_be_leaf(const Ref *refs, uint32_t n, const SplitPlan *p)
 	return 1;
 }
 
-uint32_t bvh_split_apply(Ref *refs, uint32_t n, const Box *box, const SplitPlan *p, const Bins *bins)
+/* The SAH partition: refs whose bin on `axis` is at most best_bin first.
+ * A ref found on the right is swapped with the last unexamined one, which
+ * is examined next: the order every tree was built with. */
+static uint32_t partition(Ref *refs, uint32_t n, const SplitPlan *p, int axis, int best_bin)
+{
+	float cmin = p->cmin[axis], scale = p->scale[axis];
+	uint32_t i = 0, j = n;
+	while (i < j) {
+		if (bin_of(ref_key(&refs[i], axis), cmin, scale, p->nb) <= best_bin) {
+			i++;
+		} else {
+			Ref t = refs[i];
+			refs[i] = refs[--j];
+			refs[j] = t;
+		}
+	}
+	return i;
+}
+
+/* partition, filling the two sides' bounds on the way (one pass less per
+ * level). A bin is at most best_bin exactly where (key - cmin) * scale is
+ * not >= best_bin + 1 (negative and NaN keys bin to 0). The left side's
+ * refs are met in their final order, so its bounds grow as bvh_bounds
+ * grows them; the right side's in the reverse of theirs, so a tie goes to
+ * the later ref (f4_min_late), which is the earlier in the final order:
+ * the same bits, given no NaN (p->nan_free). */
+static uint32_t partition_bounds(Ref *refs, uint32_t n, const SplitPlan *p, int axis, int best_bin,
+				 NodeBounds child[2])
+{
+	F4 cmin = f4_set(p->cmin[0], p->cmin[1], p->cmin[2]), scale = f4_set(p->scale[0], p->scale[1], p->scale[2]);
+	F4 edge = f4_splat((float)(best_bin + 1));
+	Box4 lbox = box4_empty(), lc = box4_empty(), rbox = box4_empty(), rc = box4_empty();
+	uint32_t i = 0, j = n;
+	while (i < j) {
+		Box4 r = box4_of_ref(&refs[i]);
+		F4 key = f4_add(r.lo, r.hi);
+		if (!f4_lane_ge(f4_mul(f4_sub(key, cmin), scale), edge, axis)) {
+			lbox = box4_grow(lbox, r);
+			lc.lo = f4_min(key, lc.lo);
+			lc.hi = f4_max(key, lc.hi);
+			i++;
+		} else {
+			rbox.lo = f4_min_late(rbox.lo, r.lo);
+			rbox.hi = f4_max_late(rbox.hi, r.hi);
+			rc.lo = f4_min_late(rc.lo, key);
+			rc.hi = f4_max_late(rc.hi, key);
+			Ref t = refs[i];
+			refs[i] = refs[--j];
+			refs[j] = t;
+		}
+	}
+	child[0] = (NodeBounds){lbox, lc};
+	child[1] = (NodeBounds){rbox, rc};
+	return i;
+}
+
+/* Both sides' bounds after a split that did not fill them. */
+static void sides_bounds(const Ref *refs, uint32_t n, uint32_t nleft, NodeBounds child[2])
+{
+	child[0] = child[1] = (NodeBounds){box4_empty(), box4_empty()};
+	bvh_bounds(refs, 0, nleft, &child[0]);
+	bvh_bounds(refs, nleft, n, &child[1]);
+}
+
+uint32_t bvh_split_apply(Ref *refs, uint32_t n, const Box *box, const SplitPlan *p, const Bins *bins,
+			 NodeBounds child[2])
 {
 	if (n <= 1)
 		return 0;
 	int leaf_ok = may_be_leaf(refs, n, p);
-	if (p->ext[p->axis] <= 0.0f) /* all centroids equal: any halving will do */
-		return leaf_ok ? 0 : n / 2;
+	if (p->ext[p->axis] <= 0.0f) { /* all centroids equal: any halving will do */
+		if (leaf_ok)
+			return 0;
+		sides_bounds(refs, n, n / 2, child);
+		return n / 2;
+	}
 	if (p->nb) {
 		int best_bin;
 		float best_cost;
-		int best_axis = sah_sweep(bins, p, &best_bin, &best_cost);
+		int best_axis = n <= BVH_FEW ? sweep_few(refs, n, p, &best_bin, &best_cost)
+					     : sah_sweep(bins, p, &best_bin, &best_cost);
 		if (best_axis >= 0) {
 			float area = box_area(box);
 			if (leaf_ok && (float)n * area <= BVH_COST_TRAVERSE * area + best_cost)
 				return 0;
-			float cmin = p->cmin[best_axis], scale = p->scale[best_axis];
-			uint32_t i = 0, j = n;
-			while (i < j) {
-				if (bin_of(ref_key(&refs[i], best_axis), cmin, scale, p->nb) <= best_bin) {
-					i++;
-				} else {
-					Ref t = refs[i];
-					refs[i] = refs[--j];
-					refs[j] = t;
-				}
-			}
-			return i; /* both sides non-empty by construction of the bins */
+			/* Both sides non-empty by construction of the bins. */
+			if (p->nan_free)
+				return partition_bounds(refs, n, p, best_axis, best_bin, child);
+			uint32_t nleft = partition(refs, n, p, best_axis, best_bin);
+			sides_bounds(refs, n, nleft, child);
+			return nleft;
 		}
 		/* Every centroid fell into one bin (float rounding on a tiny
 		 * extent): fall through to the median. */
@@ -250,5 +490,6 @@ uint32_t bvh_split_apply(Ref *refs, uint32_t n, const Box *box, const SplitPlan 
 	if (leaf_ok)
 		return 0;
 	select_nth(refs, n, n / 2, p->axis);
+	sides_bounds(refs, n, n / 2, child);
 	return n / 2;
 }

@@ -5,10 +5,11 @@
  * made. Renderers of the unchanged scene reuse the share and its BVH.
  *
  * Peak memory of a build over n triangles of 112 bytes (Tri and
- * TriShade): the triangles, 28 n of references, 4 n of order and the
- * binary tree (some 26 n) while binning; then the references are freed,
- * the triangles reordered, the order freed, and the binary tree and the
- * wide nodes (about 44 n) held during the collapse: about 182 n. */
+ * TriShade): the triangles, 32 n of references, 4 n of order and the
+ * binary tree (some 26 n) while binning; then the triangles are reordered
+ * through the references' memory (bvh_permute), the references and the
+ * order freed, and the binary tree and the wide nodes (about 44 n) held
+ * during the collapse: about 182 n. */
 #include "prepare/scene_bvh.h"
 
 #include <pthread.h>
@@ -31,12 +32,12 @@ static double seconds(void)
 	return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
-/* new[i] = old[order[i]] for the three arrays at once, cycle by cycle;
+/* new[i] = old[order[i]] for the three arrays at once, cycle by cycle,
+ * over the whole arrays (scene_bvh_two_level, where the order is its own);
  * the top bit of order marks the entries done (indices are below 2^29). */
 #define DONE 0x80000000u
-static void reorder_in_place(uint32_t *order, uint32_t n, void *ctx)
+static void reorder_all(SceneShare *sh, uint32_t *order, uint32_t n)
 {
-	SceneShare *sh = ctx;
 	Tri *tris = sh->tris;
 	TriShade *shade = sh->shade;
 	TriExtra *extra = sh->extra;
@@ -68,8 +69,15 @@ static void reorder_in_place(uint32_t *order, uint32_t n, void *ctx)
 	}
 }
 
-/* new[i] = old[order[i]] over the whole arrays (scene_bvh_two_level). */
-static void reorder_all(SceneShare *sh, uint32_t *order, uint32_t n) { reorder_in_place(order, n, sh); }
+/* The one-level build's leaf order, on its threads (bvh_permute). */
+static void reorder_leaves(BvhPermute *p, void *ctx)
+{
+	SceneShare *sh = ctx;
+	bvh_permute(p, sh->tris, sizeof *sh->tris);
+	bvh_permute(p, sh->shade, sizeof *sh->shade);
+	if (sh->extra)
+		bvh_permute(p, sh->extra, sizeof *sh->extra);
+}
 
 /* With instanced meshes (scene.h, SceneMesh): a top-level tree over the
  * flat triangles and the instances' world boxes, then one tree per mesh
@@ -167,7 +175,7 @@ ajar_status scene_bvh(Scene *s, SceneShare **out)
 			st = scene_bvh_two_level(s, sh);
 		} else {
 			Bvh bvh;
-			st = bvh_build_reorder(sh->tris, (uint32_t)sh->ntris, bvh_threads(), reorder_in_place, sh, &bvh);
+			st = bvh_build_reorder(sh->tris, (uint32_t)sh->ntris, bvh_threads(), reorder_leaves, sh, &bvh);
 			if (st == AJAR_OK) {
 				sh->nodes = bvh.nodes;
 				sh->nnodes = bvh.nnodes;
