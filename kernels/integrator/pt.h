@@ -25,7 +25,6 @@
 #include "sample/roulette.h"
 #include "geom/surface.h"
 #include "geom/visibility.h"
-#include "integrator/pane_choice.h"
 #include "integrator/pane_mirror.h"
 
 #define PT_CROSS_EDGES 33
@@ -77,7 +76,7 @@ INLINE V3 pt_radiance(const SceneView *sc, V3 o, V3 d, Rng *rng)
 			if ((sc->tris[s.tri].flags & TRI_PANE) && panes < PT_PANES_MAX) {
 				Bsdf pb;
 				surface_bsdf(sc, &s, surface_base_color(sc, &s), &pb);
-				float pn = pane_null_choice(sc, bsdf_null_prob(&pb, v3_neg(d)), s.p, d, s.ng);
+				float pn = bsdf_null_prob(&pb, v3_neg(d));
 				if (pn > 0.0f && rng_f(rng) < pn) {
 					beta = v3_mul(beta, v3_scale(bsdf_null_weight(&pb, d), 1.0f / pn));
 					V3 q = ray_offset(s.p, s.ng, d);

@@ -18,7 +18,6 @@
 #include "geom/portal_crossing.h"
 #include "geom/surface.h"
 #include "geom/visibility.h"
-#include "integrator/pane_choice.h"
 
 /* Panes one walk segment may cross before it counts as lost (a guard
  * against a ray caught between coincident panes). */
@@ -247,8 +246,6 @@ CALLED int vertex_trace(const SceneView *sc, VRef path, int n, V3 o, V3 d, V3 be
 #ifndef AJAR_NO_PANES
 		if (sc->tris[s.tri].flags & TRI_PANE) {
 			float pn = bsdf_null_prob(&v->bs, v->wo);
-			if (!light_side)
-				pn = pane_null_choice(sc, pn, s.p, d, s.ng);
 			if (pn > 0.0f && rng_f(rng) < pn) {
 				if (panes >= VERTEX_PANES_MAX)
 					return 0;
