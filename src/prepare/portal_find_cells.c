@@ -25,7 +25,28 @@ typedef struct {
 	const float *u1, *u2;
 	uint32_t k;
 	V3 o, a1, a2, n;
+	const Rects *done; /* the portals accepted before: what is seen through them is found */
 } CellPlane;
+
+/* Whether the segment from P along d (length l) passes through a portal
+ * accepted before. */
+static int through_done(const CellPlane *cp, V3 P, V3 d, float l)
+{
+	for (uint32_t i = 0; cp->done && i < cp->done->n; i++) {
+		const Rect *r = &cp->done->r[i];
+		float dn = v3_dot(r->n, d);
+		if (!r->accepted || !(fabs(dn) > 1e-6f))
+			continue;
+		float t = v3_dot(r->n, v3_sub(r->o, P)) / dn;
+		if (!(t > 0.0f && t < l))
+			continue;
+		V3 y = v3_sub(v3_madd(P, d, t), r->o);
+		float p1 = v3_dot(y, r->a1), p2 = v3_dot(y, r->a2);
+		if (p1 >= r->lo1 && p1 <= r->hi1 && p2 >= r->lo2 && p2 <= r->hi2)
+			return 1;
+	}
+	return 0;
+}
 
 /* Whether surface point p (normal n, facing where the ray came from) is
  * under the open sky: at least SKY_SEEN of SKY_RAYS cosine rays escape. */
@@ -73,7 +94,9 @@ static int point_open(Ctx *c, const CellPlane *cp, float p1, float p2, uint32_t 
 		float l = v3_len(d);
 		d = v3_scale(d, 1.0f / l);
 		V3 start = v3_madd(X, d, -back);
-		if (!pf_clear(c, P, start))
+		/* Seen through a portal found before: no new opening there (the
+		 * room behind a door's gap, seen through it). */
+		if (through_done(cp, P, d, l - back) || !pf_clear(c, P, start))
 			continue;
 		Solid sol;
 		pf_trace(c, start, d, AJAR_INF, &sol);
@@ -236,7 +259,7 @@ ajar_status pf_open_rects(Ctx *c, const Crossing *xs, const uint32_t *idx, uint3
 	float e1 = h1 - l1, e2 = h2 - l2;
 	l1 -= 0.25f * e1 + 0.02f * R, h1 += 0.25f * e1 + 0.02f * R;
 	l2 -= 0.25f * e2 + 0.02f * R, h2 += 0.25f * e2 + 0.02f * R;
-	CellPlane cp = {.xs = xs, .yl = yl, .u1 = u1, .u2 = u2, .k = k, .o = o, .a1 = a1, .a2 = a2, .n = n};
+	CellPlane cp = {.xs = xs, .yl = yl, .u1 = u1, .u2 = u2, .k = k, .o = o, .a1 = a1, .a2 = a2, .n = n, .done = rs};
 	float c1 = 0.0f, c2 = 0.0f;
 	int touch = 0;
 	for (int pass = 0; pass < 2; pass++) {
