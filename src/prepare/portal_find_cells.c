@@ -437,3 +437,32 @@ int pf_rect_catches(const Rect *r, const Crossing *x, float R)
 	float p1 = v3_dot(y, r->a1), p2 = v3_dot(y, r->a2);
 	return p1 >= r->lo1 && p1 <= r->hi1 && p2 >= r->lo2 && p2 <= r->hi2;
 }
+
+/* Whether line x passes within m of rectangle r: through it, or along it
+ * (a gap's lines that graze the plane its portal lies in, past the
+ * portal's end, went through it too): the part of the line inside the
+ * slab |n . (y - o)| <= m, clipped to the rectangle, is not empty. */
+int pf_rect_near(const Rect *r, const Crossing *x, float m, float R)
+{
+	float h = v3_dot(r->n, v3_sub(x->P, r->o)), dn = v3_dot(r->n, x->d);
+	float t0 = 0.0f, t1 = x->t == AJAR_INF ? 8.0f * R : x->t;
+	if (fabs(dn) > 1e-9f) {
+		float ta = (-m - h) / dn, tb = (m - h) / dn;
+		t0 = fmax(t0, fmin(ta, tb)), t1 = fmin(t1, fmax(ta, tb));
+	} else if (fabs(h) > m) {
+		return 0;
+	}
+	V3 y = v3_sub(x->P, r->o);
+	float p[2] = {v3_dot(y, r->a1), v3_dot(y, r->a2)}, q[2] = {v3_dot(x->d, r->a1), v3_dot(x->d, r->a2)};
+	float lo[2] = {r->lo1, r->lo2}, hi[2] = {r->hi1, r->hi2};
+	for (int a = 0; a < 2 && t0 <= t1; a++) {
+		if (fabs(q[a]) < 1e-9f) {
+			if (p[a] < lo[a] || p[a] > hi[a])
+				return 0;
+			continue;
+		}
+		float ua = (lo[a] - p[a]) / q[a], ub = (hi[a] - p[a]) / q[a];
+		t0 = fmax(t0, fmin(ua, ub)), t1 = fmin(t1, fmax(ua, ub));
+	}
+	return t0 <= t1;
+}

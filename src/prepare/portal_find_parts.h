@@ -32,6 +32,9 @@
 #define FOCUS_TARGET 96    /* crossings a place (and direction) should have */
 #define FOCUS_NEAR 0.05f   /* x R: a place's radius */
 #define FOCUS_MAX 32768    /* aimed rays a round at most */
+#define BESIDE_PAIRS 131072 /* step 7: room points joined to light points */
+#define BESIDE_SLAB 0.003f /* x R: a line this near a portal went through it */
+#define BESIDE_TIE 0.7     /* planes scoring this near the best: the nearest the room wins */
 #define LIGHT_POINTS 64    /* light samples of emitters and lamps */
 #define BOUNCE_POINTS 64   /* and of what they light */
 #define RING_DIRS 8        /* step 3 */
@@ -78,6 +81,7 @@ typedef struct {
 	uint64_t rays;
 	LightPoint *lp;
 	uint32_t nlp;
+	uint32_t ndirect; /* lp[0..ndirect): on the lamps and emitters; after them, what they light */
 	int sky;       /* a sky or a sun: what escapes finds light */
 } Ctx;
 
@@ -184,9 +188,10 @@ int pf_meet(const Crossing *x, V3 n, float s, float R, float min_dn, float *t);
  * 0.5% of the hits. Each normal faces where the lines come from. */
 int pf_candidate_planes(const Crossings *xs, float R, V3 *cand, float *offs);
 /* Of the lines still open (alive), where they crowd most tightly on one
- * candidate plane: best[0] the best patch, best[1] the best on another. */
+ * candidate plane (lines crossing it at a cosine of at least min_dn):
+ * best[0] the best patch, best[1] the best on another. */
 void pf_best_patch(Ctx *c, const Crossings *xs, const uint8_t *alive, const V3 *pn, const float *po, int np,
-		   V3 blo, V3 bhi, Raster *g, Patch best[2]);
+		   float min_dn, V3 blo, V3 bhi, Raster *g, Patch best[2]);
 
 /* Steps 5 to 7: open cells, rectangles (portal_find_cells.c). */
 /* Open cells of plane (n, s) over the footprint, their connected parts as
@@ -201,5 +206,11 @@ ajar_status pf_open_rects(Ctx *c, const Crossing *xs, const uint32_t *idx, uint3
 void pf_merge_rects(Rects *rs, uint32_t from, float R);
 /* Whether line x passes through rectangle r before its far hit. */
 int pf_rect_catches(const Rect *r, const Crossing *x, float R);
+/* Whether line x passes within m of rectangle r (through it or along it). */
+int pf_rect_near(const Rect *r, const Crossing *x, float m, float R);
+
+/* Step 7 (portal_find_crossings.c): lines through openings beside the
+ * accepted rectangles of rs, added to xs with weight 0. */
+ajar_status pf_beside(Ctx *c, const RoomPts *r, Crossings *xs, const Rects *rs);
 
 #endif
