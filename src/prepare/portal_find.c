@@ -35,7 +35,9 @@
  *  6. Portals. Rectangles with light behind them close the lines they catch;
  *     again until under MIN_SHARE of the lines remain. Rectangles of nearly
  *     one plane merge where one covers them with little more area (a row of
- *     panes). Portals face the side their lines come from.
+ *     panes). Portals face the side their lines come from. A gap's
+ *     rectangle (much longer than wide) is turned onto the gap's narrowest
+ *     section, between the solids on either side of it.
  *  7. Openings beside the portals. Where lamps or emitters light the scene,
  *     lines from the room's points to their light points that pass no
  *     portal found (nor along one) went through an opening the room's rays
@@ -175,6 +177,8 @@ static uint32_t accept(Search *s, uint32_t from)
 		rc->share = s->nfirst ? (float)first / (float)s->nfirst : 0.0f;
 		rc->accepted = (float)gain >= MIN_SHARE * (float)n;
 		s->accepted += rc->accepted;
+		if (rc->accepted)
+			pf_refit_gap(c, s->xs.x, n, rc);
 	}
 	uint32_t left = 0;
 	for (uint32_t k = 0; k < n; k++)

@@ -466,3 +466,76 @@ int pf_rect_near(const Rect *r, const Crossing *x, float m, float R)
 	}
 	return t0 <= t1;
 }
+
+/* The lines of xs[0..n) that rectangle r catches. */
+static uint32_t catches(const Rect *r, const Crossing *xs, uint32_t n, const uint8_t *pick, float R)
+{
+	uint32_t k = 0;
+	for (uint32_t i = 0; i < n; i++)
+		k += pick[i] && pf_rect_catches(r, &xs[i], R);
+	return k;
+}
+
+void pf_refit_gap(Ctx *c, const Crossing *xs, uint32_t n, Rect *r)
+{
+	float w1 = r->hi1 - r->lo1, w2 = r->hi2 - r->lo2;
+	if (!(fmin(w1, w2) < GAP_ASPECT * fmax(w1, w2)))
+		return;
+	V3 L = w1 >= w2 ? r->a1 : r->a2, S = w1 >= w2 ? r->a2 : r->a1;
+	float half = 0.5f * fmax(w1, w2);
+	V3 C = v3_add(r->o, v3_add(v3_scale(r->a1, 0.5f * (r->lo1 + r->hi1)), v3_scale(r->a2, 0.5f * (r->lo2 + r->hi2))));
+	/* The solid around the gap in its cross-section through C: hits of
+	 * rays in that plane. */
+	V3 hp[GAP_DIRS];
+	int nh = 0;
+	for (int i = 0; i < GAP_DIRS; i++) {
+		float ph = 2.0f * AJAR_PI * ((float)i + 0.5f) / GAP_DIRS;
+		V3 d = v3_add(v3_scale(S, cos(ph)), v3_scale(r->n, sin(ph)));
+		Solid h;
+		if (pf_trace(c, C, d, GAP_REACH * c->R, &h))
+			hp[nh++] = h.p;
+	}
+	/* Its narrowest section: the shortest segment between two hits that
+	 * passes by C, C between its ends (a door's jamb corner to its leaf's
+	 * free edge; not two points of one wall). */
+	float best = AJAR_INF;
+	V3 A = C, B = C;
+	for (int i = 0; i < nh; i++)
+		for (int j = i + 1; j < nh; j++) {
+			V3 ab = v3_sub(hp[j], hp[i]);
+			float l = v3_len2(ab);
+			if (!(l > 0.0f) || l >= best)
+				continue;
+			float u = v3_dot(v3_sub(C, hp[i]), ab) / l;
+			V3 off = v3_sub(v3_sub(C, hp[i]), v3_scale(ab, u));
+			if (u > 0.1f && u < 0.9f && v3_len2(off) < 0.25f * l)
+				best = l, A = hp[i], B = hp[j];
+		}
+	if (best == AJAR_INF)
+		return;
+	V3 AB = v3_sub(B, A), nt = v3_norm(v3_cross(L, AB));
+	if (!(v3_len2(nt) > 0.5f))
+		return;
+	if (v3_dot(nt, r->n) < 0.0f)
+		nt = v3_neg(nt);
+	/* The section's rectangle, its long sides as before; kept if it
+	 * catches more of the lines that pass near the gap (grazing lines
+	 * cross a jamb's plane past the rectangle's end, not the gap). */
+	float wd = sqrtf(best), m = EDGE_MARGIN / GRID * wd;
+	Rect t = *r;
+	t.n = nt, t.a1 = L, t.a2 = v3_cross(nt, L);
+	t.o = v3_madd(v3_scale(v3_add(A, B), 0.5f), L, v3_dot(L, v3_sub(C, A)));
+	t.o = v3_madd(t.o, nt, -PLANE_OFFSET * c->R); /* beyond the edges' points, as step 5's planes */
+	t.lo1 = -half, t.hi1 = half;
+	t.lo2 = -0.5f * wd - m, t.hi2 = 0.5f * wd + m;
+	uint8_t *near = malloc(n ? n : 1);
+	if (!near)
+		return;
+	for (uint32_t i = 0; i < n; i++)
+		near[i] = (uint8_t)pf_rect_near(r, &xs[i], GAP_SLAB * c->R, c->R);
+	uint32_t before = catches(r, xs, n, near, c->R), after = catches(&t, xs, n, near, c->R);
+	PF_DEBUG("gap section: width %.4f, normal (%.3f %.3f %.3f), catches %u -> %u lines\n", wd, nt.x, nt.y, nt.z, before, after);
+	if (after > before)
+		*r = t;
+	free(near);
+}

@@ -33,7 +33,7 @@
 #define FOCUS_NEAR 0.05f   /* x R: a place's radius */
 #define FOCUS_MAX 32768    /* aimed rays a round at most */
 #define BESIDE_PAIRS 131072 /* step 7: room points joined to light points */
-#define BESIDE_SLAB 0.003f /* x R: a line this near a portal went through it */
+#define BESIDE_SLAB GAP_SLAB /* a line this near a portal went through it */
 #define BESIDE_TIE 0.7     /* planes scoring this near the best: the nearest the room wins */
 #define LIGHT_POINTS 64    /* light samples of emitters and lamps */
 #define BOUNCE_POINTS 64   /* and of what they light */
@@ -66,6 +66,10 @@
 #define RIM_GAP 0.03f      /* x its size: its rim lies this far outside it */
 #define SLIDE_SOLID 0.1f   /* x R */
 #define CONNECT 2          /* open cells this many cells apart join */
+#define GAP_ASPECT 0.125f  /* a rectangle this narrow is a gap: its section refitted */
+#define GAP_SLAB 0.003f    /* x R: its lines pass this near it */
+#define GAP_DIRS 360       /* rays around its centre, across it */
+#define GAP_REACH 0.05f    /* x R: as far */
 #define MERGE_AREA 1.25    /* step 6 */
 #define MERGE_GAP 0.03f    /* x R: rectangles of planes this close may merge */
 #define MIN_SHARE 0.02f    /* lines a portal must catch */
@@ -208,6 +212,12 @@ void pf_merge_rects(Rects *rs, uint32_t from, float R);
 int pf_rect_catches(const Rect *r, const Crossing *x, float R);
 /* Whether line x passes within m of rectangle r (through it or along it). */
 int pf_rect_near(const Rect *r, const Crossing *x, float m, float R);
+/* A gap's rectangle (GAP_ASPECT: much longer than wide) turned about its
+ * long axis onto the gap's narrowest section, the shortest segment
+ * between the solids on either side of it (a door's jamb corner to its
+ * leaf's free edge), where it catches more of the lines of xs[0..n) that
+ * pass near it. */
+void pf_refit_gap(Ctx *c, const Crossing *xs, uint32_t n, Rect *r);
 
 /* Step 7 (portal_find_crossings.c): lines through openings beside the
  * accepted rectangles of rs, added to xs with weight 0. */
