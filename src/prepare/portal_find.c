@@ -375,6 +375,9 @@ ajar_status portal_find(const SceneView *v, uint32_t ntris, const PortalFindInpu
 				st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "portal search: out of memory");
 				goto done;
 			}
+			/* The rounds before settled the other lines: too few
+			 * were left for a portal, and stay so. */
+			memset(s.alive, 0, had);
 			if ((st = beside_rounds(&s)) != AJAR_OK)
 				goto done;
 		}
