@@ -476,66 +476,116 @@ static uint32_t catches(const Rect *r, const Crossing *xs, uint32_t n, const uin
 	return k;
 }
 
+/* A segment between two solid points of a gap's cross-section, by length. */
+typedef struct {
+	float l2;
+	uint16_t i, j;
+} Span;
+
+static int cmp_span(const void *a, const void *b)
+{
+	const Span *x = a, *y = b;
+	if (x->l2 != y->l2)
+		return x->l2 < y->l2 ? -1 : 1;
+	return x->i != y->i ? (x->i < y->i ? -1 : 1) : (x->j > y->j) - (x->j < y->j);
+}
+
+/* Whether line x, seen along L (both projected on the plane normal to
+ * L), crosses segment a b before its far hit. */
+static int crosses(const Crossing *x, V3 L, V3 a, V3 b)
+{
+	V3 p = v3_madd(x->P, L, -v3_dot(L, x->P)), d = v3_madd(x->d, L, -v3_dot(L, x->d));
+	V3 e = v3_sub(b, a), q = v3_sub(a, p);
+	V3 den = v3_cross(d, e);
+	float dd = v3_dot(den, L);
+	if (!(fabs(dd) > 1e-12f))
+		return 0;
+	float t = v3_dot(v3_cross(q, e), L) / dd, s = v3_dot(v3_cross(q, d), L) / dd;
+	return t > 0.0f && t < x->t && s >= 0.0f && s <= 1.0f;
+}
+
 void pf_refit_gap(Ctx *c, const Crossing *xs, uint32_t n, Rect *r)
 {
 	float w1 = r->hi1 - r->lo1, w2 = r->hi2 - r->lo2;
 	if (!(fmin(w1, w2) < GAP_ASPECT * fmax(w1, w2)))
 		return;
 	V3 L = w1 >= w2 ? r->a1 : r->a2, S = w1 >= w2 ? r->a2 : r->a1;
-	float half = 0.5f * fmax(w1, w2);
-	V3 C = v3_add(r->o, v3_add(v3_scale(r->a1, 0.5f * (r->lo1 + r->hi1)), v3_scale(r->a2, 0.5f * (r->lo2 + r->hi2))));
-	/* The solid around the gap in its cross-section through C: hits of
-	 * rays in that plane. */
+	float half = 0.5f * fmax(w1, w2), lo = w1 >= w2 ? r->lo2 : r->lo1, hi = w1 >= w2 ? r->hi2 : r->hi1;
+	float mid = 0.5f * (w1 >= w2 ? r->lo1 + r->hi1 : r->lo2 + r->hi2);
+	V3 C = v3_madd(r->o, L, mid); /* on the long axis's middle, S-coordinate 0 */
+	/* The lines through the gap: those passing near the rectangle. */
+	uint8_t *near = malloc(n ? n : 1);
+	uint32_t *li = malloc(sizeof *li * (n ? n : 1)), m = 0;
+	Span *sp = malloc(sizeof *sp * GAP_DIRS * GAP_DIRS / 2);
+	if (!near || !li || !sp)
+		goto done;
+	for (uint32_t i = 0; i < n; i++)
+		if ((near[i] = (uint8_t)pf_rect_near(r, &xs[i], GAP_SLAB * c->R, c->R)))
+			li[m++] = i;
+	if (m < 8)
+		goto done;
+	/* The solid around the gap in its cross-section through the long
+	 * axis's middle: hits of rays in that plane from GAP_FROM points across
+	 * the rectangle. */
 	V3 hp[GAP_DIRS];
 	int nh = 0;
-	for (int i = 0; i < GAP_DIRS; i++) {
-		float ph = 2.0f * AJAR_PI * ((float)i + 0.5f) / GAP_DIRS;
-		V3 d = v3_add(v3_scale(S, cos(ph)), v3_scale(r->n, sin(ph)));
-		Solid h;
-		if (pf_trace(c, C, d, GAP_REACH * c->R, &h))
-			hp[nh++] = h.p;
+	float reach = GAP_REACH * c->R + 2.0f * (hi - lo);
+	for (int f = 0; f < GAP_FROM; f++) {
+		V3 X = v3_madd(C, S, lo + (hi - lo) * ((float)f + 0.5f) / GAP_FROM);
+		for (int i = 0; i < GAP_DIRS / GAP_FROM; i++) {
+			float ph = 2.0f * AJAR_PI * ((float)i + 0.5f) / (GAP_DIRS / GAP_FROM);
+			Solid h;
+			if (pf_trace(c, X, v3_add(v3_scale(S, cos(ph)), v3_scale(r->n, sin(ph))), reach, &h))
+				hp[nh++] = h.p;
+		}
 	}
-	/* Its narrowest section: the shortest segment between two hits that
-	 * passes by C, C between its ends (a door's jamb corner to its leaf's
-	 * free edge; not two points of one wall). */
-	float best = AJAR_INF;
-	V3 A = C, B = C;
+	/* Its narrowest section: the shortest segment between two of them
+	 * that the lines (GAP_CROSS of them) cross, seen along the long axis
+	 * (a door's jamb corner to its leaf's face by the free edge; a segment
+	 * on one wall is crossed by none). */
+	uint32_t ns = 0;
 	for (int i = 0; i < nh; i++)
 		for (int j = i + 1; j < nh; j++) {
-			V3 ab = v3_sub(hp[j], hp[i]);
-			float l = v3_len2(ab);
-			if (!(l > 0.0f) || l >= best)
-				continue;
-			float u = v3_dot(v3_sub(C, hp[i]), ab) / l;
-			V3 off = v3_sub(v3_sub(C, hp[i]), v3_scale(ab, u));
-			if (u > 0.1f && u < 0.9f && v3_len2(off) < 0.25f * l)
-				best = l, A = hp[i], B = hp[j];
+			V3 e = v3_sub(hp[j], hp[i]);
+			e = v3_madd(e, L, -v3_dot(L, e));
+			sp[ns++] = (Span){v3_len2(e), (uint16_t)i, (uint16_t)j};
 		}
-	if (best == AJAR_INF)
-		return;
-	V3 AB = v3_sub(B, A), nt = v3_norm(v3_cross(L, AB));
-	if (!(v3_len2(nt) > 0.5f))
-		return;
+	qsort(sp, ns, sizeof *sp, cmp_span);
+	uint32_t miss_most = m - (uint32_t)(GAP_CROSS * (float)m);
+	int found = -1;
+	for (uint32_t k = 0; k < ns && found < 0; k++) {
+		if (!(sp[k].l2 > 0.0f))
+			continue;
+		uint32_t miss = 0;
+		for (uint32_t q = 0; q < m && miss <= miss_most; q++)
+			miss += !crosses(&xs[li[q]], L, hp[sp[k].i], hp[sp[k].j]);
+		if (miss <= miss_most)
+			found = (int)k;
+	}
+	if (found < 0)
+		goto done;
+	V3 A = hp[sp[found].i], B = hp[sp[found].j];
+	V3 AB = v3_sub(B, A);
+	AB = v3_madd(AB, L, -v3_dot(L, AB));
+	V3 nt = v3_norm(v3_cross(L, AB));
 	if (v3_dot(nt, r->n) < 0.0f)
 		nt = v3_neg(nt);
-	/* The section's rectangle, its long sides as before; kept if it
-	 * catches more of the lines that pass near the gap (grazing lines
-	 * cross a jamb's plane past the rectangle's end, not the gap). */
-	float wd = sqrtf(best), m = EDGE_MARGIN / GRID * wd;
+	/* The section's rectangle, its long sides as before, a little beyond
+	 * the solid points as step 5's planes are; kept where it catches more
+	 * of the lines (grazing lines cross a jamb's plane past the
+	 * rectangle's end, not the gap). */
+	float wd = sqrtf(sp[found].l2), mg = EDGE_MARGIN / GRID * wd;
+	V3 M = v3_madd(v3_scale(v3_add(A, v3_madd(A, AB, 1.0f)), 0.5f), L, v3_dot(L, v3_sub(C, A)));
 	Rect t = *r;
 	t.n = nt, t.a1 = L, t.a2 = v3_cross(nt, L);
-	t.o = v3_madd(v3_scale(v3_add(A, B), 0.5f), L, v3_dot(L, v3_sub(C, A)));
-	t.o = v3_madd(t.o, nt, -PLANE_OFFSET * c->R); /* beyond the edges' points, as step 5's planes */
+	t.o = v3_madd(M, nt, -PLANE_OFFSET * c->R);
 	t.lo1 = -half, t.hi1 = half;
-	t.lo2 = -0.5f * wd - m, t.hi2 = 0.5f * wd + m;
-	uint8_t *near = malloc(n ? n : 1);
-	if (!near)
-		return;
-	for (uint32_t i = 0; i < n; i++)
-		near[i] = (uint8_t)pf_rect_near(r, &xs[i], GAP_SLAB * c->R, c->R);
+	t.lo2 = -0.5f * wd - mg, t.hi2 = 0.5f * wd + mg;
 	uint32_t before = catches(r, xs, n, near, c->R), after = catches(&t, xs, n, near, c->R);
-	PF_DEBUG("gap section: width %.4f, normal (%.3f %.3f %.3f), catches %u -> %u lines\n", wd, nt.x, nt.y, nt.z, before, after);
+	PF_DEBUG("gap section: %u lines, width %.4f, normal (%.3f %.3f %.3f), catches %u -> %u\n", m, wd, nt.x, nt.y, nt.z,
+		 before, after);
 	if (after > before)
 		*r = t;
-	free(near);
+done:
+	free(near), free(li), free(sp);
 }

@@ -66,10 +66,12 @@
 #define RIM_GAP 0.03f      /* x its size: its rim lies this far outside it */
 #define SLIDE_SOLID 0.1f   /* x R */
 #define CONNECT 2          /* open cells this many cells apart join */
-#define GAP_ASPECT 0.125f  /* a rectangle this narrow is a gap: its section refitted */
+#define GAP_ASPECT 0.25f   /* a rectangle this narrow is a gap: its section refitted */
 #define GAP_SLAB 0.003f    /* x R: its lines pass this near it */
-#define GAP_DIRS 360       /* rays around its centre, across it */
-#define GAP_REACH 0.05f    /* x R: as far */
+#define GAP_DIRS 360       /* rays across it, from GAP_FROM points */
+#define GAP_FROM 5
+#define GAP_REACH 0.05f    /* x R: as far, and twice its width */
+#define GAP_CROSS 0.9f     /* its section: crossed by this many of its lines */
 #define MERGE_AREA 1.25    /* step 6 */
 #define MERGE_GAP 0.03f    /* x R: rectangles of planes this close may merge */
 #define MIN_SHARE 0.02f    /* lines a portal must catch */
@@ -212,11 +214,11 @@ void pf_merge_rects(Rects *rs, uint32_t from, float R);
 int pf_rect_catches(const Rect *r, const Crossing *x, float R);
 /* Whether line x passes within m of rectangle r (through it or along it). */
 int pf_rect_near(const Rect *r, const Crossing *x, float m, float R);
-/* A gap's rectangle (GAP_ASPECT: much longer than wide) turned about its
- * long axis onto the gap's narrowest section, the shortest segment
- * between the solids on either side of it (a door's jamb corner to its
- * leaf's free edge), where it catches more of the lines of xs[0..n) that
- * pass near it. */
+/* A gap's rectangle (GAP_ASPECT: longer than wide) turned about its long
+ * axis onto the gap's narrowest section, the shortest segment between two
+ * solid points that most of the lines of xs[0..n) passing near it cross
+ * (a door's jamb corner to its leaf's face by the free edge), where it
+ * catches more of those lines. */
 void pf_refit_gap(Ctx *c, const Crossing *xs, uint32_t n, Rect *r);
 
 /* Step 7 (portal_find_crossings.c): lines through openings beside the
