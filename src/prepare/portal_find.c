@@ -36,8 +36,9 @@
  *     again until under MIN_SHARE of the lines remain. Rectangles of nearly
  *     one plane merge where one covers them with little more area (a row of
  *     panes). Portals face the side their lines come from. A gap's
- *     rectangle (much longer than wide) is turned onto the gap's narrowest
- *     section, between the solids on either side of it.
+ *     rectangle (4 times longer than wide) is turned onto the gap's
+ *     narrowest section: the shortest span between solid points that its
+ *     lines cross.
  *  7. Openings beside the portals. Where lamps or emitters light the scene,
  *     lines from the room's points to their light points that pass no
  *     portal found (nor along one) went through an opening the room's rays
