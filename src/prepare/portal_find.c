@@ -35,7 +35,17 @@
  *  6. Portals. Rectangles with light behind them close the lines they catch;
  *     again until under MIN_SHARE of the lines remain. Rectangles of nearly
  *     one plane merge where one covers them with little more area (a row of
- *     panes). Portals face the side their lines come from.
+ *     panes). Portals face the side their lines come from. A gap's
+ *     rectangle (4 times longer than wide) is turned onto the gap's
+ *     narrowest section: the shortest span between solid points that its
+ *     lines cross.
+ *  7. Openings beside the portals. Where lamps or emitters light the scene,
+ *     lines from the room's points to their light points that pass no
+ *     portal found (nor along one) went through an opening the room's rays
+ *     hardly met: the thin slit over a door leaf's top, which lets a far
+ *     emitter's light straight in. Their patches, on every plane their rings
+ *     met, are scored by what the room sees of their rectangles (area times
+ *     the lines' cosine); of near ties the plane the lines cross first wins.
  *
  * A scene without openings (a closed box, a room lit only by a lamp in it)
  * gets none: nothing escapes, and lit points inside fail the ring test.
@@ -90,67 +100,107 @@ static int cmp_share(const void *a, const void *b)
 	return x->c.z < y->c.z ? -1 : x->c.z > y->c.z;
 }
 
-ajar_status portal_find(const SceneView *v, uint32_t ntris, const PortalFindInput *in, PortalSearch *out)
-{
-	double t0 = now();
-	memset(out, 0, sizeof *out);
-	Ctx c = {.v = v};
-	RoomPts room = {0};
-	Crossings xs = {0};
-	Rects rs = {0};
-	Raster g = {0};
-	Patch best[2] = {{0.0, -1, NULL, 0}, {0.0, -1, NULL, 0}};
-	uint8_t *alive = NULL, *caught = NULL, *scratch = NULL;
+/* What the rounds of steps 4 to 6 share: the lines, which are still open
+ * (alive) and which a portal caught, the candidate planes, the rectangles. */
+typedef struct {
+	Ctx *c;
+	Crossings xs;
+	Rects rs;
+	Raster g;
+	Patch best[2];
+	uint8_t *alive, *caught, *scratch;
+	uint32_t cap;     /* lines the arrays hold */
+	uint32_t nfirst;  /* lines of the first sample */
+	uint32_t accepted;
 	V3 pn[MAX_PLANES];
 	float po[MAX_PLANES];
-	ajar_status st = pf_room_points(&c, in->camera, &room);
-	if (st == AJAR_OK && c.R > 0.0f)
-		st = pf_light_points(&c, ntris, in, &room);
-	if (st == AJAR_OK && c.R > 0.0f) {
-		pf_room_lights(&c, &room);
-		st = pf_find_crossings(&c, &room, &xs);
-	}
-	if (st != AJAR_OK || xs.n == 0)
-		goto done;
+	int np;
+	V3 blo, bhi;      /* the scene's bounds */
+} Search;
 
-	uint32_t n = xs.n, nfirst = 0;
+/* The per-line arrays sized for xs.n lines; lines added since are open. */
+static int lines_fit(Search *s, uint32_t had)
+{
+	uint32_t n = s->xs.n;
+	if (n > s->cap) {
+		uint32_t *i0 = realloc(s->best[0].idx, sizeof *i0 * n);
+		if (i0)
+			s->best[0].idx = i0;
+		uint32_t *i1 = realloc(s->best[1].idx, sizeof *i1 * n);
+		if (i1)
+			s->best[1].idx = i1;
+		uint8_t *a = realloc(s->alive, n);
+		if (a)
+			s->alive = a;
+		uint8_t *cg = realloc(s->caught, n);
+		if (cg)
+			s->caught = cg;
+		uint8_t *sc = realloc(s->scratch, n);
+		if (sc)
+			s->scratch = sc;
+		int *co = realloc(s->g.cellof, sizeof *co * n);
+		if (co)
+			s->g.cellof = co;
+		uint64_t *pa = realloc(s->g.pairs, sizeof *pa * n);
+		if (pa)
+			s->g.pairs = pa;
+		if (!i0 || !i1 || !a || !cg || !sc || !co || !pa)
+			return 0;
+		s->cap = n;
+	}
+	for (uint32_t k = had; k < n; k++)
+		s->alive[k] = 1, s->caught[k] = 0, s->scratch[k] = 0;
+	return 1;
+}
+
+/* Step 6 for the rectangles rs[from..): those with light behind them
+ * that catch MIN_SHARE of the lines become portals, and close the lines
+ * they catch. Returns the lines still open. */
+static uint32_t accept(Search *s, uint32_t from)
+{
+	Ctx *c = s->c;
+	uint32_t n = s->xs.n;
+	for (uint32_t r = from; r < s->rs.n; r++) {
+		Rect *rc = &s->rs.r[r];
+		if (!rc->alive || !light_behind(c, rc))
+			continue;
+		/* The lines it catches that no portal caught: their count
+		 * decides (aimed rays count: a small opening found is kept),
+		 * the first sample's share is its share. */
+		uint32_t gain = 0, first = 0;
+		for (uint32_t k = 0; k < n; k++)
+			if (!s->caught[k] && pf_rect_catches(rc, &s->xs.x[k], c->R)) {
+				s->caught[k] = 1;
+				s->alive[k] = 0;
+				gain++;
+				first += (uint32_t)s->xs.x[k].weight;
+			}
+		rc->share = s->nfirst ? (float)first / (float)s->nfirst : 0.0f;
+		rc->accepted = (float)gain >= MIN_SHARE * (float)n;
+		s->accepted += rc->accepted;
+		if (rc->accepted)
+			pf_refit_gap(c, s->xs.x, n, rc);
+	}
+	uint32_t left = 0;
 	for (uint32_t k = 0; k < n; k++)
-		nfirst += (uint32_t)xs.x[k].weight;
-	int np = pf_candidate_planes(&xs, c.R, pn, po);
-	best[0].idx = malloc(sizeof *best[0].idx * n);
-	best[1].idx = malloc(sizeof *best[1].idx * n);
-	alive = malloc(n);
-	caught = calloc(n, 1);
-	scratch = calloc(n, 1);
-	g.count = malloc(sizeof *g.count * PATCH_MAX * PATCH_MAX);
-	g.comp = malloc(sizeof *g.comp * PATCH_MAX * PATCH_MAX);
-	g.stack = malloc(sizeof *g.stack * PATCH_MAX * PATCH_MAX);
-	g.box = malloc(sizeof *g.box * PATCH_MAX * PATCH_MAX);
-	g.cellof = malloc(sizeof *g.cellof * n);
-	g.pairs = malloc(sizeof *g.pairs * n);
-	out->portals = malloc(sizeof *out->portals * MAX_PORTALS);
-	if (np < 0 || !best[0].idx || !best[1].idx || !alive || !caught || !scratch || !g.count || !g.comp || !g.stack || !g.box || !g.cellof ||
-	    !g.pairs || !out->portals) {
-		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "portal search: out of memory");
-		goto done;
-	}
-	memset(alive, 1, n);
-	V3 blo = v3(AJAR_INF, AJAR_INF, AJAR_INF), bhi = v3(-AJAR_INF, -AJAR_INF, -AJAR_INF);
-	for (uint32_t i = 0; i < ntris; i++) {
-		GLOBAL const Tri *t = &v->tris[i];
-		blo = v3_min(blo, v3_min(t->p0, v3_min(t->p1, t->p2)));
-		bhi = v3_max(bhi, v3_max(t->p0, v3_max(t->p1, t->p2)));
-	}
+		left += s->alive[k];
+	return left;
+}
 
-	/* Steps 4 to 8: again and again, the patch of a candidate plane where
-	 * the open lines crowd most tightly; its open cells' rectangles with
-	 * light behind them become portals, and the lines they catch (any
-	 * line, not only the patch's) are closed, until under MIN_SHARE of
-	 * them would remain for a portal. */
-	uint32_t left = n;
-	uint32_t accepted = 0;
-	for (int round = 0; round < MAX_ROUNDS && accepted < MAX_PORTALS; round++) {
-		pf_best_patch(&c, &xs, alive, pn, po, np, blo, bhi, &g, best);
+/* Steps 4 to 6: again and again, the patch of a candidate plane where the
+ * open lines crowd most tightly; its open cells' rectangles with light
+ * behind them become portals, and the lines they catch (any line, not only
+ * the patch's) are closed, until under MIN_SHARE of them would remain for
+ * a portal. */
+static ajar_status rounds(Search *s)
+{
+	Ctx *c = s->c;
+	uint32_t n = s->xs.n;
+	const Crossings *xs = &s->xs;
+	uint8_t *alive = s->alive;
+	Patch *best = s->best;
+	for (int round = 0; round < MAX_ROUNDS && s->accepted < MAX_PORTALS; round++) {
+		pf_best_patch(c, xs, alive, s->pn, s->po, s->np, PATCH_DN, s->blo, s->bhi, &s->g, best);
 		PF_DEBUG("round %d best %.1f plane %d m %u; next %.1f plane %d m %u\n", round, best[0].score, best[0].q,
 			 best[0].m, best[1].score, best[1].q, best[1].m);
 		if (best[0].score <= 0.0 || (float)best[0].m < MIN_SHARE * (float)n)
@@ -158,75 +208,188 @@ ajar_status portal_find(const SceneView *v, uint32_t ntris, const PortalFindInpu
 		/* The best patch, or the runner-up on another plane where its
 		 * score comes close: the one whose rectangles catch the open lines
 		 * more tightly (lines per area^0.75) wins. */
-		uint32_t from = rs.n;
+		uint32_t from = s->rs.n;
 		int pick = 0;
 		double tight[2] = {0.0, 0.0};
 		for (int b = 0; b < 2; b++) {
 			if (b == 1 && !(best[1].score >= RUNNER_UP * best[0].score && (float)best[1].m >= MIN_SHARE * (float)n))
 				break;
-			uint32_t mark = rs.n;
-			if ((st = pf_open_rects(&c, xs.x, best[b].idx, best[b].m, pn[best[b].q], po[best[b].q], n, scratch, &rs)) !=
-			    AJAR_OK)
-				goto done;
-			pf_merge_rects(&rs, mark, c.R);
+			uint32_t mark = s->rs.n;
+			ajar_status st = pf_open_rects(c, xs->x, best[b].idx, best[b].m, s->pn[best[b].q], s->po[best[b].q], n,
+						       s->scratch, &s->rs);
+			if (st != AJAR_OK)
+				return st;
+			pf_merge_rects(&s->rs, mark, c->R);
 			double area = 0.0;
 			uint32_t lines = 0;
 			for (uint32_t k = 0; k < n; k++) {
 				int in = 0;
-				for (uint32_t r = mark; r < rs.n && !in; r++)
-					in = rs.r[r].alive && pf_rect_catches(&rs.r[r], &xs.x[k], c.R);
+				for (uint32_t r = mark; r < s->rs.n && !in; r++)
+					in = s->rs.r[r].alive && pf_rect_catches(&s->rs.r[r], &xs->x[k], c->R);
 				lines += alive[k] && in;
 			}
-			for (uint32_t r = mark; r < rs.n; r++)
-				if (rs.r[r].alive)
-					area += (double)(rs.r[r].hi1 - rs.r[r].lo1) * (rs.r[r].hi2 - rs.r[r].lo2);
+			for (uint32_t r = mark; r < s->rs.n; r++)
+				if (s->rs.r[r].alive)
+					area += (double)(s->rs.r[r].hi1 - s->rs.r[r].lo1) * (s->rs.r[r].hi2 - s->rs.r[r].lo2);
 			tight[b] = area > 0.0 ? lines / pow(area, 0.75) : 0.0;
 			if (b == 1) {
 				pick = tight[1] > tight[0];
 				/* The loser's rectangles are dropped. */
-				for (uint32_t r = pick ? from : mark; r < (pick ? mark : rs.n); r++)
-					rs.r[r].alive = 0;
+				for (uint32_t r = pick ? from : mark; r < (pick ? mark : s->rs.n); r++)
+					s->rs.r[r].alive = 0;
 			}
 		}
 		PF_DEBUG("  tightness %.1f / %.1f: plane %d\n", tight[0], tight[1], best[pick].q);
-		int q = best[pick].q;
 		uint32_t m = best[pick].m, *idx = best[pick].idx;
-		(void)q;
 		for (uint32_t i = 0; i < m; i++)
 			alive[idx[i]] = 0; /* the patch is settled, caught or not */
-		for (uint32_t r = from; r < rs.n; r++) {
-			Rect *rc = &rs.r[r];
-			if (!rc->alive || !light_behind(&c, rc))
-				continue;
-			/* The lines it catches that no portal caught: their count
-			 * decides (aimed rays count: a small opening found is
-			 * kept), the first sample's share is its share. */
-			uint32_t gain = 0, first = 0;
-			for (uint32_t k = 0; k < n; k++)
-				if (!caught[k] && pf_rect_catches(rc, &xs.x[k], c.R)) {
-					caught[k] = 1;
-					alive[k] = 0;
-					gain++;
-					first += (uint32_t)xs.x[k].weight;
-				}
-			rc->share = nfirst ? (float)first / (float)nfirst : 0.0f;
-			rc->accepted = (float)gain >= MIN_SHARE * (float)n;
-			accepted += rc->accepted;
-		}
-		left = 0;
-		for (uint32_t k = 0; k < n; k++)
-			left += alive[k];
-		PF_DEBUG("round %d: plane n(%.3f %.3f %.3f) s %.3f patch %u lines, %u portals, %u left\n", round, pn[q].x, pn[q].y, pn[q].z, po[q], m, accepted, left);
+		uint32_t left = accept(s, from);
+		PF_DEBUG("round %d: plane %d patch %u lines, %u portals, %u left\n", round, best[pick].q, m, s->accepted, left);
 		if ((float)left < MIN_SHARE * (float)n)
 			break;
 	}
+	return AJAR_OK;
+}
+
+/* Step 7's rounds, for the few lines of openings beside the portals: the
+ * best patch of every candidate plane (lines at any cosine but MEET_DN's:
+ * a slit's lines may graze its own plane), its open cells' rectangles,
+ * scored by lines caught per projected area^0.75 (the area times the mean
+ * cosine of the lines it catches: what the room sees of it). The same
+ * lines cross a thin opening and, beyond it, a strip of the next surface's
+ * plane (over a door leaf's top: the lintel's plane, then the leaf's, just
+ * above its edge), about as tightly: of planes within BESIDE_TIE of the
+ * best score, the one the lines cross first, nearest the room, goes to
+ * step 6. */
+static ajar_status beside_rounds(Search *s)
+{
+	Ctx *c = s->c;
+	uint32_t n = s->xs.n;
+	Patch *pa = s->best;
+	for (int round = 0; round < MAX_ROUNDS && s->accepted < MAX_PORTALS; round++) {
+		uint32_t lo[MAX_PLANES], hi[MAX_PLANES];
+		double tight[MAX_PLANES], along[MAX_PLANES], top = 0.0;
+		for (int q = 0; q < s->np; q++) {
+			tight[q] = 0.0;
+			lo[q] = hi[q] = s->rs.n;
+			pf_best_patch(c, &s->xs, s->alive, s->pn + q, s->po + q, 1, MEET_DN, s->blo, s->bhi, &s->g, pa);
+			if (pa[0].score <= 0.0 || (float)pa[0].m < MIN_SHARE * (float)n)
+				continue;
+			ajar_status st = pf_open_rects(c, s->xs.x, pa[0].idx, pa[0].m, s->pn[q], s->po[q], n, s->scratch, &s->rs);
+			if (st != AJAR_OK)
+				return st;
+			pf_merge_rects(&s->rs, lo[q], c->R);
+			hi[q] = s->rs.n;
+			double area = 0.0, dist = 0.0;
+			uint32_t lines = 0;
+			for (uint32_t r = lo[q]; r < hi[q]; r++) {
+				const Rect *rc = &s->rs.r[r];
+				double cs = 0.0;
+				uint32_t in = 0;
+				for (uint32_t k = 0; rc->alive && k < n; k++)
+					if (s->alive[k] && pf_rect_catches(rc, &s->xs.x[k], c->R)) {
+						const Crossing *x = &s->xs.x[k];
+						float dn = v3_dot(rc->n, x->d);
+						cs += fabs(dn);
+						dist += (v3_dot(rc->n, rc->o) - v3_dot(rc->n, x->P)) / dn;
+						in++;
+					}
+				lines += in;
+				if (in)
+					area += (double)(rc->hi1 - rc->lo1) * (rc->hi2 - rc->lo2) * cs / in;
+			}
+			tight[q] = area > 0.0 ? lines / pow(area, 0.75) : 0.0;
+			along[q] = lines ? dist / lines : 0.0;
+			top = fmax(top, tight[q]);
+			PF_DEBUG("  beside plane %d: patch %u lines, tightness %.1f at %.3f\n", q, pa[0].m, tight[q], along[q]);
+		}
+		int bq = -1;
+		for (int q = 0; q < s->np; q++)
+			if (top > 0.0 && tight[q] >= BESIDE_TIE * top && (bq < 0 || along[q] < along[bq]))
+				bq = q;
+		if (bq < 0)
+			break;
+		for (int q = 0; q < s->np; q++)
+			for (uint32_t r = lo[q]; q != bq && r < hi[q]; r++)
+				s->rs.r[r].alive = 0;
+		/* Its patch again (the same lines: the search is deterministic),
+		 * settled, caught or not. */
+		pf_best_patch(c, &s->xs, s->alive, s->pn + bq, s->po + bq, 1, MEET_DN, s->blo, s->bhi, &s->g, pa);
+		for (uint32_t i = 0; i < pa[0].m; i++)
+			s->alive[pa[0].idx[i]] = 0;
+		uint32_t left = accept(s, lo[bq]);
+		PF_DEBUG("beside round %d: plane %d, %u portals, %u left\n", round, bq, s->accepted, left);
+		if ((float)left < MIN_SHARE * (float)n)
+			break;
+	}
+	return AJAR_OK;
+}
+
+ajar_status portal_find(const SceneView *v, uint32_t ntris, const PortalFindInput *in, PortalSearch *out)
+{
+	double t0 = now();
+	memset(out, 0, sizeof *out);
+	Ctx c = {.v = v};
+	RoomPts room = {0};
+	Search s = {.c = &c, .best = {{0.0, -1, NULL, 0}, {0.0, -1, NULL, 0}}};
+	ajar_status st = pf_room_points(&c, in->camera, &room);
+	if (st == AJAR_OK && c.R > 0.0f)
+		st = pf_light_points(&c, ntris, in, &room);
+	if (st == AJAR_OK && c.R > 0.0f) {
+		pf_room_lights(&c, &room);
+		st = pf_find_crossings(&c, &room, &s.xs);
+	}
+	if (st != AJAR_OK || s.xs.n == 0)
+		goto done;
+
+	for (uint32_t k = 0; k < s.xs.n; k++)
+		s.nfirst += (uint32_t)s.xs.x[k].weight;
+	s.np = pf_candidate_planes(&s.xs, c.R, s.pn, s.po);
+	s.g.count = malloc(sizeof *s.g.count * PATCH_MAX * PATCH_MAX);
+	s.g.comp = malloc(sizeof *s.g.comp * PATCH_MAX * PATCH_MAX);
+	s.g.stack = malloc(sizeof *s.g.stack * PATCH_MAX * PATCH_MAX);
+	s.g.box = malloc(sizeof *s.g.box * PATCH_MAX * PATCH_MAX);
+	out->portals = malloc(sizeof *out->portals * MAX_PORTALS);
+	if (s.np < 0 || !lines_fit(&s, 0) || !s.g.count || !s.g.comp || !s.g.stack || !s.g.box || !out->portals) {
+		st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "portal search: out of memory");
+		goto done;
+	}
+	s.blo = v3(AJAR_INF, AJAR_INF, AJAR_INF), s.bhi = v3(-AJAR_INF, -AJAR_INF, -AJAR_INF);
+	for (uint32_t i = 0; i < ntris; i++) {
+		GLOBAL const Tri *t = &v->tris[i];
+		s.blo = v3_min(s.blo, v3_min(t->p0, v3_min(t->p1, t->p2)));
+		s.bhi = v3_max(s.bhi, v3_max(t->p0, v3_max(t->p1, t->p2)));
+	}
+	if ((st = rounds(&s)) != AJAR_OK)
+		goto done;
+	/* Step 7: openings beside the portals found, which the room's rays
+	 * hardly met; their lines in rounds of their own, on the planes their
+	 * rings met. */
+	if (s.accepted && s.accepted < MAX_PORTALS) {
+		uint32_t had = s.xs.n;
+		if ((st = pf_beside(&c, &room, &s.xs, &s.rs)) != AJAR_OK)
+			goto done;
+		if (s.xs.n > had) {
+			Crossings added = {s.xs.x + had, s.xs.n - had, s.xs.n - had};
+			s.np = pf_candidate_planes(&added, c.R, s.pn, s.po);
+			if (s.np < 0 || !lines_fit(&s, had)) {
+				st = err_set(AJAR_ERROR_OUT_OF_MEMORY, "portal search: out of memory");
+				goto done;
+			}
+			/* The rounds before settled the other lines: too few
+			 * were left for a portal, and stay so. */
+			memset(s.alive, 0, had);
+			if ((st = beside_rounds(&s)) != AJAR_OK)
+				goto done;
+		}
+	}
 	/* The portals: the accepted rectangles, those of one plane merged where
 	 * one rectangle covers them with little more area. */
-	for (uint32_t r = 0; r < rs.n; r++)
-		rs.r[r].alive = rs.r[r].accepted;
-	pf_merge_rects(&rs, 0, c.R);
-	for (uint32_t r = 0; r < rs.n && out->count < MAX_PORTALS; r++) {
-		const Rect *rc = &rs.r[r];
+	for (uint32_t r = 0; r < s.rs.n; r++)
+		s.rs.r[r].alive = s.rs.r[r].accepted;
+	pf_merge_rects(&s.rs, 0, c.R);
+	for (uint32_t r = 0; r < s.rs.n && out->count < MAX_PORTALS; r++) {
+		const Rect *rc = &s.rs.r[r];
 		if (!rc->alive)
 			continue;
 		FoundPortal *f = &out->portals[out->count++];
@@ -244,13 +407,13 @@ done:
 	out->rays = c.rays;
 	out->seconds = now() - t0;
 	free(room.pt);
-	free(xs.x);
-	free(rs.r);
-	free(best[0].idx), free(best[1].idx);
-	free(alive);
-	free(caught);
-	free(scratch);
-	free(g.count), free(g.comp), free(g.stack), free(g.box), free(g.cellof), free(g.pairs);
+	free(s.xs.x);
+	free(s.rs.r);
+	free(s.best[0].idx), free(s.best[1].idx);
+	free(s.alive);
+	free(s.caught);
+	free(s.scratch);
+	free(s.g.count), free(s.g.comp), free(s.g.stack), free(s.g.box), free(s.g.cellof), free(s.g.pairs);
 	free(c.lp);
 	if (st != AJAR_OK)
 		portal_search_free(out);

@@ -25,7 +25,28 @@ typedef struct {
 	const float *u1, *u2;
 	uint32_t k;
 	V3 o, a1, a2, n;
+	const Rects *done; /* the portals accepted before: what is seen through them is found */
 } CellPlane;
+
+/* Whether the segment from P along d (length l) passes through a portal
+ * accepted before. */
+static int through_done(const CellPlane *cp, V3 P, V3 d, float l)
+{
+	for (uint32_t i = 0; cp->done && i < cp->done->n; i++) {
+		const Rect *r = &cp->done->r[i];
+		float dn = v3_dot(r->n, d);
+		if (!r->accepted || !(fabs(dn) > 1e-6f))
+			continue;
+		float t = v3_dot(r->n, v3_sub(r->o, P)) / dn;
+		if (!(t > 0.0f && t < l))
+			continue;
+		V3 y = v3_sub(v3_madd(P, d, t), r->o);
+		float p1 = v3_dot(y, r->a1), p2 = v3_dot(y, r->a2);
+		if (p1 >= r->lo1 && p1 <= r->hi1 && p2 >= r->lo2 && p2 <= r->hi2)
+			return 1;
+	}
+	return 0;
+}
 
 /* Whether surface point p (normal n, facing where the ray came from) is
  * under the open sky: at least SKY_SEEN of SKY_RAYS cosine rays escape. */
@@ -73,7 +94,9 @@ static int point_open(Ctx *c, const CellPlane *cp, float p1, float p2, uint32_t 
 		float l = v3_len(d);
 		d = v3_scale(d, 1.0f / l);
 		V3 start = v3_madd(X, d, -back);
-		if (!pf_clear(c, P, start))
+		/* Seen through a portal found before: no new opening there (the
+		 * room behind a door's gap, seen through it). */
+		if (through_done(cp, P, d, l - back) || !pf_clear(c, P, start))
 			continue;
 		Solid sol;
 		pf_trace(c, start, d, AJAR_INF, &sol);
@@ -236,7 +259,7 @@ ajar_status pf_open_rects(Ctx *c, const Crossing *xs, const uint32_t *idx, uint3
 	float e1 = h1 - l1, e2 = h2 - l2;
 	l1 -= 0.25f * e1 + 0.02f * R, h1 += 0.25f * e1 + 0.02f * R;
 	l2 -= 0.25f * e2 + 0.02f * R, h2 += 0.25f * e2 + 0.02f * R;
-	CellPlane cp = {.xs = xs, .yl = yl, .u1 = u1, .u2 = u2, .k = k, .o = o, .a1 = a1, .a2 = a2, .n = n};
+	CellPlane cp = {.xs = xs, .yl = yl, .u1 = u1, .u2 = u2, .k = k, .o = o, .a1 = a1, .a2 = a2, .n = n, .done = rs};
 	float c1 = 0.0f, c2 = 0.0f;
 	int touch = 0;
 	for (int pass = 0; pass < 2; pass++) {
@@ -413,4 +436,156 @@ int pf_rect_catches(const Rect *r, const Crossing *x, float R)
 	V3 y = v3_sub(v3_madd(x->P, x->d, t), r->o);
 	float p1 = v3_dot(y, r->a1), p2 = v3_dot(y, r->a2);
 	return p1 >= r->lo1 && p1 <= r->hi1 && p2 >= r->lo2 && p2 <= r->hi2;
+}
+
+/* Whether line x passes within m of rectangle r: through it, or along it
+ * (a gap's lines that graze the plane its portal lies in, past the
+ * portal's end, went through it too): the part of the line inside the
+ * slab |n . (y - o)| <= m, clipped to the rectangle, is not empty. */
+int pf_rect_near(const Rect *r, const Crossing *x, float m, float R)
+{
+	float h = v3_dot(r->n, v3_sub(x->P, r->o)), dn = v3_dot(r->n, x->d);
+	float t0 = 0.0f, t1 = x->t == AJAR_INF ? 8.0f * R : x->t;
+	if (fabs(dn) > 1e-9f) {
+		float ta = (-m - h) / dn, tb = (m - h) / dn;
+		t0 = fmax(t0, fmin(ta, tb)), t1 = fmin(t1, fmax(ta, tb));
+	} else if (fabs(h) > m) {
+		return 0;
+	}
+	V3 y = v3_sub(x->P, r->o);
+	float p[2] = {v3_dot(y, r->a1), v3_dot(y, r->a2)}, q[2] = {v3_dot(x->d, r->a1), v3_dot(x->d, r->a2)};
+	float lo[2] = {r->lo1, r->lo2}, hi[2] = {r->hi1, r->hi2};
+	for (int a = 0; a < 2 && t0 <= t1; a++) {
+		if (fabs(q[a]) < 1e-9f) {
+			if (p[a] < lo[a] || p[a] > hi[a])
+				return 0;
+			continue;
+		}
+		float ua = (lo[a] - p[a]) / q[a], ub = (hi[a] - p[a]) / q[a];
+		t0 = fmax(t0, fmin(ua, ub)), t1 = fmin(t1, fmax(ua, ub));
+	}
+	return t0 <= t1;
+}
+
+/* The lines of xs[0..n) that rectangle r catches. */
+static uint32_t catches(const Rect *r, const Crossing *xs, uint32_t n, const uint8_t *pick, float R)
+{
+	uint32_t k = 0;
+	for (uint32_t i = 0; i < n; i++)
+		k += pick[i] && pf_rect_catches(r, &xs[i], R);
+	return k;
+}
+
+/* A segment between two solid points of a gap's cross-section, by length. */
+typedef struct {
+	float l2;
+	uint16_t i, j;
+} Span;
+
+static int cmp_span(const void *a, const void *b)
+{
+	const Span *x = a, *y = b;
+	if (x->l2 != y->l2)
+		return x->l2 < y->l2 ? -1 : 1;
+	return x->i != y->i ? (x->i < y->i ? -1 : 1) : (x->j > y->j) - (x->j < y->j);
+}
+
+/* Whether line x, seen along L (both projected on the plane normal to
+ * L), crosses segment a b before its far hit. */
+static int crosses(const Crossing *x, V3 L, V3 a, V3 b)
+{
+	V3 p = v3_madd(x->P, L, -v3_dot(L, x->P)), d = v3_madd(x->d, L, -v3_dot(L, x->d));
+	V3 e = v3_sub(b, a), q = v3_sub(a, p);
+	V3 den = v3_cross(d, e);
+	float dd = v3_dot(den, L);
+	if (!(fabs(dd) > 1e-12f))
+		return 0;
+	float t = v3_dot(v3_cross(q, e), L) / dd, s = v3_dot(v3_cross(q, d), L) / dd;
+	return t > 0.0f && t < x->t && s >= 0.0f && s <= 1.0f;
+}
+
+void pf_refit_gap(Ctx *c, const Crossing *xs, uint32_t n, Rect *r)
+{
+	float w1 = r->hi1 - r->lo1, w2 = r->hi2 - r->lo2;
+	if (!(fmin(w1, w2) < GAP_ASPECT * fmax(w1, w2)))
+		return;
+	V3 L = w1 >= w2 ? r->a1 : r->a2, S = w1 >= w2 ? r->a2 : r->a1;
+	float half = 0.5f * fmax(w1, w2), lo = w1 >= w2 ? r->lo2 : r->lo1, hi = w1 >= w2 ? r->hi2 : r->hi1;
+	float mid = 0.5f * (w1 >= w2 ? r->lo1 + r->hi1 : r->lo2 + r->hi2);
+	V3 C = v3_madd(r->o, L, mid); /* on the long axis's middle, S-coordinate 0 */
+	/* The lines through the gap: those passing near the rectangle. */
+	uint8_t *near = malloc(n ? n : 1);
+	uint32_t *li = malloc(sizeof *li * (n ? n : 1)), m = 0;
+	Span *sp = malloc(sizeof *sp * GAP_DIRS * GAP_DIRS / 2);
+	if (!near || !li || !sp)
+		goto done;
+	for (uint32_t i = 0; i < n; i++)
+		if ((near[i] = (uint8_t)pf_rect_near(r, &xs[i], GAP_SLAB * c->R, c->R)))
+			li[m++] = i;
+	if (m < 8)
+		goto done;
+	/* The solid around the gap in its cross-section through the long
+	 * axis's middle: hits of rays in that plane from GAP_FROM points across
+	 * the rectangle. */
+	V3 hp[GAP_DIRS];
+	int nh = 0;
+	float reach = GAP_REACH * c->R + 2.0f * (hi - lo);
+	for (int f = 0; f < GAP_FROM; f++) {
+		V3 X = v3_madd(C, S, lo + (hi - lo) * ((float)f + 0.5f) / GAP_FROM);
+		for (int i = 0; i < GAP_DIRS / GAP_FROM; i++) {
+			float ph = 2.0f * AJAR_PI * ((float)i + 0.5f) / (GAP_DIRS / GAP_FROM);
+			Solid h;
+			if (pf_trace(c, X, v3_add(v3_scale(S, cos(ph)), v3_scale(r->n, sin(ph))), reach, &h))
+				hp[nh++] = h.p;
+		}
+	}
+	/* Its narrowest section: the shortest segment between two of them
+	 * that the lines (GAP_CROSS of them) cross, seen along the long axis
+	 * (a door's jamb corner to its leaf's face by the free edge; a segment
+	 * on one wall is crossed by none). */
+	uint32_t ns = 0;
+	for (int i = 0; i < nh; i++)
+		for (int j = i + 1; j < nh; j++) {
+			V3 e = v3_sub(hp[j], hp[i]);
+			e = v3_madd(e, L, -v3_dot(L, e));
+			sp[ns++] = (Span){v3_len2(e), (uint16_t)i, (uint16_t)j};
+		}
+	qsort(sp, ns, sizeof *sp, cmp_span);
+	uint32_t miss_most = m - (uint32_t)(GAP_CROSS * (float)m);
+	int found = -1;
+	for (uint32_t k = 0; k < ns && found < 0; k++) {
+		if (!(sp[k].l2 > 0.0f))
+			continue;
+		uint32_t miss = 0;
+		for (uint32_t q = 0; q < m && miss <= miss_most; q++)
+			miss += !crosses(&xs[li[q]], L, hp[sp[k].i], hp[sp[k].j]);
+		if (miss <= miss_most)
+			found = (int)k;
+	}
+	if (found < 0)
+		goto done;
+	V3 A = hp[sp[found].i], B = hp[sp[found].j];
+	V3 AB = v3_sub(B, A);
+	AB = v3_madd(AB, L, -v3_dot(L, AB));
+	V3 nt = v3_norm(v3_cross(L, AB));
+	if (v3_dot(nt, r->n) < 0.0f)
+		nt = v3_neg(nt);
+	/* The section's rectangle, its long sides as before, a little beyond
+	 * the solid points as step 5's planes are; kept where it catches more
+	 * of the lines (grazing lines cross a jamb's plane past the
+	 * rectangle's end, not the gap). */
+	float wd = sqrtf(sp[found].l2), mg = EDGE_MARGIN / GRID * wd;
+	V3 M = v3_madd(v3_scale(v3_add(A, v3_madd(A, AB, 1.0f)), 0.5f), L, v3_dot(L, v3_sub(C, A)));
+	Rect t = *r;
+	t.n = nt, t.a1 = L, t.a2 = v3_cross(nt, L);
+	t.o = v3_madd(M, nt, -PLANE_OFFSET * c->R);
+	t.lo1 = -half, t.hi1 = half;
+	t.lo2 = -0.5f * wd - mg, t.hi2 = 0.5f * wd + mg;
+	uint32_t before = catches(r, xs, n, near, c->R), after = catches(&t, xs, n, near, c->R);
+	PF_DEBUG("gap section: %u lines, width %.4f, normal (%.3f %.3f %.3f), catches %u -> %u\n", m, wd, nt.x, nt.y, nt.z,
+		 before, after);
+	if (after > before)
+		*r = t;
+done:
+	free(near), free(li), free(sp);
 }

@@ -1,6 +1,7 @@
 /* portal_find_crossings.c — steps 2 and 3 of the portal search: rays from
  * the room that leave through openings, the ring test that finds their wall,
- * rays aimed where crossings are few. */
+ * rays aimed where crossings are few; and step 7's lines from the room to
+ * the light points that pass beside the portals found. */
 #include "prepare/portal_find_parts.h"
 
 static int cmp_float(const void *a, const void *b)
@@ -227,5 +228,58 @@ ajar_status pf_find_crossings(Ctx *c, const RoomPts *r, Crossings *out)
 	return AJAR_OK;
 oom:
 	free(strong.x), free(weak.x), free(more.x), free(size);
+	return err_set(AJAR_ERROR_OUT_OF_MEMORY, "portal search: out of memory");
+}
+
+/* Whether line x went through a portal already accepted: passes within
+ * BESIDE_SLAB R of it (pf_rect_near). */
+static int caught_by(const Rects *rs, const Crossing *x, float R)
+{
+	for (uint32_t i = 0; i < rs->n; i++)
+		if (rs->r[i].accepted && pf_rect_near(&rs->r[i], x, BESIDE_SLAB * R, R))
+			return 1;
+	return 0;
+}
+
+ajar_status pf_beside(Ctx *c, const RoomPts *r, Crossings *xs, const Rects *rs)
+{
+	Crossings strong = {0}, weak = {0}, more = {0};
+	Rng rng = rng_init(0x70a7a1u, 7u, 0u, 0u);
+	uint32_t per = c->nlp, start = 0;
+	if (r->n && per * r->n > BESIDE_PAIRS)
+		per = BESIDE_PAIRS / r->n > 0 ? BESIDE_PAIRS / r->n : 1;
+	for (uint32_t i = 0; i < r->n && c->nlp; i++) {
+		const RoomPt *from = &r->pt[i];
+		for (uint32_t k = 0; k < per; k++) {
+			uint32_t li = (start + k * c->nlp / per) % c->nlp;
+			const LightPoint *l = &c->lp[li];
+			V3 to = v3_sub(l->p, from->p);
+			float t = v3_len(to);
+			if (!(t > 0.0f) || (from->surf && v3_dot(to, from->n) <= 0.0f) ||
+			    (!v3_is_zero(l->n) && !(v3_dot(to, l->n) < 0.0f)))
+				continue;
+			Crossing x = {.from = from, .origin = i, .P = from->p, .d = v3_scale(to, 1.0f / t), .t = t};
+			/* A light point the room point sees past every portal:
+			 * its line went through another opening. */
+			if (caught_by(rs, &x, c->R) || !pf_clear(c, from->p, l->p))
+				continue;
+			x.strong = li < c->ndirect; /* a lamp's or an emitter's point */
+			if (!push(x.strong ? &strong : &weak, &x))
+				goto oom;
+		}
+		start += 7919u;
+	}
+	if (!ring_all(c, &rng, &strong, MAX_CANDIDATES, &more) || !ring_all(c, &rng, &weak, MAX_CANDIDATES, &more))
+		goto oom;
+	for (uint32_t i = 0; i < more.n; i++) {
+		more.x[i].weight = 0;
+		if (!push(xs, &more.x[i]))
+			goto oom;
+	}
+	PF_DEBUG("beside: strong %u weak %u -> %u lines\n", strong.n, weak.n, more.n);
+	free(strong.x), free(weak.x), free(more.x);
+	return AJAR_OK;
+oom:
+	free(strong.x), free(weak.x), free(more.x);
 	return err_set(AJAR_ERROR_OUT_OF_MEMORY, "portal search: out of memory");
 }

@@ -32,6 +32,9 @@
 #define FOCUS_TARGET 96    /* crossings a place (and direction) should have */
 #define FOCUS_NEAR 0.05f   /* x R: a place's radius */
 #define FOCUS_MAX 32768    /* aimed rays a round at most */
+#define BESIDE_PAIRS 131072 /* step 7: room points joined to light points */
+#define BESIDE_SLAB GAP_SLAB /* a line this near a portal went through it */
+#define BESIDE_TIE 0.7     /* planes scoring this near the best: the nearest the room wins */
 #define LIGHT_POINTS 64    /* light samples of emitters and lamps */
 #define BOUNCE_POINTS 64   /* and of what they light */
 #define RING_DIRS 8        /* step 3 */
@@ -63,6 +66,12 @@
 #define RIM_GAP 0.03f      /* x its size: its rim lies this far outside it */
 #define SLIDE_SOLID 0.1f   /* x R */
 #define CONNECT 2          /* open cells this many cells apart join */
+#define GAP_ASPECT 0.25f   /* a rectangle this narrow is a gap: its section refitted */
+#define GAP_SLAB 0.003f    /* x R: its lines pass this near it */
+#define GAP_DIRS 360       /* rays across it, from GAP_FROM points */
+#define GAP_FROM 5
+#define GAP_REACH 0.05f    /* x R: as far, and twice its width */
+#define GAP_CROSS 0.9f     /* its section: crossed by this many of its lines */
 #define MERGE_AREA 1.25    /* step 6 */
 #define MERGE_GAP 0.03f    /* x R: rectangles of planes this close may merge */
 #define MIN_SHARE 0.02f    /* lines a portal must catch */
@@ -78,6 +87,7 @@ typedef struct {
 	uint64_t rays;
 	LightPoint *lp;
 	uint32_t nlp;
+	uint32_t ndirect; /* lp[0..ndirect): on the lamps and emitters; after them, what they light */
 	int sky;       /* a sky or a sun: what escapes finds light */
 } Ctx;
 
@@ -184,9 +194,10 @@ int pf_meet(const Crossing *x, V3 n, float s, float R, float min_dn, float *t);
  * 0.5% of the hits. Each normal faces where the lines come from. */
 int pf_candidate_planes(const Crossings *xs, float R, V3 *cand, float *offs);
 /* Of the lines still open (alive), where they crowd most tightly on one
- * candidate plane: best[0] the best patch, best[1] the best on another. */
+ * candidate plane (lines crossing it at a cosine of at least min_dn):
+ * best[0] the best patch, best[1] the best on another. */
 void pf_best_patch(Ctx *c, const Crossings *xs, const uint8_t *alive, const V3 *pn, const float *po, int np,
-		   V3 blo, V3 bhi, Raster *g, Patch best[2]);
+		   float min_dn, V3 blo, V3 bhi, Raster *g, Patch best[2]);
 
 /* Steps 5 to 7: open cells, rectangles (portal_find_cells.c). */
 /* Open cells of plane (n, s) over the footprint, their connected parts as
@@ -201,5 +212,17 @@ ajar_status pf_open_rects(Ctx *c, const Crossing *xs, const uint32_t *idx, uint3
 void pf_merge_rects(Rects *rs, uint32_t from, float R);
 /* Whether line x passes through rectangle r before its far hit. */
 int pf_rect_catches(const Rect *r, const Crossing *x, float R);
+/* Whether line x passes within m of rectangle r (through it or along it). */
+int pf_rect_near(const Rect *r, const Crossing *x, float m, float R);
+/* A gap's rectangle (GAP_ASPECT: longer than wide) turned about its long
+ * axis onto the gap's narrowest section, the shortest segment between two
+ * solid points that most of the lines of xs[0..n) passing near it cross
+ * (a door's jamb corner to its leaf's face by the free edge), where it
+ * catches more of those lines. */
+void pf_refit_gap(Ctx *c, const Crossing *xs, uint32_t n, Rect *r);
+
+/* Step 7 (portal_find_crossings.c): lines through openings beside the
+ * accepted rectangles of rs, added to xs with weight 0. */
+ajar_status pf_beside(Ctx *c, const RoomPts *r, Crossings *xs, const Rects *rs);
 
 #endif

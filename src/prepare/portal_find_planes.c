@@ -98,7 +98,7 @@ static int cmp_u64(const void *a, const void *b)
 }
 
 void pf_best_patch(Ctx *c, const Crossings *xs, const uint8_t *alive, const V3 *pn, const float *po, int np,
-		   V3 blo, V3 bhi, Raster *g, Patch best[2])
+		   float min_dn, V3 blo, V3 bhi, Raster *g, Patch best[2])
 {
 	best[0].score = best[1].score = 0.0;
 	best[0].q = best[1].q = -1;
@@ -120,7 +120,7 @@ void pf_best_patch(Ctx *c, const Crossings *xs, const uint8_t *alive, const V3 *
 		for (uint32_t i = 0; i < xs->n; i++) {
 			float t;
 			g->cellof[i] = -1;
-			if (!alive[i] || !pf_meet(&xs->x[i], pn[k], po[k], R, PATCH_DN, &t))
+			if (!alive[i] || !pf_meet(&xs->x[i], pn[k], po[k], R, min_dn, &t))
 				continue;
 			V3 y = v3_madd(xs->x[i].P, xs->x[i].d, t);
 			int ci = (int)((v3_dot(y, a1) - l1) / g->cell), cj = (int)((v3_dot(y, a2) - l2) / g->cell);

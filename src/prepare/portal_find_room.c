@@ -150,7 +150,7 @@ ajar_status pf_light_points(Ctx *c, uint32_t ntris, const PortalFindInput *in, c
 	 * light. From each light point in turn, a ray (cosine about an
 	 * emitter's normal, any way from a lamp); a point just in front of its
 	 * hit, lighting that side. */
-	uint32_t direct = c->nlp;
+	uint32_t direct = c->ndirect = c->nlp;
 	for (uint32_t i = 0; direct && i < BOUNCE_POINTS; i++) {
 		const LightPoint *l = &c->lp[i % direct];
 		V3 d = pf_dir_about(&rng, l->n, !v3_is_zero(l->n));
