@@ -61,6 +61,7 @@ DEPS_test_bsdf := $(BSDF_DEPS)
 DEPS_test_bsdf_bent := $(BSDF_DEPS)
 DEPS_test_bsdf_layers := $(BSDF_DEPS)
 DEPS_test_sampling := $(call obj,core/error)
+DEPS_test_pane_planes := $(call obj,prepare/pane_planes)
 # The glTF loader: the C++ file on tinygltf and its parts in C (src/scene/gltf_parts.h).
 GLTF_OBJS := scene/gltf scene/gltf_transform scene/gltf_decode scene/gltf_instancing scene/gltf_confine \
 	scene/gltf_extensions

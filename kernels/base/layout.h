@@ -7,7 +7,7 @@
 
 #define AJAR_LAYOUT_TYPES(X) \
 	X(BvhNode, 256) X(Tri, 48) X(TriShade, 64) X(TriExtra, 128) X(Material, 176) X(Texture, 48) \
-	X(Emitter, 16) X(PortalTri, 64) X(Camera, 64) X(Params, 320) \
+	X(Emitter, 16) X(PortalTri, 64) X(Camera, 64) X(Params, 384) \
 	X(PortalPlane, 80) X(PunctualLight, 64) X(Instance, 112)
 
 #define AJAR_LAYOUT_FIELDS(X)                                                          \

@@ -239,8 +239,9 @@ typedef struct {
 #endif
 
 /* At most this many planes of panes mirror the sky for next-event
- * estimation (integrator/pane_mirror.h): a room's windows share few. */
-#define PANE_PLANES_MAX 4
+ * estimation (integrator/pane_mirror.h): windows in a wall share one, a
+ * room has a few walls; a vertex pays only a side test for each plane. */
+#define PANE_PLANES_MAX 8
 /* A pane lies in such a plane where their normals' cosine exceeds
  * PANE_PLANE_COS and its points lie within PANE_PLANE_TOL of the scene's
  * radius of it. */
@@ -297,7 +298,7 @@ typedef struct {
 	V3 pane_n[PANE_PLANES_MAX]; /* unit normals, toward each plane's sky side */
 	float pane_d[PANE_PLANES_MAX]; /* the plane: dot(pane_n, x) = pane_d */
 	int pad_pane[3];
-} Params; /* 320 */
+} Params; /* 384 */
 
 /* Layout of the float array `env`: for an ENV_IMAGE of W x H,
  *   [0, 3WH)                    linear RGB radiance, row-major, row 0 = top
