@@ -78,6 +78,30 @@ static int cell_of(const Bsdf *bs, V3 w)
  * cancellation in 1 - F near total internal reflection). */
 int rel_close(float a, float b, float tol) { return fabs(a - b) <= tol * fmax(fmax(fabs(a), fabs(b)), 1e-2f); }
 
+int reciprocity_check(const char *name, const Bsdf *bs, Rng *r, float tol, int reciprocal)
+{
+	int nonzero = 0;
+	for (int k = 0; k < 20000; k++) {
+		V3 wo = sample_uniform_sphere(rng_f(r), rng_f(r));
+		V3 wi = sample_uniform_sphere(rng_f(r), rng_f(r));
+		float p1, r1, p2, r2, p3, r3;
+		V3 f1 = bsdf_eval(bs, wo, wi, BSDF_RADIANCE, &p1, &r1);
+		V3 f2 = bsdf_eval(bs, wi, wo, BSDF_RADIANCE, &p2, &r2);
+		V3 f3 = bsdf_eval(bs, wi, wo, BSDF_IMPORTANCE, &p3, &r3);
+		nonzero += !v3_is_zero(f1);
+		int same_side = v3_dot(wo, bs->ng) * v3_dot(wi, bs->ng) > 0 && reciprocal;
+		if (!rel_close(f1.x, f3.x, tol) || !rel_close(f1.y, f3.y, tol) || !rel_close(f1.z, f3.z, tol))
+			fail_msg("%s: f_radiance(wo,wi) %g != f_importance(wi,wo) %g", name, f1.x, f3.x);
+		if (same_side && (!rel_close(f1.x, f2.x, tol) || !rel_close(f1.y, f2.y, tol) || !rel_close(f1.z, f2.z, tol)))
+			fail_msg("%s: f not reciprocal: %g vs %g", name, f1.x, f2.x);
+		if (!rel_close(r1, p2, 1e-5f) || !rel_close(p1, r2, 1e-5f))
+			fail_msg("%s: pdf_rev_w mismatch", name);
+		if (p1 < 0 || !isfinite(p1) || !finite3(f1))
+			fail_msg("%s: bad eval", name);
+	}
+	return nonzero;
+}
+
 /* One chi-square test; returns its p-value. Also checks that the pdf
  * integrates to the non-delta probability and that samples agree with eval. */
 double chi2_run(const char *name, uint seed, const Bsdf *bsp, V3 wo, int wo_index, int mode,

@@ -38,6 +38,12 @@ int finite3(V3 v);
 /* Relative closeness; values below 1e-2 are compared absolutely (float
  * cancellation in 1 - F near total internal reflection). */
 int rel_close(float a, float b, float tol);
+/* 20,000 random direction pairs: f_radiance(wo, wi) == f_importance(wi, wo)
+ * (the adjoint BSDF), f(wo, wi) == f(wi, wo) where both lie on one side and
+ * `reciprocal` (reflection), pdf_rev_w(wo, wi) == pdf_w(wi, wo), every value
+ * finite; f within tol relative. Fails the test naming `name`; returns how
+ * many pairs had f != 0. */
+int reciprocity_check(const char *name, const Bsdf *bs, Rng *r, float tol, int reciprocal);
 /* One chi-square test; returns its p-value. Also checks that the pdf
  * integrates to the non-delta probability and that samples agree with eval. */
 double chi2_run(const char *name, uint seed, const Bsdf *bsp, V3 wo, int wo_index, int mode, double alpha_each);
