@@ -10,6 +10,8 @@ OPTIONAL="libopenmpi-dev openmpi-bin"
 # make fuzz (FUZZ=1): clang with libFuzzer's runtime, and the JSON parser
 # tinygltf's header includes (the harnesses compile tinygltf in).
 [ "${FUZZ:-0}" = 1 ] && PKGS="$PKGS clang libclang-rt-14-dev nlohmann-json3-dev"
+# make bench-portals (BENCH=1): Python writes the layouts it benches.
+[ "${BENCH:-0}" = 1 ] && PKGS="$PKGS python3"
 missing=""
 optional=""
 for p in $PKGS; do

@@ -370,13 +370,15 @@ def main():
 		help="door opening angle in degrees (0: closed, for the leak test; default %(default)s)")
 	ap.add_argument("--out", default=os.path.dirname(os.path.abspath(__file__)),
 		help="output folder (default: next to this script)")
+	ap.add_argument("--name", default="door-ajar",
+		help="file name without extension, of the .gltf and its .bin (default %(default)s)")
 	args = ap.parse_args()
 
 	os.makedirs(args.out, exist_ok=True)
-	gltf, blob = build(args.angle, "door-ajar.bin")
-	with open(os.path.join(args.out, "door-ajar.bin"), "wb") as f:
+	gltf, blob = build(args.angle, args.name + ".bin")
+	with open(os.path.join(args.out, args.name + ".bin"), "wb") as f:
 		f.write(blob)
-	with open(os.path.join(args.out, "door-ajar.gltf"), "w", encoding="utf-8", newline="\n") as f:
+	with open(os.path.join(args.out, args.name + ".gltf"), "w", encoding="utf-8", newline="\n") as f:
 		json.dump(gltf, f, indent=1)
 		f.write("\n")
 

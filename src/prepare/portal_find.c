@@ -153,6 +153,34 @@ static int lines_fit(Search *s, uint32_t had)
 	return 1;
 }
 
+/* Whether accepted rectangle q nearly repeats rc: normals within DUP_COS,
+ * rc's centre in q's plane (MERGE_GAP R), half of rc over q. A gap's
+ * section found again from the lines the first one left out, a few
+ * degrees askew, is one opening: q grows over rc. */
+static int absorb(Rect *q, const Rect *rc, float R)
+{
+	if (!q->accepted || v3_dot(q->n, rc->n) < DUP_COS)
+		return 0;
+	V3 c = v3_add(rc->o, v3_add(v3_scale(rc->a1, 0.5f * (rc->lo1 + rc->hi1)), v3_scale(rc->a2, 0.5f * (rc->lo2 + rc->hi2))));
+	if (fabs(v3_dot(q->n, v3_sub(c, q->o))) > MERGE_GAP * R)
+		return 0;
+	float lo1 = AJAR_INF, hi1 = -AJAR_INF, lo2 = AJAR_INF, hi2 = -AJAR_INF;
+	for (int k = 0; k < 4; k++) {
+		V3 p = v3_sub(v3_add(rc->o, v3_add(v3_scale(rc->a1, k & 1 ? rc->hi1 : rc->lo1),
+						     v3_scale(rc->a2, k & 2 ? rc->hi2 : rc->lo2))),
+			      q->o);
+		float p1 = v3_dot(p, q->a1), p2 = v3_dot(p, q->a2);
+		lo1 = fmin(lo1, p1), hi1 = fmax(hi1, p1), lo2 = fmin(lo2, p2), hi2 = fmax(hi2, p2);
+	}
+	double ov1 = fmin(q->hi1, hi1) - fmax(q->lo1, lo1), ov2 = fmin(q->hi2, hi2) - fmax(q->lo2, lo2);
+	if (!(ov1 > 0.0 && ov2 > 0.0 && ov1 * ov2 >= 0.5 * (double)(hi1 - lo1) * (hi2 - lo2)))
+		return 0;
+	q->lo1 = fmin(q->lo1, lo1), q->hi1 = fmax(q->hi1, hi1);
+	q->lo2 = fmin(q->lo2, lo2), q->hi2 = fmax(q->hi2, hi2);
+	q->share += rc->share;
+	return 1;
+}
+
 /* Step 6 for the rectangles rs[from..): those with light behind them
  * that catch MIN_SHARE of the lines become portals, and close the lines
  * they catch. Returns the lines still open. */
@@ -168,18 +196,32 @@ static uint32_t accept(Search *s, uint32_t from)
 		 * decides (aimed rays count: a small opening found is kept),
 		 * the first sample's share is its share. */
 		uint32_t gain = 0, first = 0;
-		for (uint32_t k = 0; k < n; k++)
-			if (!s->caught[k] && pf_rect_catches(rc, &s->xs.x[k], c->R)) {
+		for (uint32_t k = 0; k < n; k++) {
+			s->scratch[k] = !s->caught[k] && pf_rect_catches(rc, &s->xs.x[k], c->R);
+			if (s->scratch[k]) {
 				s->caught[k] = 1;
 				s->alive[k] = 0;
 				gain++;
 				first += (uint32_t)s->xs.x[k].weight;
 			}
-		rc->share = s->nfirst ? (float)first / (float)s->nfirst : 0.0f;
+		}
 		rc->accepted = (float)gain >= MIN_SHARE * (float)n;
 		s->accepted += rc->accepted;
-		if (rc->accepted)
-			pf_refit_gap(c, s->xs.x, n, rc);
+		/* A gap's section may leave a few of the doorway's lines (over a
+		 * leaf's top): they are open again, for an opening of their own. */
+		if (rc->accepted && pf_refit_gap(c, s->xs.x, n, rc))
+			for (uint32_t k = 0; k < n; k++)
+				if (s->scratch[k] && !pf_rect_catches(rc, &s->xs.x[k], c->R)) {
+					s->caught[k] = 0;
+					s->alive[k] = 1;
+					first -= (uint32_t)s->xs.x[k].weight;
+				}
+		rc->share = s->nfirst ? (float)first / (float)s->nfirst : 0.0f;
+		for (uint32_t q = 0; q < r && rc->accepted; q++)
+			if (absorb(&s->rs.r[q], rc, c->R)) {
+				rc->accepted = rc->alive = 0;
+				s->accepted--;
+			}
 	}
 	uint32_t left = 0;
 	for (uint32_t k = 0; k < n; k++)

@@ -66,7 +66,10 @@
 #define RIM_GAP 0.03f      /* x its size: its rim lies this far outside it */
 #define SLIDE_SOLID 0.1f   /* x R */
 #define CONNECT 2          /* open cells this many cells apart join */
-#define GAP_ASPECT 0.25f   /* a rectangle this narrow is a gap: its section refitted */
+#define GAP_ASPECT 0.5f    /* a rectangle this narrow is a gap (a doorway too): its section refitted */
+#define GAP_KEEP 0.9f      /* a section catching this share of its lines is kept */
+#define GAP_SHRINK 0.7f    /* where its area is at most this share: the rest find their own */
+#define GAP_SURE 128       /* lines near it, at least, for that: a few lost ones say little */
 #define GAP_SLAB 0.003f    /* x R: its lines pass this near it */
 #define GAP_DIRS 360       /* rays across it, from GAP_FROM points */
 #define GAP_FROM 5
@@ -74,6 +77,7 @@
 #define GAP_CROSS 0.9f     /* its section: crossed by this many of its lines */
 #define MERGE_AREA 1.25    /* step 6 */
 #define MERGE_GAP 0.03f    /* x R: rectangles of planes this close may merge */
+#define DUP_COS 0.99f      /* an accepted portal grows over a new one this near its normal, half over it */
 #define MIN_SHARE 0.02f    /* lines a portal must catch */
 #define MAX_PORTALS 16
 
@@ -218,8 +222,14 @@ int pf_rect_near(const Rect *r, const Crossing *x, float m, float R);
  * axis onto the gap's narrowest section, the shortest segment between two
  * solid points that most of the lines of xs[0..n) passing near it cross
  * (a door's jamb corner to its leaf's face by the free edge), where it
- * catches more of those lines. */
-void pf_refit_gap(Ctx *c, const Crossing *xs, uint32_t n, Rect *r);
+ * catches more of those lines, or nearly as many (GAP_KEEP) of GAP_SURE
+ * lines or more on a much smaller area (GAP_SHRINK: a door opened 20
+ * degrees, whose doorway is four times the gap; not the slit over a
+ * leaf's top, whose few lines say little and whose wedge's middle section
+ * leaves out lines by its wide end, which would make a second portal).
+ * Returns whether it turned; the lines it no longer catches are the
+ * caller's to reopen. */
+int pf_refit_gap(Ctx *c, const Crossing *xs, uint32_t n, Rect *r);
 
 /* Step 7 (portal_find_crossings.c): lines through openings beside the
  * accepted rectangles of rs, added to xs with weight 0. */

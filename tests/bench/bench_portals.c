@@ -22,7 +22,10 @@
  *
  * AJAR_BENCH_SECONDS (default 10) per render, AJAR_BENCH_SIZE (default 64),
  * AJAR_BENCH_SCENES (comma-separated names) picks scenes; each scene's
- * integrator may be forced with AJAR_BENCH_INTEGRATOR=pt|bdpt|portal. */
+ * integrator may be forced with AJAR_BENCH_INTEGRATOR=pt|bdpt|portal.
+ * Arguments FILE.gltf[:pt|bdpt|portal] (default portal) bench those files
+ * instead of the shipped scenes: layouts not shipped, a door at another
+ * angle (make_door_ajar.py --angle). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -44,6 +47,11 @@ static const BenchScene scenes[] = {
 	{"atrium-forest", AJAR_INTEGRATOR_PORTAL},	{"door-ajar", AJAR_INTEGRATOR_PORTAL},
 	{"door-ajar-lamp", AJAR_INTEGRATOR_PORTAL},	{"bathroom", AJAR_INTEGRATOR_BDPT},
 };
+
+static ajar_integrator integ_of(const char *name)
+{
+	return !strcmp(name, "pt") ? AJAR_INTEGRATOR_PT : !strcmp(name, "bdpt") ? AJAR_INTEGRATOR_BDPT : AJAR_INTEGRATOR_PORTAL;
+}
 
 static const char *integ_name(ajar_integrator i)
 {
@@ -108,7 +116,7 @@ static double rel_var(float *const img[2], const double *ref, size_t npix)
 	return e / (3.0 * npix);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
 	double secs = getenv("AJAR_BENCH_SECONDS") ? atof(getenv("AJAR_BENCH_SECONDS")) : 10.0;
 	uint32_t size = getenv("AJAR_BENCH_SIZE") ? (uint32_t)atoi(getenv("AJAR_BENCH_SIZE")) : 64;
@@ -119,9 +127,25 @@ int main(void)
 	printf("%-19s %-6s %-24s %-24s %-24s %7s %8s %7s %8s %8s\n", "scene", "integ", "marked (spp relvar cpu)",
 	       "found (spp relvar cpu)", "none, pt (spp relvar cpu)", "fnd/mrk", "none/fnd", "(wall:", "f/m", "n/f)");
 	printf("%-19s %-6s %-24s %-24s %-24s %7s %8s %7s %8s %8s\n", "", "", "", "", "", "cpu", "cpu", "", "", "");
-	for (size_t i = 0; i < sizeof scenes / sizeof scenes[0]; i++) {
+	size_t nscenes = argc > 1 ? (size_t)argc - 1 : sizeof scenes / sizeof scenes[0];
+	for (size_t i = 0; i < nscenes; i++) {
+		char path[256], name[64];
+		BenchScene arg = {name, AJAR_INTEGRATOR_PORTAL};
 		const BenchScene *b = &scenes[i];
-		if (only) {
+		if (argc > 1) {
+			snprintf(path, sizeof path, "%s", argv[i + 1]);
+			char *colon = strrchr(path, ':');
+			if (colon) {
+				*colon = '\0';
+				arg.integ = integ_of(colon + 1);
+			}
+			size_t len = strlen(path); /* its tail names it: scenes often share file names */
+			snprintf(name, sizeof name, "%.63s", len > 19 ? path + len - 19 : path);
+			b = &arg;
+		} else {
+			snprintf(path, sizeof path, "scenes/%s/%s.gltf", b->name, b->name);
+		}
+		if (only && argc <= 1) {
 			char pad[256];
 			snprintf(pad, sizeof pad, ",%s,", only);
 			char key[64];
@@ -131,11 +155,7 @@ int main(void)
 		}
 		ajar_integrator integ = b->integ;
 		if (force)
-			integ = !strcmp(force, "pt") ? AJAR_INTEGRATOR_PT
-				: !strcmp(force, "bdpt") ? AJAR_INTEGRATOR_BDPT
-							 : AJAR_INTEGRATOR_PORTAL;
-		char path[256];
-		snprintf(path, sizeof path, "scenes/%s/%s.gltf", b->name, b->name);
+			integ = integ_of(force);
 		ajar_scene *marked, *stripped;
 		check(ajar_scene_load(path, &marked));
 		check(ajar_scene_load(path, &stripped));

@@ -9,9 +9,12 @@
  *   portals (the bathroom's slot behind its side wall; the share is
  *   printed). Each found portal overlaps a marked one (none where there is
  *   no opening).
- * - The thin triangle over door-ajar's (and door-ajar-lamp's) leaf top,
- *   part of the marked gap portal, is covered on its own (80%, normals
- *   agreeing).
+ * - door-ajar-20 (the door opened 20 degrees): the gap, a quarter of the
+ *   doorway, is covered with the gap's normal (the doorway's face, found
+ *   first, turned onto the gap's section).
+ * - The thin triangle over door-ajar's (door-ajar-lamp's, door-ajar-20's)
+ *   leaf top, part of the marked gap portal, is covered on its own (80%,
+ *   normals agreeing).
  * - None where there is no opening or no light behind one: the Cornell box,
  *   a closed box lit inside, a room lit only by a lamp and a ceiling
  *   emitter in it, two closed rooms with an emitter in the other, a room
@@ -293,6 +296,7 @@ static void test_covers_doors_and_bathroom(void **state)
 	(void)state;
 	check_covers(SCENE("door-ajar/door-ajar.gltf"));
 	check_covers(SCENE("door-ajar-lamp/door-ajar-lamp.gltf"));
+	check_covers(SCENE("door-ajar/door-ajar-20.gltf"));
 	check_covers(SCENE("bathroom/bathroom.gltf"));
 }
 
@@ -326,6 +330,7 @@ static void test_covers_leaf_top(void **state)
 	(void)state;
 	check_leaf_top(SCENE("door-ajar/door-ajar.gltf"));
 	check_leaf_top(SCENE("door-ajar-lamp/door-ajar-lamp.gltf"));
+	check_leaf_top(SCENE("door-ajar/door-ajar-20.gltf"));
 }
 
 /* ---- No opening, no portal ---------------------------------------------- */
