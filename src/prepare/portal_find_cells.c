@@ -91,6 +91,11 @@ static int point_open(Ctx *c, const CellPlane *cp, float p1, float p2, uint32_t 
 	for (int q = 0; q < nn; q++) {
 		const Crossing *line = &cp->xs[cp->yl[near[q]]];
 		V3 P = line->P, d = v3_sub(X, P);
+		/* From the room's side only: a garden seen through a glazed door
+		 * holds room points too, and a wall of one face hides nothing
+		 * from behind. */
+		if (!(v3_dot(cp->n, d) < 0.0f))
+			continue;
 		float l = v3_len(d);
 		d = v3_scale(d, 1.0f / l);
 		V3 start = v3_madd(X, d, -back);

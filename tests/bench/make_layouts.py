@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """make_layouts.py -- rooms of layouts no shipped scene has, for the portal search.
 
-  make_layouts.py OUTDIR
+  make_layouts.py [--sky-color R,G,B] OUTDIR
 
-Writes OUTDIR/l-room.gltf and OUTDIR/terrace.gltf (each with its .bin and a copy of
-scenes/skies/forest.exr), under the forest sky, each opening marked by hand with a
+Writes OUTDIR/l-room.gltf, terrace.gltf and terrace-one-face.gltf (each with its
+.bin and a copy of scenes/skies/forest.exr), under the forest sky (or a sky of one
+colour: tests/data/layouts, test_portal_find), each opening marked by hand with a
 portal node (extras.portal) as a user would place it: on the room's face of the
 wall, the size of the opening. `make bench-portals` takes them as arguments
 (tests/bench/bench_portals.c) to compare the portals Ajar finds with the marked ones
@@ -16,7 +17,8 @@ on layouts the search was not tuned on:
   terrace  a 5 x 4 m room whose glazed door (1.6 x 2.2 m, a thin pane of clear
            glass: KHR_materials_transmission without a volume) opens to a
            garden (a ground plane and a hedge outside), and a small open window
-           high in the side wall.
+           high in the side wall; terrace-one-face the same with walls of one
+           face (the room's, and the openings' reveals), as quick models have.
 
 Python 3 standard library only; the same bytes on every run.
 """
@@ -34,7 +36,7 @@ H = 2.6       # floor to ceiling
 REVEAL = 0.25  # depth of an opening through the wall
 
 
-def wall(axis, c, lo, hi, normal_sign, holes):
+def wall(axis, c, lo, hi, normal_sign, holes, faces=2):
 	"""The room's face of a wall in the plane axis = c (axis 'x' or 'z'), spanning
 	[lo, hi] along the other horizontal axis and [0, H] up, its normal toward
 	normal_sign along axis, and its outer face REVEAL behind (a solid wall);
@@ -53,7 +55,7 @@ def wall(axis, c, lo, hi, normal_sign, holes):
 
 	m = Mesh()
 	cuts = sorted(holes)
-	for off in (0.0, REVEAL):  # the room's face and the outer one: a solid wall
+	for off in (0.0, REVEAL)[:faces]:  # the room's face and the outer one: a solid wall
 		s = lo
 		for s0, s1, y0, y1 in cuts:  # columns beside and between the holes
 			if s0 > s:
@@ -121,7 +123,7 @@ def l_room():
 	return objs, portals, (3.6, 1.4, 0.4), (0.8, 1.0, 5.5)
 
 
-def terrace():
+def terrace(faces=2):
 	objs = []
 	f, c = floor_ceiling(0.0, 5.0, 0.0, 4.0)
 	objs += [("floor", f, "floor"), ("ceiling", c, "ceiling")]
@@ -130,7 +132,7 @@ def terrace():
 	for name, args in (("wall_back", ("z", 0.0, 0.0, 5.0, 1, [])), ("wall_east", ("x", 5.0, 0.0, 4.0, -1, [])),
 			   ("wall_garden", ("z", 4.0, 0.0, 5.0, -1, [door])),
 			   ("wall_west", ("x", 0.0, 0.0, 4.0, 1, [(1.2, 2.0, 1.8, 2.4)]))):
-		m, ps = wall(*args)
+		m, ps = wall(*args, faces=faces)
 		objs.append((name, m, "wall"))
 		portals += ps
 	zp = 4.0 + 0.5 * REVEAL  # the pane in the middle of the wall's depth
@@ -141,7 +143,7 @@ def terrace():
 	return objs, portals, (4.5, 1.5, 0.5), (2.0, 1.0, 4.0)
 
 
-def write(path, objs, portals, eye, target):
+def write(path, objs, portals, eye, target, env):
 	blob = bytearray()
 	views, accessors, meshes, nodes = [], [], [], []
 
@@ -186,7 +188,7 @@ def write(path, objs, portals, eye, target):
 		"extensionsUsed": ["KHR_materials_specular", "KHR_materials_transmission"],
 		"scene": 0,
 		"scenes": [{"name": "Scene", "nodes": list(range(len(nodes))),
-			    "extras": {"environment": {"image": "forest.exr", "strength": 1.0, "rotation": 40.0}}}],
+			    "extras": {"environment": env}}],
 		"nodes": nodes, "meshes": meshes, "materials": MATERIALS,
 		"cameras": [{"name": "camera", "type": "perspective",
 			     "perspective": {"yfov": 1.0, "aspectRatio": 1.0, "znear": 0.01}}],
@@ -201,14 +203,23 @@ def write(path, objs, portals, eye, target):
 
 
 def main():
-	if len(sys.argv) != 2:
+	args = sys.argv[1:]
+	color = None
+	if len(args) == 3 and args[0] == "--sky-color":
+		color = [float(c) for c in args[1].split(",")]
+		args = args[2:]
+	if len(args) != 1 or (color is not None and len(color) != 3):
 		sys.exit(__doc__)
-	out = sys.argv[1]
+	out = args[0]
 	os.makedirs(out, exist_ok=True)
-	shutil.copyfile(os.path.join(HERE, "..", "..", "scenes", "skies", "forest.exr"), os.path.join(out, "forest.exr"))
-	for name, make in (("l-room", l_room), ("terrace", terrace)):
+	if color is None:
+		shutil.copyfile(os.path.join(HERE, "..", "..", "scenes", "skies", "forest.exr"), os.path.join(out, "forest.exr"))
+		env = {"image": "forest.exr", "strength": 1.0, "rotation": 40.0}
+	else:
+		env = {"color": color}
+	for name, make in (("l-room", l_room), ("terrace", terrace), ("terrace-one-face", lambda: terrace(1))):
 		objs, portals, eye, target = make()
-		write(os.path.join(out, name + ".gltf"), objs, portals, eye, target)
+		write(os.path.join(out, name + ".gltf"), objs, portals, eye, target, env)
 
 
 if __name__ == "__main__":
