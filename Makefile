@@ -343,7 +343,8 @@ bench-portals:
 	python3 tests/bench/make_layouts.py $(BUILD)/layouts
 	python3 scenes/door-ajar/make_door_ajar.py --angle 35 --name door-ajar-35 --out $(BUILD)/layouts
 	$(BUILD)/tests/bench_portals scenes/door-ajar/door-ajar-20.gltf $(BUILD)/layouts/door-ajar-35.gltf \
-		$(BUILD)/layouts/l-room.gltf $(BUILD)/layouts/terrace.gltf $(BUILD)/layouts/terrace-one-face.gltf
+		$(BUILD)/layouts/l-room.gltf $(BUILD)/layouts/terrace.gltf $(BUILD)/layouts/terrace-one-face.gltf \
+		$(BUILD)/layouts/bay.gltf $(BUILD)/layouts/skylight.gltf
 
 # The shared library is installed under its full version with the soname
 # (libajar.so.0, as the link rule sets it) and the development name as links.

@@ -3,9 +3,10 @@
 
   make_layouts.py [--sky-color R,G,B] OUTDIR
 
-Writes OUTDIR/l-room.gltf, terrace.gltf and terrace-one-face.gltf (each with its
-.bin and a copy of scenes/skies/forest.exr), under the forest sky (or a sky of one
-colour: tests/data/layouts, test_portal_find), each opening marked by hand with a
+Writes OUTDIR/l-room.gltf, terrace.gltf, terrace-one-face.gltf, bay.gltf and
+skylight.gltf (each with its .bin and a copy of scenes/skies/forest.exr), under the
+forest sky (or a sky of one colour: tests/data/layouts, test_portal_find), each
+opening marked by hand with a
 portal node (extras.portal) as a user would place it: on the room's face of the
 wall, the size of the opening. `make bench-portals` takes them as arguments
 (tests/bench/bench_portals.c) to compare the portals Ajar finds with the marked ones
@@ -19,6 +20,10 @@ on layouts the search was not tuned on:
            garden (a ground plane and a hedge outside), and a small open window
            high in the side wall; terrace-one-face the same with walls of one
            face (the room's, and the openings' reveals), as quick models have.
+  bay      a row of three windows (mullions of 10 cm) under a balcony slab,
+           a ground outside, and a window in the side wall.
+  skylight a room under a 30 cm roof slab with a 1 x 1 m skylight the camera
+           does not see, and a small window.
 
 Python 3 standard library only; the same bytes on every run.
 """
@@ -143,6 +148,51 @@ def terrace(faces=2):
 	return objs, portals, (4.5, 1.5, 0.5), (2.0, 1.0, 4.0)
 
 
+def bay():
+	objs = []
+	f, c = floor_ceiling(0.0, 6.0, 0.0, 4.0)
+	objs += [("floor", f, "floor"), ("ceiling", c, "ceiling")]
+	portals = []
+	row = [(0.9 + 1.0 * k, 1.8 + 1.0 * k, 0.8, 2.2) for k in range(3)]  # mullions of 10 cm
+	for name, args in (("wall_back", ("z", 0.0, 0.0, 6.0, 1, [])), ("wall_west", ("x", 0.0, 0.0, 4.0, 1, [])),
+			   ("wall_bay", ("z", 4.0, 0.0, 6.0, -1, row)),
+			   ("wall_east", ("x", 6.0, 0.0, 4.0, -1, [(1.0, 2.2, 0.9, 2.1)]))):
+		m, ps = wall(*args)
+		objs.append((name, m, "wall"))
+		portals += ps
+	objs.append(("balcony", Mesh().box(-1.0, 2.7, 4.0 + REVEAL, 7.0, 2.9, 5.6), "wall"))
+	objs.append(("ground", Mesh().quad((-20.0, -0.01, 4.0 + REVEAL), (-20.0, -0.01, 30.0), (25.0, -0.01, 30.0), (25.0, -0.01, 4.0 + REVEAL)), "ground"))
+	objs.append(("desk", Mesh().box(1.0, 0.0, 3.0, 3.5, 0.75, 3.7, bottom=False), "furniture"))
+	return objs, portals, (5.4, 1.5, 0.4), (2.2, 1.2, 4.0)
+
+
+def skylight():
+	"""A 4 x 4 m room under a roof slab 0.3 m thick with a 1 x 1 m skylight, and a
+	small window; the camera does not see the sky through the skylight."""
+	objs = []
+	f, _ = floor_ceiling(0.0, 4.0, 0.0, 4.0)
+	objs.append(("floor", f, "floor"))
+	x0, x1, z0, z1, t = 1.6, 2.6, 1.4, 2.4, 0.3
+	ceiling, roof = Mesh(), Mesh()
+	for a0, a1, b0, b1 in ((0.0, 4.0, 0.0, z0), (0.0, 4.0, z1, 4.0), (0.0, x0, z0, z1), (x1, 4.0, z0, z1)):
+		ceiling.quad((a0, H, b0), (a1, H, b0), (a1, H, b1), (a0, H, b1))
+		roof.quad((a0, H + t, b0), (a0, H + t, b1), (a1, H + t, b1), (a1, H + t, b0))
+	shaft = Mesh()
+	shaft.quad((x0, H, z0), (x0, H + t, z0), (x1, H + t, z0), (x1, H, z0))
+	shaft.quad((x0, H, z1), (x1, H, z1), (x1, H + t, z1), (x0, H + t, z1))
+	shaft.quad((x0, H, z0), (x0, H, z1), (x0, H + t, z1), (x0, H + t, z0))
+	shaft.quad((x1, H, z0), (x1, H + t, z0), (x1, H + t, z1), (x1, H, z1))
+	objs += [("ceiling", ceiling, "ceiling"), ("roof", roof, "wall"), ("shaft", shaft, "wall")]
+	portals = [Mesh().quad((x0, H, z0), (x1, H, z0), (x1, H, z1), (x0, H, z1))]
+	for name, args in (("wall_back", ("z", 0.0, 0.0, 4.0, 1, [(2.6, 3.4, 1.2, 2.0)])), ("wall_front", ("z", 4.0, 0.0, 4.0, -1, [])),
+			   ("wall_west", ("x", 0.0, 0.0, 4.0, 1, [])), ("wall_east", ("x", 4.0, 0.0, 4.0, -1, []))):
+		m, ps = wall(*args)
+		objs.append((name, m, "wall"))
+		portals += ps
+	objs.append(("table", Mesh().box(1.4, 0.0, 1.6, 2.6, 0.75, 2.4, bottom=False), "furniture"))
+	return objs, portals, (3.6, 1.4, 3.6), (1.5, 0.8, 1.0)
+
+
 def write(path, objs, portals, eye, target, env):
 	blob = bytearray()
 	views, accessors, meshes, nodes = [], [], [], []
@@ -217,7 +267,8 @@ def main():
 		env = {"image": "forest.exr", "strength": 1.0, "rotation": 40.0}
 	else:
 		env = {"color": color}
-	for name, make in (("l-room", l_room), ("terrace", terrace), ("terrace-one-face", lambda: terrace(1))):
+	for name, make in (("l-room", l_room), ("terrace", terrace), ("terrace-one-face", lambda: terrace(1)),
+			   ("bay", bay), ("skylight", skylight)):
 		objs, portals, eye, target = make()
 		write(os.path.join(out, name + ".gltf"), objs, portals, eye, target, env)
 

@@ -10,7 +10,9 @@
  *   printed). Each found portal overlaps a marked one (none where there is
  *   no opening).
  * - Layouts not tuned on (tests/data/layouts): an L-shaped room, a glazed
- *   terrace door with solid walls and with walls of one face.
+ *   terrace door with solid walls and with walls of one face, a row of
+ *   windows under a balcony, a skylight; and no found portal larger than
+ *   1.5 times the bounding rectangle of the marked openings it covers.
  * - door-ajar-20 (the door opened 20 degrees): the gap, a quarter of the
  *   doorway, is covered with the gap's normal (the doorway's face, found
  *   first, turned onto the gap's section).
@@ -336,16 +338,18 @@ static void test_covers_doors_and_bathroom(void **state)
 }
 
 /* Layouts the search was not tuned on (tests/data/layouts/README.md): an
- * L-shaped room whose windows the camera's leg does not see, and a room
- * with a glazed door to a garden, its walls solid and of one face (where
- * the garden seen through the glass once made the door's portal 3.4 m wide
- * instead of 1.6). */
+ * L-shaped room whose windows the camera's leg does not see; a room with a
+ * glazed door to a garden, its walls solid and of one face (where the
+ * garden seen through the glass once made the door's portal 3.4 m wide
+ * instead of 1.6); a row of windows under a balcony; a skylight. */
 static void test_covers_layouts(void **state)
 {
 	(void)state;
 	check_covers("tests/data/layouts/l-room.gltf");
 	check_covers("tests/data/layouts/terrace.gltf");
 	check_covers("tests/data/layouts/terrace-one-face.gltf");
+	check_covers("tests/data/layouts/bay.gltf");
+	check_covers("tests/data/layouts/skylight.gltf");
 }
 
 /* The thin triangle over door-ajar's leaf top (the marked portal's part
