@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "prepare/found_portals.h"
+#include "prepare/portal_slide.h"
 #include "prepare/pane_planes.h"
 #include "prepare/policy.h"
 #include "prepare/portal_flux.h"
@@ -152,7 +153,23 @@ static void *dup_array(const void *p, size_t n, size_t size)
 	return q;
 }
 
-/* The portals the render uses (policy_portals): the scene's marked ones,
+/* What the host's traversal sees of d's geometry. */
+static void prepared_view(const SceneData *d, SceneView *v)
+{
+	memset(v, 0, sizeof *v);
+	v->nodes = d->nodes;
+	v->tris = d->tris;
+	v->shade = d->shade;
+	v->extra = d->extra;
+	v->materials = d->materials;
+	v->textures = d->textures;
+	v->texels = d->texels;
+	v->instances = d->instances;
+	v->params = d->params;
+}
+
+/* The portals the render uses (policy_portals): the scene's marked ones
+ * (moved out through the tunnels they lie in, portal_slide.c),
  * those the search finds from the camera (portal_find.c, on the BVH just
  * built), or none. d's triangles, shading and materials must be set. */
 static ajar_status choose_portals(const Scene *s, const ajar_options *o, SceneData *d)
@@ -163,16 +180,7 @@ static ajar_status choose_portals(const Scene *s, const ajar_options *o, SceneDa
 		n = s->nportal_tris;
 	} else if (d->portal_source == POLICY_PORTALS_FOUND) {
 		SceneView v;
-		memset(&v, 0, sizeof v);
-		v.nodes = d->nodes;
-		v.tris = d->tris;
-		v.shade = d->shade;
-		v.extra = d->extra;
-		v.materials = d->materials;
-		v.textures = d->textures;
-		v.texels = d->texels;
-		v.instances = d->instances;
-		v.params = d->params;
+		prepared_view(d, &v);
 		PortalFindInput in;
 		portal_find_input(s, &in);
 		/* The flat triangles come first (scene_bvh.c); instances' are
@@ -188,8 +196,18 @@ static ajar_status choose_portals(const Scene *s, const ajar_options *o, SceneDa
 	d->portals = malloc(sizeof *d->portals * (n ? n : 1));
 	if (!d->portals)
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory for %u portal triangles", s->source, n);
-	if (d->portal_source == POLICY_PORTALS_MARKED)
+	if (d->portal_source == POLICY_PORTALS_MARKED) {
 		memcpy(d->portals, s->portals, sizeof *d->portals * n);
+		SceneView v;
+		prepared_view(d, &v);
+		V3 cam, fwd, up;
+		float yfov;
+		scene_camera(s, &cam, &fwd, &up, &yfov);
+		uint32_t moved = portal_slide_marked(&v, d->portals, n, cam);
+		if (moved)
+			log_msg(AJAR_LOG_INFO, "%s: %u marked portal triangle%s moved out through the opening%s they mark", s->source,
+				moved, moved == 1 ? "" : "s", moved == 1 ? " it" : "s");
+	}
 	for (uint32_t i = 0; d->portal_source == POLICY_PORTALS_FOUND && i < d->found.count; i++)
 		portal_found_tris(&d->found.portals[i], d->portals + 2 * i);
 	d->n_portals = n;

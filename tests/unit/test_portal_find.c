@@ -24,6 +24,8 @@
  *   emitter in it, two closed rooms with an emitter in the other, a room
  *   with a window but no sky (the lamp inside lights it); the same room
  *   under a sky gets one portal over its window.
+ * - Marked portals slide out through the tunnel they lie in (a skylight
+ *   in a roof slab, a window in a thick wall) and stay where no tunnel is.
  * - The same portals twice, bit for bit; ajar_scene_find_portals and a
  *   prepared scene (ajar_options.portals) give the search's portals; the
  *   policy's table of which portals a render takes. */
@@ -612,6 +614,46 @@ static void test_deterministic(void **state)
 	ajar_scene_destroy(&s);
 }
 
+/* Marked portals move out through the tunnel they lie in (portal_slide.c):
+ * on tests/data/layouts/skylight.gltf the skylight marked at the ceiling,
+ * under a 30 cm slab, goes up by the slab's depth (to half a step before
+ * the roof's face), and the window marked on its wall's room face out to
+ * the far face, 25 cm; window-room's marked
+ * portal, in no tunnel, stays where it is, bit for bit. */
+static void check_slide(const char *path, float up_lo, float up_hi, float out_lo, float out_hi)
+{
+	Scene *s;
+	assert_int_equal(ajar_scene_load(path, &s), AJAR_OK);
+	ajar_options o;
+	ajar_options_default(&o);
+	o.max_depth = 8;
+	SceneData d;
+	assert_int_equal(prepare_scene(s, &o, 8, 8, NULL, &d), AJAR_OK);
+	assert_int_equal(d.n_portals, s->nportal_tris);
+	for (uint32_t i = 0; i < s->nportal_tris; i++) {
+		const PortalTri *a = &s->portals[i], *b = &d.portals[i];
+		V3 sh[3] = {v3_sub(b->p0, a->p0), v3_sub(b->p1, a->p1), v3_sub(b->p2, a->p2)};
+		for (int k = 0; k < 3; k++) {
+			float along = v3_dot(sh[k], a->n), rest = v3_len(v3_madd(sh[k], a->n, -along));
+			int up = fabsf(a->n.y) > 0.9f;
+			float lo = up ? up_lo : out_lo, hi = up ? up_hi : out_hi;
+			print_message("%s: triangle %u moved %.4f along its normal\n", path, i, along);
+			if (!(fabsf(along) >= lo && fabsf(along) <= hi && rest < 1e-5f))
+				fail_msg("%s: marked portal triangle %u moved %.4f (and %.2g across), not %.3f..%.3f", path, i,
+					 along, rest, lo, hi);
+		}
+	}
+	prepare_free(&d);
+	ajar_scene_destroy(&s);
+}
+
+static void test_marked_slide(void **state)
+{
+	(void)state;
+	check_slide("tests/data/layouts/skylight.gltf", 0.27f, 0.3f, 0.22f, 0.25f);
+	check_slide(SCENE("window-room/window-room.gltf"), 0.0f, 0.0f, 0.0f, 0.0f);
+}
+
 static void test_policy_portals(void **state)
 {
 	(void)state;
@@ -635,6 +677,7 @@ int main(void)
 		cmocka_unit_test(test_covers_doors_and_bathroom),
 		cmocka_unit_test(test_covers_leaf_top),
 		cmocka_unit_test(test_covers_layouts),
+		cmocka_unit_test(test_marked_slide),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
