@@ -175,15 +175,18 @@ static void build_subtree(Build *b, Task root)
 			max_depth = task.depth + 1;
 		BinNode *node = &b->bn[id];
 		box4_store(&node->b, task.nb.box);
-		uint32_t n = task.end - task.start;
-		SplitPlan plan;
-		bvh_split_plan(n, &task.nb.cbox, task.depth, b->inst_from, b->nan_free, &plan);
-		if (plan.nb && n > BVH_FEW) { /* fewer are split without bins (bvh_split.c) */
-			bvh_bins_clear(&bins, plan.nb);
-			bvh_bins_add(&bins, &plan, b->refs, task.start, task.end);
-		}
+		uint32_t n = task.end - task.start, nleft;
 		NodeBounds child[2];
-		uint32_t nleft = bvh_split_apply(b->refs + task.start, n, &node->b, &plan, &bins, child);
+		if (n != 2 || !bvh_split_two(b->refs + task.start, &node->b, &task.nb.cbox, task.depth, b->inst_from,
+					     b->nan_free, &nleft, child)) {
+			SplitPlan plan;
+			bvh_split_plan(n, &task.nb.cbox, task.depth, b->inst_from, b->nan_free, &plan);
+			if (plan.nb && n > BVH_FEW) { /* fewer are split without bins (bvh_split.c) */
+				bvh_bins_clear(&bins, plan.nb);
+				bvh_bins_add(&bins, &plan, b->refs, task.start, task.end);
+			}
+			nleft = bvh_split_apply(b->refs + task.start, n, &node->b, &plan, &bins, child);
+		}
 		if (nleft == 0) {
 			node->index = (int)task.start;
 			node->count = (int)n;
