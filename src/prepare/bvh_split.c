@@ -188,15 +188,18 @@ static inline float box4_area(Box4 b) { return f4_half_area(f4_sub(b.hi, b.lo));
 
 #if defined(__SSE2__)
 /* Half the areas of three boxes' extents d0, d1, d2 in lanes 0-2: each
- * f4_half_area's products and sums in its order, lane by lane. */
-static inline __m128 half_area3(__m128 d0, __m128 d1, __m128 d2)
+ * f4_half_area's products and sums in its order, lane by lane; with
+ * zero_neg, 0 where an extent is negative, as f4_half_area gives. */
+static inline __m128 half_area3(__m128 d0, __m128 d1, __m128 d2, int zero_neg)
 {
 	__m128 t0 = _mm_unpacklo_ps(d0, d1), t1 = _mm_unpackhi_ps(d0, d1);
 	__m128 x = _mm_movelh_ps(t0, d2), y = _mm_shuffle_ps(t0, d2, _MM_SHUFFLE(3, 1, 3, 2));
 	__m128 z = _mm_shuffle_ps(t1, d2, _MM_SHUFFLE(3, 2, 1, 0));
+	__m128 a = _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, y), _mm_mul_ps(y, z)), _mm_mul_ps(z, x));
+	if (!zero_neg)
+		return a;
 	__m128 zero = _mm_setzero_ps();
 	__m128 neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(x, zero), _mm_cmplt_ps(y, zero)), _mm_cmplt_ps(z, zero));
-	__m128 a = _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, y), _mm_mul_ps(y, z)), _mm_mul_ps(z, x));
 	return _mm_andnot_ps(neg, a);
 }
 
@@ -216,10 +219,10 @@ static inline __m128i grow3(Box4 acc[3], const Bins *bins, int k)
 	return _mm_castps_si128(c);
 }
 
-static inline __m128 area3(const Box4 acc[3])
+static inline __m128 area3(const Box4 acc[3], int zero_neg)
 {
 	return half_area3(_mm_sub_ps(acc[0].hi, acc[0].lo), _mm_sub_ps(acc[1].hi, acc[1].lo),
-			  _mm_sub_ps(acc[2].hi, acc[2].lo));
+			  _mm_sub_ps(acc[2].hi, acc[2].lo), zero_neg);
 }
 
 /* The cheapest SAH split over the bins (the scalar sah_sweep below, for
@@ -230,7 +233,8 @@ static inline __m128 area3(const Box4 acc[3])
  * and the axes are then compared in order with strict <, as the scalar
  * scan over axis after axis compares them. Empty bins are swept too:
  * they change nothing, and a split after one is never strictly cheaper. */
-static int sah_sweep(const Bins *bins, const SplitPlan *p, int *best_bin, float *best_cost)
+static inline __attribute__((always_inline)) int sah_sweep_lanes(const Bins *bins, const SplitPlan *p,
+								  int *best_bin, float *best_cost, int zero_neg)
 {
 	int nb = p->nb;
 	__m128 right_area[BVH_BINS];
@@ -239,7 +243,7 @@ static int sah_sweep(const Bins *bins, const SplitPlan *p, int *best_bin, float 
 	__m128i cnt = _mm_setzero_si128(), zero = _mm_setzero_si128();
 	for (int k = nb - 1; k > 0; k--) {
 		cnt = _mm_add_epi32(cnt, grow3(acc, bins, k));
-		right_area[k] = area3(acc);
+		right_area[k] = area3(acc, zero_neg);
 		right_count[k] = cnt;
 	}
 	__m128i axes = _mm_setr_epi32(p->ext[0] > 0.0f ? -1 : 0, p->ext[1] > 0.0f ? -1 : 0,
@@ -250,7 +254,7 @@ static int sah_sweep(const Bins *bins, const SplitPlan *p, int *best_bin, float 
 	cnt = zero;
 	for (int k = 0; k < nb - 1; k++) {
 		cnt = _mm_add_epi32(cnt, grow3(acc, bins, k));
-		__m128 cost = _mm_add_ps(_mm_mul_ps(area3(acc), _mm_cvtepi32_ps(cnt)),
+		__m128 cost = _mm_add_ps(_mm_mul_ps(area3(acc, zero_neg), _mm_cvtepi32_ps(cnt)),
 					 _mm_mul_ps(right_area[k + 1], _mm_cvtepi32_ps(right_count[k + 1])));
 		__m128i valid = _mm_and_si128(axes, _mm_and_si128(_mm_cmpgt_epi32(cnt, zero),
 								   _mm_cmpgt_epi32(right_count[k + 1], zero)));
@@ -273,6 +277,18 @@ static int sah_sweep(const Bins *bins, const SplitPlan *p, int *best_bin, float 
 			best_axis = a;
 		}
 	return best_axis;
+}
+
+/* A box of at least one triangle has lo <= hi in every lane where no
+ * corner is NaN (a ref's bounds are its corners' min and max), so among
+ * NaN-free triangles only an empty side has a negative extent, and its
+ * cost is never taken (its count is 0): the areas need not zero them
+ * (some 8% of the sweep). Instances' boxes are the caller's. */
+static int sah_sweep(const Bins *bins, const SplitPlan *p, int *best_bin, float *best_cost)
+{
+	if (p->nan_free && p->inst_from == UINT32_MAX)
+		return sah_sweep_lanes(bins, p, best_bin, best_cost, 0);
+	return sah_sweep_lanes(bins, p, best_bin, best_cost, 1);
 }
 #else
 /* The cheapest SAH split over the bins: its axis (-1 if none) and the
