@@ -79,17 +79,31 @@ static inline void bin_grow(Box4 *bin, Box4 r)
 	bin->hi = f4_count1(f4_max(r.hi, bin->hi));
 }
 
-/* Bins one ref: (int)((key - cmin) * scale) clamped to [0, nb - 1], as
- * the float clamped before truncation: the same bin for every value. */
-static inline void bin_ref(Bins *b, const Ref *ref, F4 cmin, F4 scale, F4 top)
+/* One ref's box and bins: (int)((key - cmin) * scale) clamped to
+ * [0, nb - 1], as the float clamped before truncation: the same bin for
+ * every value. Binning is split in two, finding a ref's bins and growing
+ * them (ref_bins_grow), so a loop can find the next refs' bins before it
+ * grows this one's: every store's address is then known before the bin
+ * loads after it issue, which need not wait on it or guess. */
+typedef struct {
+	Box4 r;
+	int k[3];
+} RefBins;
+
+static inline RefBins ref_bins(const Ref *ref, F4 cmin, F4 scale, F4 top)
 {
-	Box4 r = box4_of_ref(ref);
-	F4 f = f4_mul(f4_sub(f4_add(r.lo, r.hi), cmin), scale);
-	int k0, k1, k2;
-	f4_trunc3(f4_min(f4_max(f, f4_zero()), top), &k0, &k1, &k2);
-	bin_grow(&b->box[0][k0], r);
-	bin_grow(&b->box[1][k1], r);
-	bin_grow(&b->box[2][k2], r);
+	RefBins q;
+	q.r = box4_of_ref(ref);
+	F4 f = f4_mul(f4_sub(f4_add(q.r.lo, q.r.hi), cmin), scale);
+	f4_trunc3(f4_min(f4_max(f, f4_zero()), top), &q.k[0], &q.k[1], &q.k[2]);
+	return q;
+}
+
+static inline void ref_bins_grow(Bins *b, const RefBins *q)
+{
+	bin_grow(&b->box[0][q->k[0]], q->r);
+	bin_grow(&b->box[1][q->k[1]], q->r);
+	bin_grow(&b->box[2][q->k[2]], q->r);
 }
 
 void bvh_bins_add(Bins *b, const SplitPlan *p, const Ref *refs, uint32_t start, uint32_t end)
@@ -102,30 +116,59 @@ void bvh_bins_add(Bins *b, const SplitPlan *p, const Ref *refs, uint32_t start, 
 	 * others wait on their stores: against two sets from 256 refs on,
 	 * unique-1m 0.86x and bathroom 0.92x the CPU of the whole build. The
 	 * merged boxes may differ from one pass's only in the sign of a zero,
-	 * which neither their areas nor the split see. */
+	 * which neither their areas nor the split see. Each loop finds the
+	 * bins of the refs after the ones it grows (ref_bins): the binning
+	 * 0.8x its cycles on unique-1m, the build 0.94x (bathroom 0.96x). */
 	if (end - start >= 256) {
 		Bins more[3];
 		for (int k = 0; k < 3; k++)
 			bvh_bins_clear(&more[k], p->nb);
-		for (; i + 3 < end; i += 4) {
-			bin_ref(b, &refs[i], cmin, scale, top);
-			bin_ref(&more[0], &refs[i + 1], cmin, scale, top);
-			bin_ref(&more[1], &refs[i + 2], cmin, scale, top);
-			bin_ref(&more[2], &refs[i + 3], cmin, scale, top);
+		RefBins q0 = ref_bins(&refs[i], cmin, scale, top), q1 = ref_bins(&refs[i + 1], cmin, scale, top);
+		RefBins q2 = ref_bins(&refs[i + 2], cmin, scale, top), q3 = ref_bins(&refs[i + 3], cmin, scale, top);
+		for (; i + 7 < end; i += 4) {
+			RefBins n0 = ref_bins(&refs[i + 4], cmin, scale, top), n1 = ref_bins(&refs[i + 5], cmin, scale, top);
+			RefBins n2 = ref_bins(&refs[i + 6], cmin, scale, top), n3 = ref_bins(&refs[i + 7], cmin, scale, top);
+			ref_bins_grow(b, &q0);
+			ref_bins_grow(&more[0], &q1);
+			ref_bins_grow(&more[1], &q2);
+			ref_bins_grow(&more[2], &q3);
+			q0 = n0;
+			q1 = n1;
+			q2 = n2;
+			q3 = n3;
 		}
+		ref_bins_grow(b, &q0);
+		ref_bins_grow(&more[0], &q1);
+		ref_bins_grow(&more[1], &q2);
+		ref_bins_grow(&more[2], &q3);
+		i += 4;
 		for (int k = 0; k < 3; k++)
 			bvh_bins_merge(b, &more[k], p->nb);
 	} else if (end - start >= 64) {
 		Bins odd;
 		bvh_bins_clear(&odd, p->nb);
-		for (; i + 1 < end; i += 2) {
-			bin_ref(b, &refs[i], cmin, scale, top);
-			bin_ref(&odd, &refs[i + 1], cmin, scale, top);
+		RefBins q0 = ref_bins(&refs[i], cmin, scale, top), q1 = ref_bins(&refs[i + 1], cmin, scale, top);
+		for (; i + 3 < end; i += 2) {
+			RefBins n0 = ref_bins(&refs[i + 2], cmin, scale, top), n1 = ref_bins(&refs[i + 3], cmin, scale, top);
+			ref_bins_grow(b, &q0);
+			ref_bins_grow(&odd, &q1);
+			q0 = n0;
+			q1 = n1;
 		}
+		ref_bins_grow(b, &q0);
+		ref_bins_grow(&odd, &q1);
+		i += 2;
 		bvh_bins_merge(b, &odd, p->nb);
 	}
-	for (; i < end; i++)
-		bin_ref(b, &refs[i], cmin, scale, top);
+	if (i < end) {
+		RefBins q0 = ref_bins(&refs[i], cmin, scale, top);
+		for (; i + 1 < end; i++) {
+			RefBins n0 = ref_bins(&refs[i + 1], cmin, scale, top);
+			ref_bins_grow(b, &q0);
+			q0 = n0;
+		}
+		ref_bins_grow(b, &q0);
+	}
 }
 
 void bvh_bins_merge(Bins *acc, const Bins *later, int nb)
@@ -357,7 +400,7 @@ static int sweep_few(const Ref *refs, uint32_t n, const SplitPlan *p, int *best_
 	F4 top = f4_splat((float)(p->nb - 1));
 	Box4 r[BVH_FEW];
 	int k[BVH_FEW][3];
-	for (uint32_t i = 0; i < n; i++) { /* bin_ref's bins */
+	for (uint32_t i = 0; i < n; i++) { /* ref_bins' bins */
 		r[i] = box4_of_ref(&refs[i]);
 		F4 f = f4_mul(f4_sub(f4_add(r[i].lo, r[i].hi), cmin), scale);
 		f4_trunc3(f4_min(f4_max(f, f4_zero()), top), &k[i][0], &k[i][1], &k[i][2]);
