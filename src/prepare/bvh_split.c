@@ -112,14 +112,18 @@ void bvh_bins_add(Bins *b, const SplitPlan *p, const Ref *refs, uint32_t start, 
 	F4 top = f4_splat((float)(p->nb - 1));
 	uint32_t i = start;
 	/* Neighbouring refs often share a bin; dealing them out over four
-	 * sets of bins (two below 256 refs) lets each update run while the
-	 * others wait on their stores: against two sets from 256 refs on,
-	 * unique-1m 0.86x and bathroom 0.92x the CPU of the whole build. The
-	 * merged boxes may differ from one pass's only in the sign of a zero,
-	 * which neither their areas nor the split see. Each loop finds the
-	 * bins of the refs after the ones it grows (ref_bins): the binning
-	 * 0.8x its cycles on unique-1m, the build 0.94x (bathroom 0.96x). */
-	if (end - start >= 256) {
+	 * sets of bins (two below 4096 refs, one below 256) lets each update
+	 * run while the others wait on their stores: against two sets from
+	 * 256 refs on, unique-1m 0.86x and bathroom 0.92x the CPU of the
+	 * whole build. The merged boxes may differ from one pass's only in
+	 * the sign of a zero, which neither their areas nor the split see.
+	 * Each loop finds the bins of the refs after the ones it grows
+	 * (ref_bins): the binning 0.8x its cycles on unique-1m, the build
+	 * 0.94x (bathroom 0.96x). Since then fewer sets pay below 4096 refs
+	 * (clearing and merging them cost more than they save): nodes of
+	 * 32-1023 refs bin in 0.9x the cycles they took with four sets from
+	 * 256 and two from 64. */
+	if (end - start >= 4096) {
 		Bins more[3];
 		for (int k = 0; k < 3; k++)
 			bvh_bins_clear(&more[k], p->nb);
@@ -144,7 +148,7 @@ void bvh_bins_add(Bins *b, const SplitPlan *p, const Ref *refs, uint32_t start, 
 		i += 4;
 		for (int k = 0; k < 3; k++)
 			bvh_bins_merge(b, &more[k], p->nb);
-	} else if (end - start >= 64) {
+	} else if (end - start >= 256) {
 		Bins odd;
 		bvh_bins_clear(&odd, p->nb);
 		RefBins q0 = ref_bins(&refs[i], cmin, scale, top), q1 = ref_bins(&refs[i + 1], cmin, scale, top);
