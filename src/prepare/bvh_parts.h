@@ -297,6 +297,10 @@ typedef struct {
 
 void bvh_split_plan(uint32_t n, const Box4 *cbox, uint32_t depth, uint32_t inst_from, int nan_free, SplitPlan *p);
 void bvh_bins_clear(Bins *b, int nb);
+/* bvh_split_plan and bvh_split_apply on a node of two refs where their
+ * outcome is plain (bvh_split.c); 0 where they must decide. */
+int bvh_split_two(Ref *refs, const Box *box, const Box4 *cbox, uint32_t depth, uint32_t inst_from, int nan_free,
+		  uint32_t *nleft, NodeBounds child[2]);
 /* Bins refs [start, end) into b. */
 void bvh_bins_add(Bins *b, const SplitPlan *p, const Ref *refs, uint32_t start, uint32_t end);
 /* acc += later, the bins of refs after acc's. */
