@@ -62,11 +62,15 @@ static void check_path(const SceneView *sc, const PathRef *P, MisStats *st)
 			diff = fmax(diff, rel_diff(rec[i].pf, orc[i].pf));
 		if (i == 0)
 			diff = fmax(diff, rel_diff(rec[0].pn, orc[0].pn));
-		st->records++;
-		st->off += diff > 1e-2;
 		/* Narrow glossy lobes amplify the ray-offset direction change
-		 * (mis_oracle.h); bugs are systematic and fail the 1% count. */
-		if ((diff > 0.5 && !near_contact(x, k, i, sc->params->scene_radius)) || rec[i].delta != orc[i].delta)
+		 * (mis_oracle.h), most where an edge near the vertex is short
+		 * (near_contact): such records are not counted, as one such path
+		 * repeats in many strategies. Bugs are systematic and fail the 1%
+		 * count. */
+		int contact = near_contact(x, k, i, sc->params->scene_radius);
+		st->records += !contact;
+		st->off += diff > 1e-2 && !contact;
+		if ((diff > 0.5 && !contact) || rec[i].delta != orc[i].delta)
 			fail_msg("path (s=%d, s'=%d, t'=%d, t=%d), vertex %d of %d: kernel pf %g pr %g pn %g delta %d, "
 				 "oracle pf %g pr %g pn %g delta %d",
 				 P->s, P->sp, P->tp, P->t, i, k, rec[i].pf, rec[i].pr, i ? 0 : rec[0].pn, rec[i].delta,
@@ -253,9 +257,9 @@ static void test_join_weights(void **state)
 	for (int i = 0; i < 2; i++) {
 		HostScene h;
 		host_scene_open(&h, scenes[i], NULL, 24, 24, INTEGRATOR_PORTAL, 8);
-		assert_true(check_join_weights(&h, 150) > 1000);
+		assert_true(check_join_weights(&h, 200) > 1000);
 		use_all_portal_strategies(&h);
-		assert_true(check_join_weights(&h, 60) > 1000);
+		assert_true(check_join_weights(&h, 80) > 1000);
 		host_scene_close(&h);
 	}
 }
