@@ -196,21 +196,25 @@ static ajar_status choose_portals(const Scene *s, const ajar_options *o, SceneDa
 	d->portals = malloc(sizeof *d->portals * (n ? n : 1));
 	if (!d->portals)
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory for %u portal triangles", s->source, n);
-	if (d->portal_source == POLICY_PORTALS_MARKED) {
+	if (d->portal_source == POLICY_PORTALS_MARKED)
 		memcpy(d->portals, s->portals, sizeof *d->portals * n);
+	for (uint32_t i = 0; d->portal_source == POLICY_PORTALS_FOUND && i < d->found.count; i++)
+		portal_found_tris(&d->found.portals[i], d->portals + 2 * i);
+	d->n_portals = n;
+	/* Marked or found, each out to the far end of the tunnel it lies in:
+	 * the search's own slide stops where its sampled tests first fail, a
+	 * window's frame or mullions before its far face. */
+	if (n) {
 		SceneView v;
 		prepared_view(d, &v);
 		V3 cam, fwd, up;
 		float yfov;
 		scene_camera(s, &cam, &fwd, &up, &yfov);
-		uint32_t moved = portal_slide_marked(&v, d->portals, n, cam);
+		uint32_t moved = portal_slide(&v, d->portals, n, cam);
 		if (moved)
-			log_msg(AJAR_LOG_INFO, "%s: %u marked portal triangle%s moved out through the opening%s they mark", s->source,
+			log_msg(AJAR_LOG_INFO, "%s: %u portal triangle%s moved out through the opening%s they cover", s->source,
 				moved, moved == 1 ? "" : "s", moved == 1 ? " it" : "s");
 	}
-	for (uint32_t i = 0; d->portal_source == POLICY_PORTALS_FOUND && i < d->found.count; i++)
-		portal_found_tris(&d->found.portals[i], d->portals + 2 * i);
-	d->n_portals = n;
 	return AJAR_OK;
 }
 
