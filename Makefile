@@ -73,7 +73,7 @@ LIGHT_DEPS := $(BUILD)/tests/lit.o $(call obj,core/error core/input_file scene/s
 DEPS_test_lights_env := $(LIGHT_DEPS) $(call obj,prepare/portal_flux)
 DEPS_test_lights_emitters := $(LIGHT_DEPS)
 DEPS_test_lights_sample := $(LIGHT_DEPS)
-DEPS_test_lights_sky_planes := $(LIGHT_DEPS) $(call obj,prepare/sky_tables)
+DEPS_test_lights_sky_planes := $(LIGHT_DEPS) $(call obj,prepare/sky_tables prepare/portal_groups)
 DEPS_test_lights_sky_planes_fine := $(patsubst %/lit.o,%/lit_fine.o,$(DEPS_test_lights_sky_planes))
 # The scene module: the loader, the API's scene calls, the images a scene reads.
 SCENE_DEPS := $(call obj,core/error core/input_file scene/scene scene/emit_mask scene/scene_share core/big_array scene/scene_api $(GLTF_OBJS) scene/tangents image/texture_file image/exr image/exr_read image/hdr)
@@ -89,7 +89,7 @@ PORTAL_FIND_OBJS := prepare/portal_find prepare/portal_find_rays prepare/portal_
 	prepare/portal_find_planes prepare/portal_find_cells
 # The kernels' integrators run on the host (tests/support/kernel_host.c) on
 # scenes as prepare_scene makes them; the MIS tests add the oracle.
-HOST_DEPS := $(BUILD)/tests/kernel_host.o $(call obj,core/error core/input_file scene/scene scene/emit_mask scene/scene_share core/big_array scene/scene_api $(GLTF_OBJS) scene/tangents image/texture_file image/exr image/exr_read image/hdr $(BVH_OBJS) prepare/light_tables prepare/prepare prepare/scene_bvh prepare/policy prepare/portal_flux prepare/sky_tables prepare/pane_planes prepare/portal_slide $(PORTAL_FIND_OBJS) prepare/found_portals render/render_options)
+HOST_DEPS := $(BUILD)/tests/kernel_host.o $(call obj,core/error core/input_file scene/scene scene/emit_mask scene/scene_share core/big_array scene/scene_api $(GLTF_OBJS) scene/tangents image/texture_file image/exr image/exr_read image/hdr $(BVH_OBJS) prepare/light_tables prepare/prepare prepare/scene_bvh prepare/policy prepare/portal_flux prepare/sky_tables prepare/pane_planes prepare/portal_groups prepare/portal_slide $(PORTAL_FIND_OBJS) prepare/found_portals render/render_options)
 DEPS_test_bdpt := $(BUILD)/tests/mis_oracle.o $(HOST_DEPS)
 DEPS_test_punctual := $(HOST_DEPS)
 DEPS_test_scene_share := $(HOST_DEPS)

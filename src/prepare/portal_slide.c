@@ -21,6 +21,7 @@
  * 9 points meet an opaque surface within SLIDE_SOLID of its size both ways
  * along the normal): still in the tunnel, not yet out in the open. */
 #include "prepare/portal_slide.h"
+#include "prepare/portal_groups.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -35,18 +36,6 @@
 static int blocked(const SceneView *v, V3 o, V3 d, float tmax)
 {
 	return v3_is_zero(ray_transmittance(v, o, d, tmax));
-}
-
-static int same_corner(V3 a, V3 b, float eps)
-{
-	return fabsf(a.x - b.x) <= eps && fabsf(a.y - b.y) <= eps && fabsf(a.z - b.z) <= eps;
-}
-
-static uint32_t root_of(uint32_t *parent, uint32_t a)
-{
-	while (parent[a] != a)
-		a = parent[a] = parent[parent[a]];
-	return a;
 }
 
 /* How many steps the rectangle [a0, a1] x [b0, b1] about o in frame (t, b)
@@ -89,27 +78,9 @@ uint32_t portal_slide(const SceneView *v, PortalTri *p, uint32_t n, V3 camera)
 	uint32_t *parent = malloc(sizeof *parent * (n ? n : 1)), moved = 0;
 	if (!parent)
 		return 0; /* a sampling aid: left where the user put it */
-	V3 lo = p[0].p0, hi = p[0].p0;
-	for (uint32_t i = 0; i < n; i++) {
-		parent[i] = i;
-		lo = v3_min(lo, v3_min(p[i].p0, v3_min(p[i].p1, p[i].p2)));
-		hi = v3_max(hi, v3_max(p[i].p0, v3_max(p[i].p1, p[i].p2)));
-	}
-	float eps = 1e-5f * fmaxf(v3_len(v3_sub(hi, lo)), 1e-6f);
-	for (uint32_t i = 0; i < n; i++)
-		for (uint32_t j = i + 1; j < n; j++) {
-			const V3 a[3] = {p[i].p0, p[i].p1, p[i].p2}, c[3] = {p[j].p0, p[j].p1, p[j].p2};
-			int shared = 0;
-			for (int x = 0; x < 9 && !shared; x++)
-				shared = same_corner(a[x / 3], c[x % 3], eps);
-			if (shared && fabsf(v3_dot(p[i].n, p[j].n)) > 0.9999f) {
-				uint32_t ri = root_of(parent, i), rj = root_of(parent, j);
-				if (ri != rj)
-					parent[ri > rj ? ri : rj] = ri > rj ? rj : ri;
-			}
-		}
+	portal_groups(p, n, 0, parent);
 	for (uint32_t g = 0; g < n; g++) {
-		if (root_of(parent, g) != g)
+		if (parent[g] != g)
 			continue;
 		/* The group's frame: its first triangle's normal, turned away
 		 * from the camera's side, and the edge direction whose bounding
@@ -120,7 +91,7 @@ uint32_t portal_slide(const SceneView *v, PortalTri *p, uint32_t n, V3 camera)
 		V3 o = p[g].p0, t = v3(0, 0, 0), b = t;
 		float best = INFINITY, a0 = 0, a1 = 0, b0 = 0, b1 = 0;
 		for (uint32_t e = 0; e < n; e++) {
-			if (root_of(parent, e) != g)
+			if (parent[e] != g)
 				continue;
 			const V3 ce[3] = {p[e].p0, p[e].p1, p[e].p2};
 			for (int m = 0; m < 3; m++) {
@@ -131,7 +102,7 @@ uint32_t portal_slide(const SceneView *v, PortalTri *p, uint32_t n, V3 camera)
 				V3 tt = v3_norm(d), bb = v3_cross(out, tt);
 				float l1 = INFINITY, h1 = -INFINITY, l2 = INFINITY, h2 = -INFINITY;
 				for (uint32_t k = 0; k < n; k++) {
-					if (root_of(parent, k) != g)
+					if (parent[k] != g)
 						continue;
 					const V3 c[3] = {p[k].p0, p[k].p1, p[k].p2};
 					for (int x = 0; x < 3; x++) {
@@ -152,7 +123,7 @@ uint32_t portal_slide(const SceneView *v, PortalTri *p, uint32_t n, V3 camera)
 		 * points by the opening would lie in the portal's plane. */
 		V3 shift = v3_scale(out, ((float)k - 0.5f) * SLIDE_STEP * fmaxf(a1 - a0, b1 - b0));
 		for (uint32_t q = 0; q < n; q++)
-			if (root_of(parent, q) == g) {
+			if (parent[q] == g) {
 				p[q].p0 = v3_add(p[q].p0, shift);
 				p[q].p1 = v3_add(p[q].p1, shift);
 				p[q].p2 = v3_add(p[q].p2, shift);

@@ -7,6 +7,7 @@
  * no direction in a rectangle has zero density; its summed-area table is
  * summed in double and stored as float pairs (hi, lo). */
 #include "prepare/sky_tables.h"
+#include "prepare/portal_groups.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -18,28 +19,6 @@
 
 #define SKY_SS 4
 #define SKY_FLOOR 1e-3
-
-static uint32_t find(uint32_t *parent, uint32_t a)
-{
-	while (parent[a] != a)
-		a = parent[a] = parent[parent[a]];
-	return a;
-}
-
-/* Whether sky-showing portal triangles a and b lie in one plane, face the
- * sky the same way and share a corner (eps: a length tolerance). */
-static int same_plane(const PortalTri *a, const PortalTri *b, float eps)
-{
-	V3 na = v3_scale(a->n, (float)a->env_side), nb = v3_scale(b->n, (float)b->env_side);
-	if (!(v3_dot(na, nb) > 1.0f - 1e-4f) || !(fabsf(v3_dot(na, v3_sub(b->p0, a->p0))) < eps))
-		return 0;
-	const V3 pa[3] = {a->p0, a->p1, a->p2}, pb[3] = {b->p0, b->p1, b->p2};
-	for (int i = 0; i < 3; i++)
-		for (int j = 0; j < 3; j++)
-			if (v3_len(v3_sub(pa[i], pb[j])) < eps)
-				return 1;
-	return 0;
-}
 
 /* Frame and bounding rectangle of the triangles k with root[k] == g. */
 static int plane_frame(const PortalTri *portals, const uint32_t *root, uint32_t n, uint32_t g, PortalPlane *P)
@@ -143,25 +122,10 @@ ajar_status portal_sky_planes(const PortalTri *portals, uint32_t n, PortalPlane 
 	uint32_t *root = malloc(sizeof *root * n);
 	if (!root)
 		return err_set(AJAR_ERROR_OUT_OF_MEMORY, "portals: out of memory grouping %u triangles", n);
-	V3 lo = portals[0].p0, hi = portals[0].p0;
-	for (uint32_t k = 0; k < n; k++) {
-		root[k] = k;
-		lo = v3_min(lo, v3_min(portals[k].p0, v3_min(portals[k].p1, portals[k].p2)));
-		hi = v3_max(hi, v3_max(portals[k].p0, v3_max(portals[k].p1, portals[k].p2)));
-	}
-	float eps = 1e-5f * fmaxf(v3_len(v3_sub(hi, lo)), 1e-6f);
-	for (uint32_t a = 0; a < n; a++)
-		for (uint32_t b = a + 1; b < n; b++)
-			if (portals[a].env_side != 0 && portals[b].env_side != 0 && same_plane(&portals[a], &portals[b], 10.0f * eps)) {
-				uint32_t ra = find(root, a), rb = find(root, b);
-				if (ra != rb)
-					root[ra > rb ? ra : rb] = ra > rb ? rb : ra;
-			}
+	portal_groups(portals, n, 1, root);
 	uint32_t groups = 0;
-	for (uint32_t k = 0; k < n; k++) {
-		root[k] = find(root, k);
+	for (uint32_t k = 0; k < n; k++)
 		groups += root[k] == k && portals[k].env_side != 0;
-	}
 	if (groups == 0) {
 		free(root);
 		return AJAR_OK;

@@ -1,0 +1,15 @@
+/* portal_groups.h — portal triangles grouped into openings. */
+#ifndef AJAR_PORTAL_GROUPS_H
+#define AJAR_PORTAL_GROUPS_H
+#include <stdint.h>
+
+#include "base/types.h"
+
+/* root[k]: the smallest index of triangle k's group, the triangles in one
+ * plane that share a corner, transitively (a window's two triangles, a row
+ * of panes marked as one mesh). With sky, only triangles that show the sky
+ * (env_side != 0, portal_flux_build) join, and only those facing it alike;
+ * the others are groups of their own. Without, any two coplanar ones,
+ * whichever way they face (before the sky's side is known). */
+void portal_groups(const PortalTri *p, uint32_t n, int sky, uint32_t *root);
+#endif
