@@ -103,6 +103,7 @@ DEPS_test_portal_policy := $(PORTAL_DEPS)
 DEPS_test_portal_find := $(HOST_DEPS)
 # Tests that render need the whole library.
 DEPS_test_layout := $(BUILD)/libajar.a
+DEPS_test_device_cdf := $(BUILD)/libajar.a
 DEPS_test_render := $(BUILD)/libajar.a
 DEPS_test_api := $(BUILD)/libajar.a
 DEPS_test_cache := $(BUILD)/libajar.a

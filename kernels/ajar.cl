@@ -97,6 +97,21 @@ __kernel void layout_probe(__global uint *out)
 	AJAR_LAYOUT_FIELDS(AJAR_PROBE_FIELD)
 }
 
+/* sample_cdf as this device compiles it (on a CPU with AVX its vector
+ * count, sampling.h), for tests/render/test_device_cdf.c: draw i takes u[i]
+ * and writes its bucket, probability and remapped u to out[3i .. 3i+2]. */
+__kernel void cdf_probe(__global const float *cdf, int n, __global const float *u, __global float *out, uint count)
+{
+	uint i = (uint)get_global_id(0);
+	if (i >= count)
+		return;
+	float pdf, ur;
+	int k = sample_cdf(cdf, n, u[i], &pdf, &ur);
+	out[3 * i] = (float)k;
+	out[3 * i + 1] = pdf;
+	out[3 * i + 2] = ur;
+}
+
 /* Closest-hit traversal alone, for the throughput benchmark: ray i is
  * rays[6i .. 6i+5] (origin, direction); hits[i] gets the triangle or -1. */
 __kernel void trace_closest(AJAR_SCENE_BUFFERS(AJAR_KERNEL_ARG) __global const float *rays,

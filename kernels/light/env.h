@@ -164,13 +164,20 @@ INLINE V3 env_table_sample(const SceneView *sc, int line, float u1, float u2, V3
 	int col = sample_cdf(env_conditional(sc, line, row), w, u2, &p_col, &uc);
 	if (col < 0)
 		return v3(0.0f, 0.0f, 0.0f);
+	/* The drawn texel's radiance is read now, so the load (a cache miss in
+	 * a large image: a tenth of pt's time under a sky image) runs while d
+	 * and its texel are computed; d's texel is nearly always this one. */
+	V3 drawn = env_pixel(sc, row, col);
+	int row_d = row, col_d = col;
 	*d = env_dir(prm, ((float)col + uc) / (float)w, ((float)row + ur) / (float)h);
 	/* Density and radiance from d's own texel, exactly what env_pdf_w
 	 * and env_radiance return for d, even where rounding put a sample on
 	 * a texel edge into the neighbour. */
 	float sin_theta = env_texel(prm, *d, &row, &col);
 	*pdf_w = env_table_pdf_w(sc, line, row, col, sin_theta);
-	return *pdf_w > 0.0f ? env_pixel(sc, row, col) : v3(0.0f, 0.0f, 0.0f);
+	if (!(*pdf_w > 0.0f))
+		return v3(0.0f, 0.0f, 0.0f);
+	return row == row_d && col == col_d ? drawn : env_pixel(sc, row, col);
 }
 
 /* By the environment's own distribution. */

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """kernel_profile.py -- where a render's kernel time goes on PoCL's CPU device (issue 45).
 
-  kernel_profile.py AJAR SCENE.gltf INTEGRATOR [SIZE SPP [FREQ]]
+  kernel_profile.py AJAR SCENE.gltf INTEGRATOR [SIZE SPP [FREQ [RENDER-OPTION ...]]]
 
 Renders SCENE with the render program built with -g (AJAR_CL_OPTIONS; debug information
 changes no code: the image is the same bits), once to warm the caches and once under
@@ -23,7 +23,8 @@ to a part of the work:
 It prints each part's share of the kernel's samples, and the kernel's share of the
 process (the rest: start-up, the host, PoCL's runtime). Shares of CPU time, sampled
 (cpu-clock), not instruction counts. Needs perf and llvm-symbolizer; SIZE defaults to
-128x128, SPP to 16, FREQ (samples per second) to 2000. AJAR_PROFILE_LINES=N also prints
+128x128, SPP to 16, FREQ (samples per second) to 2000; options after FREQ go to the
+render (e.g. --portals none). AJAR_PROFILE_LINES=N also prints
 the N source lines with the most samples.
 """
 import collections
@@ -69,18 +70,19 @@ def main():
     size = sys.argv[4] if len(sys.argv) > 4 else "128x128"
     spp = sys.argv[5] if len(sys.argv) > 5 else "16"
     freq = sys.argv[6] if len(sys.argv) > 6 else "2000"
+    extra = sys.argv[7:]
     top = int(os.environ.get("AJAR_PROFILE_LINES", "0"))
     env = dict(os.environ, POCL_MAX_PTHREAD_COUNT="1")
     env["AJAR_CL_OPTIONS"] = (env.get("AJAR_CL_OPTIONS", "") + " -g").strip()
     tmp = tempfile.mkdtemp()
     try:
-        profile(ajar, scene, integ, size, spp, freq, top, env, tmp)
+        profile(ajar, scene, integ, size, spp, freq, top, env, tmp, extra)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 
 
-def profile(ajar, scene, integ, size, spp, freq, top, env, tmp):
-    render = [ajar, "render", scene, "-o", os.path.join(tmp, "x.exr"), "--integrator", integ, "-q"]
+def profile(ajar, scene, integ, size, spp, freq, top, env, tmp, extra):
+    render = [ajar, "render", scene, "-o", os.path.join(tmp, "x.exr"), "--integrator", integ, "-q"] + extra
     subprocess.run(render + ["--size", "16x16", "--spp", "1"], env=env, check=True,
                    stderr=subprocess.DEVNULL)
     data = os.path.join(tmp, "perf.data")
