@@ -41,6 +41,12 @@ enum {
 };
 /* Primitive modes that make triangles. */
 enum { GLTF_MODE_TRIANGLES = 4, GLTF_MODE_TRIANGLE_STRIP = 5, GLTF_MODE_TRIANGLE_FAN = 6 };
+/* Samplers' filter and wrap codes. */
+enum {
+	GLTF_FILTER_NEAREST = 9728,
+	GLTF_WRAP_CLAMP_TO_EDGE = 33071,
+	GLTF_WRAP_MIRRORED_REPEAT = 33648,
+};
 /* Bytes of one component; 0 for an unknown type. */
 int gltf_component_size(int ctype);
 /* n components of type ctype, tightly packed, as floats; normalized
@@ -67,6 +73,12 @@ uint64_t gltf_mode_triangles(int mode, uint64_t count);
  * links resolved): 1 inside, 0 outside, -1 if it cannot be resolved.
  * `real` (PATH_MAX bytes) gets the resolved path. */
 int gltf_path_inside(const char *root, const char *path, char *real);
+/* Whether existing `path`, which the scene names `uri`, may be read: it
+ * resolves inside `root`, or allow_outside. Where it resolves outside,
+ * `why` (size bytes) gets the refusal naming the URI; else it is "". */
+int gltf_confined(const char *root, int allow_outside, const char *path, const char *uri, char *why, size_t size);
+/* Bytes for gltf_confined's `why`: more than a load's message holds. */
+#define GLTF_WHY_SIZE 2048
 
 /* Whether the loader implements extension `name` (len bytes): one a file
  * may require. */
