@@ -15,9 +15,6 @@
  * readers check every range. */
 #include <tiny_gltf.h>
 
-#include <cerrno>
-#include <cstdarg>
-#include <climits>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -30,7 +27,6 @@
 #include <unistd.h>
 
 #include "core/error.h"
-#include "core/input_file.h"
 #include "image/texture_file.h"
 #include "scene/gltf_doc.h"
 #include "scene/gltf_parts.h"
@@ -40,7 +36,8 @@ static_assert(GLTF_BYTE == TINYGLTF_COMPONENT_TYPE_BYTE && GLTF_UNSIGNED_BYTE ==
 		      GLTF_SHORT == TINYGLTF_COMPONENT_TYPE_SHORT &&
 		      GLTF_UNSIGNED_SHORT == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
 		      GLTF_UNSIGNED_INT == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT && GLTF_FLOAT == TINYGLTF_COMPONENT_TYPE_FLOAT &&
-		      GLTF_MODE_TRIANGLES == TINYGLTF_MODE_TRIANGLES &&
+		      GLTF_VEC2 == TINYGLTF_TYPE_VEC2 && GLTF_VEC3 == TINYGLTF_TYPE_VEC3 && GLTF_VEC4 == TINYGLTF_TYPE_VEC4 &&
+		      GLTF_SCALAR == TINYGLTF_TYPE_SCALAR && GLTF_MODE_TRIANGLES == TINYGLTF_MODE_TRIANGLES &&
 		      GLTF_MODE_TRIANGLE_STRIP == TINYGLTF_MODE_TRIANGLE_STRIP &&
 		      GLTF_MODE_TRIANGLE_FAN == TINYGLTF_MODE_TRIANGLE_FAN &&
 		      GLTF_FILTER_NEAREST == TINYGLTF_TEXTURE_FILTER_NEAREST &&
@@ -62,15 +59,11 @@ struct Loader {
 	std::string refused;        /* the first refusal of a file the scene names */
 };
 
-ajar_status fail(const Loader &L, ajar_status st, const char *fmt, ...) AJAR_PRINTF(3, 4);
-ajar_status fail(const Loader &L, ajar_status st, const char *fmt, ...)
+/* "file: why" as the load's error, why cut as the C loader's messages are
+ * (gltf_fail). */
+ajar_status fail(const Loader &L, const std::string &why)
 {
-	char buf[1536];
-	va_list ap;
-	va_start(ap, fmt);
-	vsnprintf(buf, sizeof buf, fmt, ap);
-	va_end(ap);
-	return err_set(st, "%s: %s", L.file, buf);
+	return err_set(AJAR_ERROR_BAD_INPUT, "%s: %.1535s", L.file, why.c_str());
 }
 
 /* tinygltf's messages end in newlines and may hold several lines. */
@@ -127,7 +120,7 @@ bool fs_exists(const std::string &path, void *user)
 	return stat(path.c_str(), &sb) == 0 && confined(L, path, uri_of(L, path));
 }
 
-ajar_status read_fd(const char *path, int fd, uint64_t size, std::vector<unsigned char> &data);
+ajar_status read_file(const char *path, std::vector<unsigned char> &data);
 
 /* Confined first, then opened as a regular file only (input_open); the
  * first refusal becomes the load's error, naming the URI. */
@@ -140,12 +133,7 @@ bool fs_read(std::vector<unsigned char> *out, std::string *err, const std::strin
 			*err += "outside the scene's folder\n";
 		return false;
 	}
-	int fd;
-	uint64_t size = 0;
-	ajar_status st = input_open(path.c_str(), &fd, &size);
-	if (st == AJAR_OK)
-		st = read_fd(path.c_str(), fd, size, *out);
-	if (st != AJAR_OK) {
+	if (read_file(path.c_str(), *out) != AJAR_OK) {
 		if (L.refused.empty())
 			L.refused = "'" + uri + "': " + ajar_last_error();
 		if (err)
@@ -215,37 +203,21 @@ bool load_image(tg::Image *im, const int i, std::string *err, std::string *, int
 	return true;
 }
 
-/* The whole of an opened regular file (closed here); at most 4 GiB, the
- * most a .glb can hold, so a buffer's size is never what a huge file says. */
-ajar_status read_fd(const char *path, int fd, uint64_t size, std::vector<unsigned char> &data)
-{
-	if (size > 0xffffffffu) {
-		close(fd);
-		return err_set(AJAR_ERROR_BAD_INPUT, "%s: file larger than 4 GiB", path);
-	}
-	data.resize((size_t)size);
-	size_t got = 0;
-	while (got < data.size()) {
-		ssize_t k = read(fd, data.data() + got, data.size() - got);
-		if (k < 0 && errno == EINTR)
-			continue;
-		if (k <= 0) {
-			int e = errno;
-			close(fd);
-			return err_set(AJAR_ERROR_IO, "%s: cannot read: %s", path, k < 0 ? strerror(e) : "the file shrank");
-		}
-		got += (size_t)k;
-	}
-	close(fd);
-	return AJAR_OK;
-}
-
+/* The whole of a file the scene names (gltf_files.c). */
 ajar_status read_file(const char *path, std::vector<unsigned char> &data)
 {
 	int fd;
-	uint64_t size = 0;
-	ajar_status st = input_open(path, &fd, &size);
-	return st ? st : read_fd(path, fd, size, data);
+	size_t size = 0;
+	ajar_status st = gltf_file_open(path, &fd, &size);
+	if (st)
+		return st;
+	try {
+		data.resize(size);
+	} catch (...) {
+		close(fd);
+		throw;
+	}
+	return gltf_file_read(path, fd, data.data(), size);
 }
 
 /* ---- The document -----------------------------------------------------------
@@ -310,7 +282,8 @@ GltfValue value(DocStore &d, const tg::Value &v)
 
 GltfValue object(DocStore &d, const std::map<std::string, tg::Value> &members)
 {
-	GltfValue out = value(d, tg::Value());
+	GltfValue out;
+	memset(&out, 0, sizeof out);
 	std::unique_ptr<GltfValue[]> items(new GltfValue[members.size()]);
 	std::unique_ptr<GltfString[]> keys(new GltfString[members.size()]);
 	size_t i = 0;
@@ -327,33 +300,13 @@ GltfValue object(DocStore &d, const std::map<std::string, tg::Value> &members)
 	return out;
 }
 
-int type_components(int type)
-{
-	switch (type) {
-	case TINYGLTF_TYPE_SCALAR: return 1;
-	case TINYGLTF_TYPE_VEC2: return 2;
-	case TINYGLTF_TYPE_VEC3: return 3;
-	case TINYGLTF_TYPE_VEC4: return 4;
-	}
-	return 0;
-}
-
 GltfAccessor accessor(const tg::Accessor &a)
 {
 	const auto &sp = a.sparse;
-	return GltfAccessor{a.bufferView,
-			    a.byteOffset,
-			    a.componentType,
-			    a.normalized,
-			    a.count,
-			    a.type,
-			    type_components(a.type),
-			    sp.isSparse,
-			    sp.count,
-			    sp.indices.bufferView,
-			    sp.indices.byteOffset,
-			    sp.indices.componentType,
-			    sp.values.bufferView,
+	return GltfAccessor{a.bufferView,	     a.byteOffset,	     a.componentType,
+			    a.normalized,	     a.count,		     a.type,
+			    sp.isSparse,	     sp.count,		     sp.indices.bufferView,
+			    sp.indices.byteOffset, sp.indices.componentType, sp.values.bufferView,
 			    sp.values.byteOffset};
 }
 
@@ -367,19 +320,12 @@ GltfMaterial material(DocStore &d, const tg::Material &m)
 	const tg::PbrMetallicRoughness &pbr = m.pbrMetallicRoughness;
 	const tg::TextureInfo &bt = pbr.baseColorTexture, &mt = pbr.metallicRoughnessTexture, &et = m.emissiveTexture;
 	const tg::NormalTextureInfo &nt = m.normalTexture;
-	return GltfMaterial{str(m.name),
-			    numbers(pbr.baseColorFactor),
-			    numbers(m.emissiveFactor),
-			    pbr.metallicFactor,
-			    pbr.roughnessFactor,
-			    m.alphaCutoff,
-			    m.doubleSided,
-			    str(m.alphaMode),
+	return GltfMaterial{str(m.name), numbers(pbr.baseColorFactor), numbers(m.emissiveFactor), pbr.metallicFactor,
+			    pbr.roughnessFactor, m.alphaCutoff, m.doubleSided, str(m.alphaMode),
 			    texture_info(d, bt.index, bt.texCoord, 1.0, bt.extensions),
 			    texture_info(d, mt.index, mt.texCoord, 1.0, mt.extensions),
 			    texture_info(d, et.index, et.texCoord, 1.0, et.extensions),
-			    texture_info(d, nt.index, nt.texCoord, nt.scale, nt.extensions),
-			    object(d, m.extensions)};
+			    texture_info(d, nt.index, nt.texCoord, nt.scale, nt.extensions), object(d, m.extensions)};
 }
 
 void copy_meshes(DocStore &d)
@@ -452,8 +398,6 @@ ajar_status parse(Loader &L, DocStore &d)
 	ajar_status st = read_file(L.file, data);
 	if (st)
 		return st;
-	if (data.size() > 0xffffffffu)
-		return fail(L, AJAR_ERROR_BAD_INPUT, "file larger than 4 GiB");
 
 	tg::TinyGLTF loader;
 	std::string err, warn;
@@ -467,11 +411,11 @@ ajar_status parse(Loader &L, DocStore &d)
 		ok = loader.LoadASCIIFromString(&d.model, &err, &warn, (const char *)data.data(), (unsigned)data.size(),
 						L.dir);
 	if (!L.refused.empty())
-		return fail(L, AJAR_ERROR_BAD_INPUT, "%s", L.refused.c_str());
+		return fail(L, L.refused);
 	if (!warn.empty())
 		log_msg(AJAR_LOG_WARNING, "%s: %s", L.file, one_line(warn).c_str());
 	if (!ok)
-		return fail(L, AJAR_ERROR_BAD_INPUT, "%s", err.empty() ? "cannot parse glTF" : one_line(err).c_str());
+		return fail(L, err.empty() ? "cannot parse glTF" : one_line(err));
 	copy_model(d);
 	return AJAR_OK;
 }

@@ -87,7 +87,7 @@ ajar_status gltf_accessor_read(const GltfLoader *L, const char *ctx, const char 
 	char what[512];
 	snprintf(what, sizeof what, "%s: accessors[%d] (%s)", ctx, idx, attr);
 	const GltfAccessor *a = &d->accessors[idx];
-	int csize = gltf_component_size(a->component_type), nc = a->components;
+	int csize = gltf_component_size(a->component_type), nc = gltf_type_components(a->type);
 	if (!csize)
 		return gltf_fail(L, AJAR_ERROR_BAD_INPUT, "%s: unsupported componentType %d", what, a->component_type);
 	if (nc != ncomp)

@@ -71,8 +71,7 @@ typedef struct {
 	int component_type; /* GLTF_FLOAT, ... (gltf_parts.h) */
 	int normalized;
 	size_t count;
-	int type;       /* tinygltf's TINYGLTF_TYPE_* code, as messages print it */
-	int components; /* 1 to 4 for SCALAR to VEC4, 0 for a matrix */
+	int type; /* GLTF_SCALAR, ... (gltf_parts.h) */
 	int is_sparse;
 	int sparse_count;
 	int sparse_indices_view, sparse_indices_offset, sparse_indices_type;

@@ -101,7 +101,7 @@ static ajar_status triangle_list(const GltfLoader *L, const char *what, const Gl
  * as RGBA clamped to [0, 1]. */
 static ajar_status read_colors(const GltfLoader *L, const char *what, int acc, size_t nv, GltfFloats *col)
 {
-	int nc = acc >= 0 && (size_t)acc < L->doc->naccessors ? L->doc->accessors[acc].components : 4;
+	int nc = acc >= 0 && (size_t)acc < L->doc->naccessors ? gltf_type_components(L->doc->accessors[acc].type) : 4;
 	GltfPacked p;
 	GltfFloats c = {NULL, 0};
 	ajar_status st = gltf_accessor_read(L, what, "COLOR_0", acc, nc == 3 ? 3 : 4, &p);
