@@ -141,7 +141,7 @@ static ajar_status load_instanced_mesh(GltfLoader *L, int mi)
 	for (size_t p = 0; p < mesh->nprimitives; p++) {
 		if (primitive_emits(L, mi, (int)p))
 			continue;
-		ajar_status st = gltf_load_primitive(L, mi, (int)p, id, (const double(*)[3])nm, 0, NULL);
+		ajar_status st = gltf_load_primitive(L, mi, (int)p, id, nm, 0, NULL);
 		if (st)
 			return st;
 	}
@@ -183,7 +183,7 @@ static ajar_status load_mesh_copy(GltfLoader *L, int ni, const double world[16],
 	for (size_t p = 0; p < mesh->nprimitives; p++) {
 		if (inst && !primitive_emits(L, mi, (int)p))
 			continue;
-		st = gltf_load_primitive(L, mi, (int)p, world, (const double(*)[3])nm, det < 0.0, portal);
+		st = gltf_load_primitive(L, mi, (int)p, world, nm, det < 0.0, portal);
 		if (st)
 			return st;
 	}

@@ -201,19 +201,6 @@ static ajar_status load_tangents(const GltfLoader *L, const char *what, const Gl
 	return set->n ? generate_tangents(L, v, set) : AJAR_OK;
 }
 
-static ajar_status add_primitive(GltfLoader *L, int mi, int pi, const double world[16], const double nm[3][3],
-				 int flip, GltfPortalMesh *portal, Vertices *v);
-
-ajar_status gltf_load_primitive(GltfLoader *L, int mi, int pi, const double world[16], const double nm[3][3],
-				int flip, GltfPortalMesh *portal)
-{
-	Vertices v;
-	memset(&v, 0, sizeof v);
-	ajar_status st = add_primitive(L, mi, pi, world, nm, flip, portal, &v);
-	vertices_free(&v);
-	return st;
-}
-
 /* A portal node's triangles gathered, positions already in world space. */
 static ajar_status add_to_portal(const GltfLoader *L, GltfPortalMesh *portal, const Vertices *v)
 {
@@ -303,4 +290,14 @@ static ajar_status add_primitive(GltfLoader *L, int mi, int pi, const double wor
 	return scene_add_triangles_ex(L->s, what, or_null(&v->pos), or_null(&v->nrm), or_null(&v->uv), or_null(&v->uv1),
 				      or_null(&v->col), or_null(&v->tan), (uint32_t)nv, v->ntri_idx ? v->tri : NULL, ntris,
 				      mat);
+}
+
+ajar_status gltf_load_primitive(GltfLoader *L, int mi, int pi, const double world[16], const double nm[3][3],
+				int flip, GltfPortalMesh *portal)
+{
+	Vertices v;
+	memset(&v, 0, sizeof v);
+	ajar_status st = add_primitive(L, mi, pi, world, nm, flip, portal, &v);
+	vertices_free(&v);
+	return st;
 }
