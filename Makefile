@@ -62,9 +62,11 @@ DEPS_test_bsdf_bent := $(BSDF_DEPS)
 DEPS_test_bsdf_layers := $(BSDF_DEPS)
 DEPS_test_sampling := $(call obj,core/error)
 DEPS_test_pane_planes := $(call obj,prepare/pane_planes)
-# The glTF loader: the C++ file on tinygltf and its parts in C (src/scene/gltf_parts.h).
-GLTF_OBJS := scene/gltf scene/gltf_transform scene/gltf_decode scene/gltf_instancing scene/gltf_confine \
-	scene/gltf_extensions
+# The glTF loader: the C++ file on tinygltf and its parts in C (src/scene/README.md).
+GLTF_OBJS := scene/gltf scene/gltf_load scene/gltf_values scene/gltf_accessors scene/gltf_textures \
+	scene/gltf_materials scene/gltf_primitives scene/gltf_instances scene/gltf_nodes scene/gltf_cameras \
+	scene/gltf_lights scene/gltf_environment scene/gltf_transform scene/gltf_decode scene/gltf_instancing \
+	scene/gltf_confine scene/gltf_files scene/gltf_extensions
 # The BVH build: its driver and threads, the node split, the wide collapse.
 BVH_OBJS := prepare/bvh_build prepare/bvh_split prepare/bvh_collapse core/workers
 DEPS_test_bvh := $(call obj,core/error core/input_file scene/scene scene/emit_mask scene/scene_share core/big_array $(BVH_OBJS) $(GLTF_OBJS) scene/tangents image/texture_file image/exr image/exr_read image/hdr)

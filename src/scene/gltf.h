@@ -1,5 +1,5 @@
-/* gltf.h — the glTF 2.0 loader, the C face of the one C++ file (gltf.cpp),
- * which wraps tinygltf and fills a Scene (scene.h).
+/* gltf.h — the glTF 2.0 loader (gltf_load.c): tinygltf parses the file in
+ * the one C++ file (gltf.cpp), C files fill a Scene (scene.h) from it.
  *
  * Conventions the loader adds to glTF (see design.md): mesh nodes with
  * extras {"portal": true} (or 1) are portals; scene extras "environment"

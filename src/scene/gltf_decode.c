@@ -1,6 +1,7 @@
 /* gltf_decode.c — a glTF file's data as the scene takes it: accessor
  * components as floats or indices, strips and fans as triangle lists,
- * image texels as RGBA8. The bounds are gltf.cpp's to check first. */
+ * image texels as RGBA8, and accessor types' sizes. The bounds are
+ * gltf_accessors.c's to check first. */
 #include "scene/gltf_parts.h"
 
 #include <math.h>
@@ -15,6 +16,17 @@ int gltf_component_size(int ctype)
 	case GLTF_UNSIGNED_SHORT: return 2;
 	case GLTF_UNSIGNED_INT:
 	case GLTF_FLOAT: return 4;
+	}
+	return 0;
+}
+
+int gltf_type_components(int type)
+{
+	switch (type) {
+	case GLTF_SCALAR: return 1;
+	case GLTF_VEC2: return 2;
+	case GLTF_VEC3: return 3;
+	case GLTF_VEC4: return 4;
 	}
 	return 0;
 }

@@ -1,13 +1,16 @@
-/* gltf_parts.h — the parts of the glTF loader (gltf.cpp) that need no
- * tinygltf types, in C: node matrices and vertex transforms
- * (gltf_transform.c), accessor data and texels decoded (gltf_decode.c),
- * the rule that keeps a mesh as instances (gltf_instancing.c), the
- * scene-folder check (gltf_confine.c), the extensions the loader reads
- * (gltf_extensions.c). */
+/* gltf_parts.h — the parts of the glTF loader that need neither tinygltf
+ * nor the document, shared by gltf.cpp and the C readers (gltf_loader.h):
+ * node matrices and vertex transforms (gltf_transform.c), accessor data
+ * and texels decoded (gltf_decode.c), the rule that keeps a mesh as
+ * instances (gltf_instancing.c), the scene-folder check (gltf_confine.c),
+ * reading a file the scene names (gltf_files.c), the extensions the loader
+ * reads (gltf_extensions.c). */
 #ifndef AJAR_GLTF_PARTS_H
 #define AJAR_GLTF_PARTS_H
 #include <stddef.h>
 #include <stdint.h>
+
+#include "ajar.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -41,8 +44,18 @@ enum {
 };
 /* Primitive modes that make triangles. */
 enum { GLTF_MODE_TRIANGLES = 4, GLTF_MODE_TRIANGLE_STRIP = 5, GLTF_MODE_TRIANGLE_FAN = 6 };
+/* Samplers' filter and wrap codes. */
+enum {
+	GLTF_FILTER_NEAREST = 9728,
+	GLTF_WRAP_CLAMP_TO_EDGE = 33071,
+	GLTF_WRAP_MIRRORED_REPEAT = 33648,
+};
+/* Accessor types that are vectors (the matrices' codes add 32). */
+enum { GLTF_VEC2 = 2, GLTF_VEC3 = 3, GLTF_VEC4 = 4, GLTF_SCALAR = 65 };
 /* Bytes of one component; 0 for an unknown type. */
 int gltf_component_size(int ctype);
+/* Components of an accessor type: 1 to 4 for SCALAR to VEC4, 0 else. */
+int gltf_type_components(int type);
 /* n components of type ctype, tightly packed, as floats; normalized
  * integers map to [0, 1] or [-1, 1] as glTF specifies. */
 void gltf_to_floats(const uint8_t *bytes, size_t n, int ctype, int normalized, float *out);
@@ -67,6 +80,18 @@ uint64_t gltf_mode_triangles(int mode, uint64_t count);
  * links resolved): 1 inside, 0 outside, -1 if it cannot be resolved.
  * `real` (PATH_MAX bytes) gets the resolved path. */
 int gltf_path_inside(const char *root, const char *path, char *real);
+/* Whether existing `path`, which the scene names `uri`, may be read: it
+ * resolves inside `root`, or allow_outside. Where it resolves outside,
+ * `why` (size bytes) gets the refusal naming the URI; else it is "". */
+int gltf_confined(const char *root, int allow_outside, const char *path, const char *uri, char *why, size_t size);
+/* Bytes for gltf_confined's `why`: more than a load's message holds. */
+#define GLTF_WHY_SIZE 2048
+
+/* Opens a file the scene names (a regular file of at most 4 GiB) into *fd
+ * and gives its size; messages name `path`. */
+ajar_status gltf_file_open(const char *path, int *fd, size_t *size);
+/* Reads size bytes of fd (gltf_file_open's) into data and closes fd. */
+ajar_status gltf_file_read(const char *path, int fd, unsigned char *data, size_t size);
 
 /* Whether the loader implements extension `name` (len bytes): one a file
  * may require. */

@@ -1,5 +1,5 @@
 /* tangents.h — tangents for normal maps where a glTF mesh has none
- * (tangents.c), used by the loader (gltf.cpp). */
+ * (tangents.c), used by the loader (gltf_primitives.c). */
 #ifndef AJAR_TANGENTS_H
 #define AJAR_TANGENTS_H
 #include <stddef.h>

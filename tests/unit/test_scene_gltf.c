@@ -1,4 +1,4 @@
-/* test_scene_gltf.c — the glTF loader (src/scene/gltf.cpp): small files
+/* test_scene_gltf.c — the glTF loader (src/scene/gltf_load.c): small files
  * written here exercise one feature each (node hierarchies with TRS and
  * matrices, scenes without "scenes", strips and fans, interleaved, sparse
  * and normalized accessors, data URIs, .glb, portals and the environment
