@@ -63,7 +63,7 @@ DEPS_test_bsdf_layers := $(BSDF_DEPS)
 DEPS_test_sampling := $(call obj,core/error)
 DEPS_test_pane_planes := $(call obj,prepare/pane_planes)
 # The glTF loader: the C++ file on tinygltf and its parts in C (src/scene/README.md).
-GLTF_OBJS := scene/gltf scene/gltf_load scene/gltf_values scene/gltf_accessors scene/gltf_textures \
+GLTF_OBJS := scene/gltf scene/gltf_load scene/gltf_fail scene/gltf_values scene/gltf_accessors scene/gltf_textures \
 	scene/gltf_materials scene/gltf_primitives scene/gltf_instances scene/gltf_nodes scene/gltf_cameras \
 	scene/gltf_lights scene/gltf_environment scene/gltf_transform scene/gltf_decode scene/gltf_instancing \
 	scene/gltf_confine scene/gltf_files scene/gltf_extensions

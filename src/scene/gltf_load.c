@@ -5,7 +5,6 @@
 #include "scene/gltf.h"
 
 #include <limits.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -13,21 +12,6 @@
 #include "core/error.h"
 #include "scene/gltf_loader.h"
 #include "scene/gltf_parts.h"
-
-ajar_status gltf_fail(const GltfLoader *L, ajar_status st, const char *fmt, ...)
-{
-	char buf[1536];
-	va_list ap;
-	va_start(ap, fmt);
-	vsnprintf(buf, sizeof buf, fmt, ap);
-	va_end(ap);
-	return err_set(st, "%s: %s", L->file, buf);
-}
-
-ajar_status gltf_out_of_memory(const GltfLoader *L)
-{
-	return err_set(AJAR_ERROR_OUT_OF_MEMORY, "%s: out of memory", L->file);
-}
 
 /* Required extensions Ajar does not implement are refused; every other
  * used one it does not read gets one warning (a material's are named per

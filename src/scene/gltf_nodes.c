@@ -10,14 +10,6 @@
 
 #include "scene/gltf_parts.h"
 
-ajar_status gltf_trs(const GltfLoader *L, const char *what, const double t[3], const double q[4], const double s[3],
-		     double m[16])
-{
-	if (!gltf_trs_matrix(t, q, s, m))
-		return gltf_fail(L, AJAR_ERROR_BAD_INPUT, "%s: rotation is a zero quaternion", what);
-	return AJAR_OK;
-}
-
 /* The node's local matrix: `matrix`, or T * R * S. */
 static ajar_status node_local(const GltfLoader *L, int i, double m[16])
 {

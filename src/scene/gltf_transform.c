@@ -2,8 +2,19 @@
  * products down the node tree, the normal matrix, and vertex arrays moved
  * to world space by them (in double, rounded to float once). */
 #include "scene/gltf_parts.h"
+#include "scene/gltf_loader.h"
 
 #include <math.h>
+
+/* gltf_trs_matrix where the loader reads T R S (a node, a GPU instance):
+ * a zero quaternion is refused, naming `what`. */
+ajar_status gltf_trs(const GltfLoader *L, const char *what, const double t[3], const double q[4], const double s[3],
+		     double m[16])
+{
+	if (!gltf_trs_matrix(t, q, s, m))
+		return gltf_fail(L, AJAR_ERROR_BAD_INPUT, "%s: rotation is a zero quaternion", what);
+	return AJAR_OK;
+}
 
 void gltf_mat_identity(double m[16])
 {
