@@ -59,8 +59,18 @@ void bvh_split_plan(uint32_t n, const Box4 *cbox, uint32_t depth, uint32_t inst_
 	/* Small nodes get fewer bins: the sweep costs per bin, and most nodes
 	 * are small. */
 	p->nb = n < BVH_BINS ? (int)n : BVH_BINS;
+#if defined(__SSE2__)
+	/* the three divisions in one vector division: the same quotients */
+	__m128 ext = _mm_sub_ps(cbox->hi, cbox->lo);
+	__m128 q = _mm_and_ps(_mm_cmpgt_ps(ext, _mm_setzero_ps()), _mm_div_ps(_mm_set1_ps((float)p->nb), ext));
+	float sc[4];
+	_mm_storeu_ps(sc, q);
+	for (int a = 0; a < 3; a++)
+		p->scale[a] = sc[a];
+#else
 	for (int a = 0; a < 3; a++)
 		p->scale[a] = p->ext[a] > 0.0f ? (float)p->nb / p->ext[a] : 0.0f;
+#endif
 }
 
 void bvh_bins_clear(Bins *b, int nb)
