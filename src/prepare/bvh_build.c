@@ -33,7 +33,8 @@
  * Times (src/prepare/README.md, "The BVH"): bathroom, 592,188 triangles,
  * 0.69 s of CPU before the vector bins, 0.23 s after; issue 42's second
  * round (the same tree) 0.74x that, Embree 1.3x faster where it was 1.8x;
- * its fourth (the same tree) 0.9x the second's, Embree 1.14x faster. */
+ * its fourth (the same tree) 0.9x the second's, Embree 1.14x faster; its
+ * fifth (the same tree) 0.9x the fourth's on bathroom and unique-10m. */
 #include "prepare/bvh_build.h"
 
 #include <pthread.h>
