@@ -32,7 +32,17 @@ typedef struct {
 
 static int bin_is_leaf(const BinNode *bn, uint32_t i) { return bn[i].count > 0; }
 
-static float slot_area(const BinNode *bn, uint32_t i) { return bin_is_leaf(bn, i) ? -1.0f : box_area(&bn[i].b); }
+/* An interior slot's children are read when it is opened, here or in its
+ * own wide node: its right child is asked for now, as it may lie far
+ * (the collapse had waited on the binary nodes, some 60% of its time in
+ * this function). */
+static float slot_area(const BinNode *bn, uint32_t i)
+{
+	if (bin_is_leaf(bn, i))
+		return -1.0f;
+	__builtin_prefetch(&bn[bn[i].index]);
+	return box_area(&bn[i].b);
+}
 
 /* Opens slot k (an interior binary node) into its two children. */
 static void slots_open(const BinNode *bn, Slots *s, int k)

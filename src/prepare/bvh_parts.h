@@ -236,6 +236,18 @@ static inline Box4 box4_of_ref(const Ref *r)
 	return b;
 }
 
+/* A ref of box b (lane 3 of b.lo and b.hi +0) and index idx, stored as
+ * two vectors. */
+static inline void ref_store(Ref *r, Box4 b, uint32_t idx)
+{
+#if defined(__SSE2__)
+	_mm_store_ps((float *)r, f4_set_lane3_bits(b.lo, idx));
+	_mm_store_ps((float *)r + 4, b.hi);
+#else
+	*r = (Ref){{b.lo.v[0], b.lo.v[1], b.lo.v[2]}, idx, {b.hi.v[0], b.hi.v[1], b.hi.v[2]}, 0.0f};
+#endif
+}
+
 static inline void box4_store(Box *out, Box4 b)
 {
 	float lo[4], hi[4];
