@@ -53,3 +53,40 @@ void portal_groups(const PortalTri *p, uint32_t n, int sky, uint32_t *root)
 	for (uint32_t k = 0; k < n; k++)
 		root[k] = find(root, k);
 }
+
+float portal_group_rect(const PortalTri *p, const uint32_t *root, uint32_t n, uint32_t g, V3 nrm, V3 o, V3 *t,
+			V3 *b, float ext[4])
+{
+	float best = INFINITY;
+	for (uint32_t e = 0; e < n; e++) {
+		if (root[e] != g)
+			continue;
+		const V3 ce[3] = {p[e].p0, p[e].p1, p[e].p2};
+		for (int m = 0; m < 3; m++) {
+			V3 d = v3_sub(ce[(m + 1) % 3], ce[m]);
+			d = v3_madd(d, nrm, -v3_dot(d, nrm));
+			if (!(v3_len2(d) > 0.0f))
+				continue;
+			V3 tt = v3_norm(d), bb = v3_cross(nrm, tt);
+			float r[4] = {INFINITY, -INFINITY, INFINITY, -INFINITY};
+			for (uint32_t k = 0; k < n; k++) {
+				if (root[k] != g)
+					continue;
+				const V3 c[3] = {p[k].p0, p[k].p1, p[k].p2};
+				for (int x = 0; x < 3; x++) {
+					float ca = v3_dot(v3_sub(c[x], o), tt), cb = v3_dot(v3_sub(c[x], o), bb);
+					r[0] = fminf(r[0], ca), r[1] = fmaxf(r[1], ca), r[2] = fminf(r[2], cb), r[3] = fmaxf(r[3], cb);
+				}
+			}
+			float area = (r[1] - r[0]) * (r[3] - r[2]);
+			if (area < best) {
+				best = area;
+				*t = tt;
+				*b = bb;
+				for (int i = 0; i < 4; i++)
+					ext[i] = r[i];
+			}
+		}
+	}
+	return best > 0.0f && best < INFINITY ? best : 0.0f;
+}

@@ -83,39 +83,15 @@ uint32_t portal_slide(const SceneView *v, PortalTri *p, uint32_t n, V3 camera)
 		if (parent[g] != g)
 			continue;
 		/* The group's frame: its first triangle's normal, turned away
-		 * from the camera's side, and the edge direction whose bounding
-		 * rectangle is the smallest (a side of a quad, not its diagonal). */
+		 * from the camera's side, and its smallest rectangle. */
 		V3 out = p[g].n;
 		if (v3_dot(out, v3_sub(camera, p[g].p0)) > 0.0f)
 			out = v3_neg(out);
-		V3 o = p[g].p0, t = v3(0, 0, 0), b = t;
-		float best = INFINITY, a0 = 0, a1 = 0, b0 = 0, b1 = 0;
-		for (uint32_t e = 0; e < n; e++) {
-			if (parent[e] != g)
-				continue;
-			const V3 ce[3] = {p[e].p0, p[e].p1, p[e].p2};
-			for (int m = 0; m < 3; m++) {
-				V3 d = v3_sub(ce[(m + 1) % 3], ce[m]);
-				d = v3_madd(d, out, -v3_dot(d, out));
-				if (!(v3_len2(d) > 0.0f))
-					continue;
-				V3 tt = v3_norm(d), bb = v3_cross(out, tt);
-				float l1 = INFINITY, h1 = -INFINITY, l2 = INFINITY, h2 = -INFINITY;
-				for (uint32_t k = 0; k < n; k++) {
-					if (parent[k] != g)
-						continue;
-					const V3 c[3] = {p[k].p0, p[k].p1, p[k].p2};
-					for (int x = 0; x < 3; x++) {
-						float ca = v3_dot(v3_sub(c[x], o), tt), cb = v3_dot(v3_sub(c[x], o), bb);
-						l1 = fminf(l1, ca), h1 = fmaxf(h1, ca), l2 = fminf(l2, cb), h2 = fmaxf(h2, cb);
-					}
-				}
-				if ((h1 - l1) * (h2 - l2) < best)
-					best = (h1 - l1) * (h2 - l2), t = tt, b = bb, a0 = l1, a1 = h1, b0 = l2, b1 = h2;
-			}
-		}
-		if (!(best > 0.0f) || best == INFINITY)
+		V3 o = p[g].p0, t, b;
+		float r[4];
+		if (!(portal_group_rect(p, parent, n, g, out, o, &t, &b, r) > 0.0f))
 			continue;
+		float a0 = r[0], a1 = r[1], b0 = r[2], b1 = r[3];
 		int k = steps_out(v, o, t, b, out, a0, a1, b0, b1);
 		if (k == 0)
 			continue;

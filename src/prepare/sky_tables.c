@@ -20,46 +20,22 @@
 #define SKY_SS 4
 #define SKY_FLOOR 1e-3
 
-/* Frame and bounding rectangle of the triangles k with root[k] == g. */
+/* Frame and bounding rectangle of the triangles k with root[k] == g: the
+ * smallest (portal_group_rect), as the sky is tabulated over it and a
+ * direction in the rectangle but beside the triangles is a sample lost. */
 static int plane_frame(const PortalTri *portals, const uint32_t *root, uint32_t n, uint32_t g, PortalPlane *P)
 {
 	const PortalTri *first = &portals[g];
-	V3 nn = v3_scale(first->n, (float)first->env_side), t = v3(0, 0, 0);
-	float best = -1.0f;
-	for (uint32_t k = 0; k < n; k++) {
-		if (root[k] != g)
-			continue;
-		const V3 p[3] = {portals[k].p0, portals[k].p1, portals[k].p2};
-		for (int e = 0; e < 3; e++) {
-			V3 d = v3_sub(p[(e + 1) % 3], p[e]);
-			d = v3_sub(d, v3_scale(nn, v3_dot(d, nn)));
-			if (v3_len2(d) > best) {
-				best = v3_len2(d);
-				t = d;
-			}
-		}
-	}
-	if (!(best > 0.0f))
-		return 0;
 	memset(P, 0, sizeof *P);
 	P->o = first->p0;
-	P->n = nn;
-	P->t = v3_norm(t);
-	P->b = v3_cross(nn, P->t);
-	P->a0 = P->b0 = INFINITY;
-	P->a1 = P->b1 = -INFINITY;
-	for (uint32_t k = 0; k < n; k++) {
-		if (root[k] != g)
-			continue;
-		const V3 p[3] = {portals[k].p0, portals[k].p1, portals[k].p2};
-		for (int e = 0; e < 3; e++) {
-			float a = v3_dot(v3_sub(p[e], P->o), P->t), b = v3_dot(v3_sub(p[e], P->o), P->b);
-			P->a0 = fminf(P->a0, a);
-			P->a1 = fmaxf(P->a1, a);
-			P->b0 = fminf(P->b0, b);
-			P->b1 = fmaxf(P->b1, b);
-		}
-	}
+	P->n = v3_scale(first->n, (float)first->env_side);
+	float r[4];
+	if (!(portal_group_rect(portals, root, n, g, P->n, P->o, &P->t, &P->b, r) > 0.0f))
+		return 0;
+	P->a0 = r[0];
+	P->a1 = r[1];
+	P->b0 = r[2];
+	P->b1 = r[3];
 	/* A little margin, so rounding at the border loses no direction. */
 	float m = 1e-4f * fmaxf(P->a1 - P->a0, P->b1 - P->b0);
 	P->a0 -= m;

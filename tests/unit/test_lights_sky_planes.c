@@ -136,16 +136,25 @@ static void test_light_sample_sky_portals(void **state)
 	check_light_sample(&l, x, v3(1, 0, 0), "+ sky sideways");
 	check_light_sample(&l, x, v3(0, 0, 0), "+ sky, no n");
 	/* From a point that sees the sun through no portal (above the window,
-	 * beside the triangle behind it; within that triangle's bounding
-	 * rectangle, which its frame along the hypotenuse makes larger). */
-	V3 x2 = v3(-0.6f, 0.5f, 0.2f), nx = v3_norm(v3(0.3f, -0.2f, 0.9f));
+	 * beside the triangle behind it, within that triangle's bounding
+	 * rectangle: a direction a plane's sampler may draw that the
+	 * triangles do not pass). */
+	V3 x2 = v3(-0.2f, 0.45f, 0.2f), nx = v3_norm(v3(0.3f, -0.2f, 0.9f));
 	SkyWeights sw;
 	sky_weights(&l.sc, x, nx, &sw);
 	assert_true(sky_portal_pdf_w(&l.sc, &sw, x, nx, sun) > 0.0f);
 	assert_int_equal(portal_crossings(&l.sc, x2, sun, 1), 0);
+	int sun_in_rect = 0;
 	for (int k = 0; k < 4; k++)
-		if (sky_rect(&l.planes[k], x2, &r))
+		if (sky_rect(&l.planes[k], x2, &r)) {
 			check_sky_uv(&l, k, x2, "");
+			float U, V, jac;
+			if (v3_dot(sun, l.planes[k].n) > 0.0f) {
+				sky_coords(&l.planes[k], sun, &U, &V, &jac);
+				sun_in_rect |= U >= r.U0 && U <= r.U1 && V >= r.V0 && V <= r.V1;
+			}
+		}
+	assert_true(sun_in_rect);
 	check_light_sample(&l, x2, v3(0, 0, 1), "+ sun outside");
 	lit_free(&l);
 }
